@@ -1,0 +1,75 @@
+//! The one error type of the library. Every variant carries what a user needs to act on it:
+//! the file, where in it (line or byte offset) and what was wrong.
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// Where in an input file a problem was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Location {
+    /// 1-based line number of a text format.
+    Line(u64),
+    /// 0-based byte offset into a binary format.
+    Byte(u64),
+    /// No finer position is known (for example an error reported by a third-party parser).
+    Unknown,
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Location::Line(n) => write!(f, "line {n}"),
+            Location::Byte(n) => write!(f, "byte offset {n}"),
+            Location::Unknown => write!(f, "unknown position"),
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path}: {location}: {message}")]
+    Parse {
+        path: PathBuf,
+        location: Location,
+        message: String,
+    },
+    #[error(
+        "{path}: unsupported file extension {ext:?} (supported: .obj, .ply, .stl, .gltf, .glb)"
+    )]
+    UnsupportedFormat { path: PathBuf, ext: String },
+    #[error("invalid mesh: {0}")]
+    InvalidMesh(String),
+    #[error("invalid option: {0}")]
+    InvalidOption(String),
+    #[error("refusing to overwrite the input file {0}; choose another output path")]
+    WouldOverwriteInput(PathBuf),
+}
+
+impl Error {
+    pub(crate) fn parse(
+        path: &std::path::Path,
+        location: Location,
+        message: impl Into<String>,
+    ) -> Self {
+        Error::Parse {
+            path: path.to_path_buf(),
+            location,
+            message: message.into(),
+        }
+    }
+    pub(crate) fn io(path: &std::path::Path, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,764 @@
+//! Backend `cpu`: greedy quadric edge collapse with a priority queue, in f64 — the quality
+//! reference every other backend is held against.
+//!
+//! The queue is lazy: an edge enters keyed by its quadric error alone, which is a lower bound of
+//! its full priority (error scaled up for poor triangle quality, MeshLab-style). When it comes out
+//! on top, the full priority and validity are computed; if the priority grew, it goes back in.
+//! So each pop does the expensive checks (link condition, flips, needles, quality) once for the
+//! edge that really is cheapest, and the many edges a collapse touches are only re-keyed cheaply.
+//! Entries are stamped with their endpoints' versions; a collapse bumps the survivor's version,
+//! which retires every older entry of its edges.
+
+use crate::error::Result;
+use crate::mesh::topology::{Dsu, edge_key};
+use crate::mesh::{Mesh, weld, weld::position_classes};
+use crate::quadric::Quadric;
+use crate::simplify::{SimplifyOptions, SimplifyReport, StopReason};
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// How a vertex may take part in collapses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Mobility {
+    /// May move and may be removed.
+    Free,
+    /// Keeps its position; may survive a collapse, never be removed: attribute seams and
+    /// non-manifold spots.
+    Pinned,
+    /// A border vertex under `lock_border`: keeps its position, and may be removed only by sliding
+    /// along a straight stretch of border onto a border neighbour.
+    LockedBorder,
+}
+
+/// Quality of a triangle as |cross| / longest edge²: 0 for a needle or sliver, √3/2 ≈ 0.866 for
+/// an equilateral triangle (the measure vcglib's quadric collapse uses, so its threshold of 0.3
+/// means the same here).
+pub(crate) fn triangle_quality(p0: [f64; 3], p1: [f64; 3], p2: [f64; 3]) -> f64 {
+    let d10 = sub(p1, p0);
+    let d20 = sub(p2, p0);
+    let d12 = sub(p1, p2);
+    let area2 = norm(cross(d10, d20));
+    let longest = dot(d10, d10).max(dot(d20, d20)).max(dot(d12, d12));
+    if longest > 0.0 { area2 / longest } else { 0.0 }
+}
+
+#[inline]
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+#[inline]
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+#[inline]
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+#[inline]
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// The prepared surface: welded topology, normalized positions, per-vertex quadrics and flags.
+/// Shared by the greedy backend and (later) the parallel ones, which start from the same state.
+pub(crate) struct Prepared {
+    /// Mesh after exact welding; its vertices are the "attribute vertices" written out.
+    pub mesh: Mesh,
+    /// Attribute vertex → topological vertex (position class).
+    pub topo: Vec<u32>,
+    /// Per topological vertex: one attribute vertex (the only one unless the vertex is a seam).
+    pub first_attr: Vec<u32>,
+    /// Faces with three distinct topological vertices, as attribute-vertex ids.
+    pub faces: Vec<[u32; 3]>,
+    /// Index of each kept face in `mesh.triangles` (for materials and groups).
+    pub face_origin: Vec<u32>,
+    /// Normalized positions per topological vertex: centred on the bounding box, divided by its
+    /// diagonal, so errors are relative to the diagonal and f32 GPU twins keep precision.
+    pub pos: Vec<[f64; 3]>,
+    pub quadrics: Vec<Quadric>,
+    pub mobility: Vec<Mobility>,
+    pub border: Vec<bool>,
+    pub center: [f64; 3],
+    pub scale: f64,
+    pub dropped_degenerate: usize,
+}
+
+impl Prepared {
+    pub fn new(input: &Mesh, opts: &SimplifyOptions) -> Prepared {
+        let mesh = weld(input).mesh;
+        let (topo, firsts) = position_classes(&mesh.positions);
+        let nt = firsts.len();
+        let mut attr_count = vec![0u32; nt];
+        for &t in &topo {
+            attr_count[t as usize] += 1;
+        }
+        let mut faces = Vec::with_capacity(mesh.triangles.len());
+        let mut face_origin = Vec::with_capacity(mesh.triangles.len());
+        for (f, t) in mesh.triangles.iter().enumerate() {
+            let [a, b, c] = t.map(|v| topo[v as usize]);
+            if a != b && b != c && a != c {
+                faces.push(*t);
+                face_origin.push(f as u32);
+            }
+        }
+        let dropped_degenerate = mesh.triangles.len() - faces.len();
+
+        let (center, scale) = match mesh.bounds() {
+            Some(b) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
+            Some(b) => (b.center(), 1.0),
+            None => ([0.0; 3], 1.0),
+        };
+        let pos: Vec<[f64; 3]> = firsts
+            .iter()
+            .map(|&v| {
+                let p = mesh.positions[v as usize];
+                [0, 1, 2].map(|i| (p[i] as f64 - center[i]) * scale)
+            })
+            .collect();
+
+        let tf = |f: &[u32; 3]| f.map(|v| topo[v as usize]);
+        let mut quadrics = vec![Quadric::default(); nt];
+        for f in &faces {
+            let t = tf(f);
+            let [p0, p1, p2] = t.map(|v| pos[v as usize]);
+            let c = cross(sub(p1, p0), sub(p2, p0));
+            let len = norm(c);
+            if len > 0.0 {
+                let n = c.map(|x| x / len);
+                let q = Quadric::from_plane(n, -dot(n, p0), 0.5 * len);
+                for v in t {
+                    quadrics[v as usize].add(&q);
+                }
+            }
+        }
+
+        // Edges with their face counts: 1 = border, 2 = manifold, more = non-manifold.
+        let mut half: Vec<(u64, u32)> = Vec::with_capacity(faces.len() * 3);
+        for (fi, f) in faces.iter().enumerate() {
+            let t = tf(f);
+            for i in 0..3 {
+                half.push((edge_key(t[i], t[(i + 1) % 3]), fi as u32));
+            }
+        }
+        half.sort_unstable();
+        let mut mobility: Vec<Mobility> = attr_count
+            .iter()
+            .map(|&c| {
+                if c > 1 {
+                    Mobility::Pinned
+                } else {
+                    Mobility::Free
+                }
+            })
+            .collect();
+        let mut border = vec![false; nt];
+        let mut corner_dsu = Dsu::new(faces.len() * 3);
+        let corner = |fi: u32, v: u32| {
+            fi * 3
+                + tf(&faces[fi as usize])
+                    .iter()
+                    .position(|&x| x == v)
+                    .unwrap_or(0) as u32
+        };
+        let mut i = 0;
+        while i < half.len() {
+            let mut j = i + 1;
+            while j < half.len() && half[j].0 == half[i].0 {
+                j += 1;
+            }
+            let (a, b) = ((half[i].0 >> 32) as u32, half[i].0 as u32);
+            match j - i {
+                1 => {
+                    border[a as usize] = true;
+                    border[b as usize] = true;
+                    // Hoppe's boundary constraint: a plane through the edge, perpendicular to
+                    // its face, weighted by the squared edge length so it scales like an area.
+                    let t = tf(&faces[half[i].1 as usize]);
+                    let [p0, p1, p2] = t.map(|v| pos[v as usize]);
+                    let fnrm = cross(sub(p1, p0), sub(p2, p0));
+                    let e = sub(pos[b as usize], pos[a as usize]);
+                    let n = cross(e, fnrm);
+                    let (ln, le2) = (norm(n), dot(e, e));
+                    if ln > 0.0 && opts.border_weight > 0.0 {
+                        let n = n.map(|x| x / ln);
+                        let q = Quadric::from_plane(
+                            n,
+                            -dot(n, pos[a as usize]),
+                            opts.border_weight * le2,
+                        );
+                        quadrics[a as usize].add(&q);
+                        quadrics[b as usize].add(&q);
+                    }
+                }
+                2 => {
+                    let (f1, f2) = (half[i].1, half[i + 1].1);
+                    corner_dsu.union(corner(f1, a), corner(f2, a));
+                    corner_dsu.union(corner(f1, b), corner(f2, b));
+                }
+                _ => {
+                    mobility[a as usize] = Mobility::Pinned;
+                    mobility[b as usize] = Mobility::Pinned;
+                }
+            }
+            i = j;
+        }
+        // A vertex whose faces form more than one fan (a bow-tie) is pinned: collapsing around
+        // it cannot keep the surface's topology well defined.
+        let mut fan = vec![u32::MAX; nt];
+        for (fi, f) in faces.iter().enumerate() {
+            for (k, v) in tf(f).into_iter().enumerate() {
+                let r = corner_dsu.find(fi as u32 * 3 + k as u32);
+                let s = &mut fan[v as usize];
+                if *s == u32::MAX {
+                    *s = r;
+                } else if *s != r {
+                    mobility[v as usize] = Mobility::Pinned;
+                }
+            }
+        }
+        if opts.lock_border {
+            for v in 0..nt {
+                if border[v] && mobility[v] == Mobility::Free {
+                    mobility[v] = Mobility::LockedBorder;
+                }
+            }
+        }
+        Prepared {
+            mesh,
+            topo,
+            first_attr: firsts,
+            faces,
+            face_origin,
+            pos,
+            quadrics,
+            mobility,
+            border,
+            center,
+            scale,
+            dropped_degenerate,
+        }
+    }
+
+    pub fn denormalize(&self, p: [f64; 3]) -> [f32; 3] {
+        [0, 1, 2].map(|i| (p[i] / self.scale + self.center[i]) as f32)
+    }
+}
+
+/// A collapse that passed every check: `remove` goes into `keep`, which moves to `pos`.
+#[derive(Debug, Clone, Copy)]
+struct Collapse {
+    keep: u32,
+    remove: u32,
+    pos: [f64; 3],
+    error: f64,
+    priority: f64,
+    /// Attribute vertex of `keep` that the removed vertex's corners take.
+    keep_attr: u32,
+}
+
+struct State<'a> {
+    opts: &'a SimplifyOptions,
+    p: Prepared,
+    topo_faces: Vec<[u32; 3]>,
+    face_alive: Vec<bool>,
+    vert_faces: Vec<Vec<u32>>,
+    alive: Vec<bool>,
+    version: Vec<u32>,
+    mark: Vec<u32>,
+    mark_gen: u32,
+    cos_max_angle: f64,
+    scratch: Vec<u32>,
+}
+
+type Entry = Reverse<(u32, u32, u32, u32)>;
+
+/// Non-negative f64 priorities as f32 bits keep the heap entries 16 bytes; ordering of
+/// non-negative IEEE floats equals ordering of their bit patterns.
+fn key(priority: f64) -> u32 {
+    (priority as f32).to_bits()
+}
+
+impl<'a> State<'a> {
+    fn next_mark(&mut self) -> u32 {
+        self.mark_gen = self.mark_gen.wrapping_add(1);
+        if self.mark_gen == 0 {
+            self.mark.iter_mut().for_each(|m| *m = 0);
+            self.mark_gen = 1;
+        }
+        self.mark_gen
+    }
+
+    fn stamp(&self, a: u32, b: u32) -> u32 {
+        self.version[a as usize].wrapping_add(self.version[b as usize])
+    }
+
+    /// Position and quadric error of collapsing edge (a, b), ignoring validity: the queue key.
+    fn placement(&self, a: u32, b: u32) -> Option<(u32, u32, [f64; 3], f64)> {
+        let (ma, mb) = (self.p.mobility[a as usize], self.p.mobility[b as usize]);
+        let q = self.p.quadrics[a as usize].sum(&self.p.quadrics[b as usize]);
+        let (pa, pb) = (self.p.pos[a as usize], self.p.pos[b as usize]);
+        use Mobility::{Free, LockedBorder, Pinned};
+        match (ma, mb) {
+            (Free, Free) => {
+                let (pos, err) = match q.optimum() {
+                    Some(p) => (p, q.eval(p)),
+                    None => {
+                        let mid = [0, 1, 2].map(|i| 0.5 * (pa[i] + pb[i]));
+                        [pa, pb, mid].into_iter().map(|p| (p, q.eval(p))).fold(
+                            (mid, f64::INFINITY),
+                            |best, c| if c.1 < best.1 { c } else { best },
+                        )
+                    }
+                };
+                // The survivor is the endpoint nearer the new position: its attributes fit best.
+                let (keep, remove) =
+                    if dot(sub(pos, pa), sub(pos, pa)) <= dot(sub(pos, pb), sub(pos, pb)) {
+                        (a, b)
+                    } else {
+                        (b, a)
+                    };
+                Some((keep, remove, pos, err))
+            }
+            (Pinned | LockedBorder, Free) => Some((a, b, pa, q.eval(pa))),
+            (Free, Pinned | LockedBorder) => Some((b, a, pb, q.eval(pb))),
+            (Pinned, Pinned) => None,
+            (Pinned | LockedBorder, LockedBorder) | (LockedBorder, Pinned) => {
+                // A locked border may shed a vertex that lies on the straight line between its
+                // border neighbours: the outline does not change.
+                for (keep, remove) in [(a, b), (b, a)] {
+                    if self.p.mobility[remove as usize] == LockedBorder
+                        && self.on_straight_border(remove, keep)
+                    {
+                        let pk = self.p.pos[keep as usize];
+                        return Some((keep, remove, pk, q.eval(pk)));
+                    }
+                }
+                None
+            }
+        }
+    }
+
+    /// True when `v` is a border vertex, `(v, toward)` a border edge, and `v` lies on the segment
+    /// between its two border neighbours (relative tolerance 1e-9 of the segment length²).
+    fn on_straight_border(&self, v: u32, toward: u32) -> bool {
+        let nbrs = self.border_neighbours(v);
+        if nbrs.len() != 2 || !nbrs.contains(&toward) {
+            return false;
+        }
+        let (p0, p1, pv) = (
+            self.p.pos[nbrs[0] as usize],
+            self.p.pos[nbrs[1] as usize],
+            self.p.pos[v as usize],
+        );
+        let d = sub(p1, p0);
+        let c = cross(d, sub(pv, p0));
+        let l2 = dot(d, d);
+        l2 > 0.0
+            && dot(c, c) <= 1e-18 * l2 * l2
+            && dot(sub(pv, p0), d) > 0.0
+            && dot(sub(pv, p1), d) < 0.0
+    }
+
+    /// Neighbours of `v` across border edges (edges with one live face).
+    fn border_neighbours(&self, v: u32) -> Vec<u32> {
+        let mut count: Vec<(u32, u32)> = Vec::new();
+        for &f in &self.vert_faces[v as usize] {
+            if !self.face_alive[f as usize] {
+                continue;
+            }
+            for &u in &self.topo_faces[f as usize] {
+                if u != v {
+                    match count.iter_mut().find(|e| e.0 == u) {
+                        Some(e) => e.1 += 1,
+                        None => count.push((u, 1)),
+                    }
+                }
+            }
+        }
+        count
+            .into_iter()
+            .filter(|e| e.1 == 1)
+            .map(|e| e.0)
+            .collect()
+    }
+
+    /// Full evaluation of edge (a, b): placement, then the checks that keep the mesh valid, then
+    /// the quality-weighted priority. `None` when the collapse is not allowed now.
+    fn evaluate(&mut self, a: u32, b: u32) -> Option<Collapse> {
+        let (keep, remove, pos, error) = self.placement(a, b)?;
+        let (k, r) = (keep as usize, remove as usize);
+
+        // Link condition: the common neighbours of the endpoints are exactly the vertices
+        // opposite the edge in its faces (Dey et al. 1999), which keeps a manifold manifold.
+        let m = self.next_mark();
+        for &f in &self.vert_faces[k] {
+            if self.face_alive[f as usize] {
+                for &u in &self.topo_faces[f as usize] {
+                    self.mark[u as usize] = m;
+                }
+            }
+        }
+        let mut edge_faces = 0u32;
+        let mut opposite = [u32::MAX; 2];
+        self.scratch.clear();
+        for &f in &self.vert_faces[r] {
+            if !self.face_alive[f as usize] {
+                continue;
+            }
+            let t = self.topo_faces[f as usize];
+            if t.contains(&keep) {
+                if edge_faces >= 2 {
+                    return None;
+                }
+                opposite[edge_faces as usize] =
+                    t.into_iter().find(|&u| u != keep && u != remove)?;
+                edge_faces += 1;
+            }
+            for u in t {
+                if u != keep && u != remove && self.mark[u as usize] == m {
+                    self.scratch.push(u);
+                }
+            }
+        }
+        if edge_faces == 0 {
+            return None;
+        }
+        self.scratch.sort_unstable();
+        self.scratch.dedup();
+        if self.scratch.len() != edge_faces as usize {
+            return None;
+        }
+        // Joining two border vertices through the interior would pinch the surface.
+        if edge_faces == 2 && self.p.border[k] && self.p.border[r] {
+            return None;
+        }
+        // A tetrahedral fan: faces (keep, c, d) and (remove, c, d) would become one face twice.
+        if edge_faces == 2 {
+            let [c, d] = opposite;
+            let has = |s: &Self, v: usize| {
+                s.vert_faces[v].iter().any(|&f| {
+                    s.face_alive[f as usize] && {
+                        let t = s.topo_faces[f as usize];
+                        t.contains(&c) && t.contains(&d)
+                    }
+                })
+            };
+            if has(self, k) && has(self, r) {
+                return None;
+            }
+        }
+        // A closed surface must not shrink below a tetrahedron; the link condition alone allows
+        // the last collapses of tiny components.
+        // (Covered by the tetrahedral check above for closed components.)
+
+        // Attribute vertex of `keep` that the removed vertex's corners take: the one `keep` uses
+        // in the faces on the edge, which must agree.
+        let mut keep_attr = u32::MAX;
+        for &f in &self.vert_faces[r] {
+            if !self.face_alive[f as usize] {
+                continue;
+            }
+            let t = self.topo_faces[f as usize];
+            if let Some(i) = t.iter().position(|&u| u == keep) {
+                let av = self.p.faces[f as usize][i];
+                if keep_attr != u32::MAX && keep_attr != av {
+                    return None;
+                }
+                keep_attr = av;
+            }
+        }
+
+        // Faces that move: the normal may not turn more than the limit, no needle may appear,
+        // and the worst resulting quality scales the priority.
+        let mut min_quality = f64::INFINITY;
+        for (moved, other) in [(k, r), (r, k)] {
+            for &f in &self.vert_faces[moved] {
+                if !self.face_alive[f as usize] {
+                    continue;
+                }
+                let t = self.topo_faces[f as usize];
+                if t.contains(&(other as u32)) {
+                    continue;
+                }
+                let old = t.map(|u| self.p.pos[u as usize]);
+                let new = t.map(|u| {
+                    if u as usize == moved {
+                        pos
+                    } else {
+                        self.p.pos[u as usize]
+                    }
+                });
+                let n_old = cross(sub(old[1], old[0]), sub(old[2], old[0]));
+                let n_new = cross(sub(new[1], new[0]), sub(new[2], new[0]));
+                let (l_old, l_new) = (norm(n_old), norm(n_new));
+                if l_new <= 0.0 {
+                    return None;
+                }
+                if l_old > 0.0 && dot(n_old, n_new) < self.cos_max_angle * l_old * l_new {
+                    return None;
+                }
+                let q_new = triangle_quality(new[0], new[1], new[2]);
+                if q_new < self.opts.min_quality && q_new < triangle_quality(old[0], old[1], old[2])
+                {
+                    return None;
+                }
+                min_quality = min_quality.min(q_new);
+            }
+        }
+        let qt = self.opts.quality_threshold;
+        let priority = if qt > 0.0 && min_quality < qt {
+            error * qt / min_quality.max(1e-12)
+        } else {
+            error
+        };
+        Some(Collapse {
+            keep,
+            remove,
+            pos,
+            error,
+            priority,
+            keep_attr,
+        })
+    }
+
+    /// Applies a checked collapse; returns how many faces it removed.
+    fn apply(&mut self, c: &Collapse) -> usize {
+        let (k, r) = (c.keep as usize, c.remove as usize);
+        self.p.pos[k] = c.pos;
+        let qr = self.p.quadrics[r];
+        self.p.quadrics[k].add(&qr);
+        self.p.border[k] |= self.p.border[r];
+        self.alive[r] = false;
+        let remove_attr = self.p.first_attr[r];
+        let mut removed = 0;
+        let moved: Vec<u32> = std::mem::take(&mut self.vert_faces[r]);
+        for &f in &moved {
+            let fu = f as usize;
+            if !self.face_alive[fu] {
+                continue;
+            }
+            if self.topo_faces[fu].contains(&c.keep) {
+                self.face_alive[fu] = false;
+                removed += 1;
+                continue;
+            }
+            for i in 0..3 {
+                if self.topo_faces[fu][i] == c.remove {
+                    self.topo_faces[fu][i] = c.keep;
+                    debug_assert_eq!(
+                        self.p.faces[fu][i], remove_attr,
+                        "a free vertex has one attribute vertex"
+                    );
+                    self.p.faces[fu][i] = c.keep_attr;
+                }
+            }
+            self.vert_faces[k].push(f);
+        }
+        let alive = &self.face_alive;
+        self.vert_faces[k].retain(|&f| alive[f as usize]);
+        self.version[k] = self.version[k].wrapping_add(1);
+        removed
+    }
+
+    /// Queues every edge around `v` with its cheap lower-bound key.
+    fn push_edges_of(&mut self, v: u32, heap: &mut BinaryHeap<Entry>) {
+        let m = self.next_mark();
+        self.mark[v as usize] = m;
+        for i in 0..self.vert_faces[v as usize].len() {
+            let f = self.vert_faces[v as usize][i] as usize;
+            for u in self.topo_faces[f] {
+                if self.mark[u as usize] != m {
+                    self.mark[u as usize] = m;
+                    if let Some((_, _, _, err)) = self.placement(v, u) {
+                        let (lo, hi) = if v < u { (v, u) } else { (u, v) };
+                        heap.push(Reverse((key(err), lo, hi, self.stamp(lo, hi))));
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Greedy simplification; `progress` receives the fraction of the needed collapses done.
+pub fn simplify_greedy(
+    input: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport)> {
+    let prepared = Prepared::new(input, opts);
+    let nt = prepared.pos.len();
+    let nf = prepared.faces.len();
+    let topo_faces: Vec<[u32; 3]> = prepared
+        .faces
+        .iter()
+        .map(|f| f.map(|v| prepared.topo[v as usize]))
+        .collect();
+    let mut counts = vec![0u32; nt];
+    for t in &topo_faces {
+        for &v in t {
+            counts[v as usize] += 1;
+        }
+    }
+    let mut vert_faces: Vec<Vec<u32>> = counts
+        .iter()
+        .map(|&c| Vec::with_capacity(c as usize))
+        .collect();
+    for (f, t) in topo_faces.iter().enumerate() {
+        for &v in t {
+            vert_faces[v as usize].push(f as u32);
+        }
+    }
+    let pinned_vertices = prepared
+        .mobility
+        .iter()
+        .filter(|&&m| m == Mobility::Pinned)
+        .count();
+    let mut s = State {
+        opts,
+        p: prepared,
+        topo_faces,
+        face_alive: vec![true; nf],
+        vert_faces,
+        alive: vec![true; nt],
+        version: vec![0; nt],
+        mark: vec![0; nt],
+        mark_gen: 0,
+        cos_max_angle: opts.max_normal_angle_deg.to_radians().cos(),
+        scratch: Vec::new(),
+    };
+
+    // Initial queue: each unique edge once, keyed by its quadric error.
+    let mut edges: Vec<u64> = Vec::with_capacity(nf * 3);
+    for t in &s.topo_faces {
+        for i in 0..3 {
+            edges.push(edge_key(t[i], t[(i + 1) % 3]));
+        }
+    }
+    edges.sort_unstable();
+    edges.dedup();
+    let mut entries: Vec<Entry> = Vec::with_capacity(edges.len());
+    for e in edges {
+        let (a, b) = ((e >> 32) as u32, e as u32);
+        if let Some((_, _, _, err)) = s.placement(a, b) {
+            entries.push(Reverse((key(err), a, b, 0)));
+        }
+    }
+    let mut heap = BinaryHeap::from(entries);
+
+    let target = opts.target_faces;
+    let max_err2 = opts.max_error.map(|e| e * e);
+    let mut faces = nf;
+    let mut collapses = 0;
+    let mut max_collapse_err2: f64 = 0.0;
+    let mut hit_max_error = false;
+    let need = nf.saturating_sub(target).max(1) as f32;
+    let mut next_report = 0usize;
+    while faces > target {
+        let Some(Reverse((k, a, b, stamp))) = heap.pop() else {
+            break;
+        };
+        if !s.alive[a as usize] || !s.alive[b as usize] || s.stamp(a, b) != stamp {
+            continue;
+        }
+        let Some(c) = s.evaluate(a, b) else { continue };
+        let full = key(c.priority);
+        if full > k {
+            heap.push(Reverse((full, a, b, stamp)));
+            continue;
+        }
+        let q = s.p.quadrics[c.keep as usize].sum(&s.p.quadrics[c.remove as usize]);
+        let err2 = if q.weight > 0.0 {
+            c.error / q.weight
+        } else {
+            0.0
+        };
+        if let Some(m) = max_err2 {
+            if err2 > m {
+                hit_max_error = true;
+                continue;
+            }
+        }
+        // An interior collapse removes two faces; never go more than one below the target.
+        let on_edge = s.vert_faces[c.remove as usize]
+            .iter()
+            .filter(|&&f| s.face_alive[f as usize] && s.topo_faces[f as usize].contains(&c.keep))
+            .count();
+        if faces - on_edge + 1 < target {
+            continue;
+        }
+        faces -= s.apply(&c);
+        collapses += 1;
+        max_collapse_err2 = max_collapse_err2.max(err2);
+        s.push_edges_of(c.keep, &mut heap);
+        if collapses >= next_report {
+            progress((nf - faces) as f32 / need);
+            next_report = collapses + 4096;
+        }
+    }
+    progress(1.0);
+
+    let stop_reason = if faces <= target {
+        StopReason::TargetReached
+    } else if hit_max_error {
+        StopReason::MaxError
+    } else {
+        StopReason::NoValidCollapse
+    };
+    let out = build_output(&s.p, &s.face_alive, &s.alive, input.normals.is_some());
+    let report = SimplifyReport {
+        backend: opts.backend,
+        input_faces: input.triangles.len(),
+        target_faces: target,
+        output_faces: out.triangles.len(),
+        input_vertices: input.positions.len(),
+        output_vertices: out.positions.len(),
+        collapses,
+        max_collapse_error: max_collapse_err2.sqrt(),
+        stop_reason,
+        dropped_degenerate_faces: s.p.dropped_degenerate,
+        pinned_vertices,
+    };
+    Ok((out, report))
+}
+
+/// The output mesh: live faces with their materials and groups, positions moved back out of the
+/// normalized frame, unused vertices dropped, normals recomputed when the input had normals.
+pub(crate) fn build_output(
+    p: &Prepared,
+    face_alive: &[bool],
+    vertex_alive: &[bool],
+    normals: bool,
+) -> Mesh {
+    let mut out = p.mesh.clone_without_geometry();
+    out.positions = p.mesh.positions.clone();
+    out.uvs = p.mesh.uvs.clone();
+    out.colors = p.mesh.colors.clone();
+    for (v, pos) in out.positions.iter_mut().enumerate() {
+        let t = p.topo[v] as usize;
+        if vertex_alive[t] {
+            *pos = p.denormalize(p.pos[t]);
+        }
+    }
+    let live: Vec<usize> = (0..p.faces.len()).filter(|&f| face_alive[f]).collect();
+    out.triangles = live.iter().map(|&f| p.faces[f]).collect();
+    let origin = |f: usize| p.face_origin[f] as usize;
+    out.face_materials = p
+        .mesh
+        .face_materials
+        .as_ref()
+        .map(|m| live.iter().map(|&f| m[origin(f)]).collect());
+    out.face_groups = p
+        .mesh
+        .face_groups
+        .as_ref()
+        .map(|g| live.iter().map(|&f| g[origin(f)]).collect());
+    out.remove_unused_vertices();
+    if normals {
+        out.recompute_normals();
+    }
+    out
+}

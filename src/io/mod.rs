@@ -1,0 +1,160 @@
+//! Reading and writing meshes: OBJ, PLY, STL, glTF and GLB, chosen by file extension.
+//!
+//! Every reader returns a mesh that passed [`Mesh::validate`] (a failure becomes a
+//! [`Error::Parse`] naming the file) and reports malformed input as an error with the file and,
+//! where it can, the line (text formats and headers) or byte offset (binary formats). No reader
+//! allocates what a header declares before the data is there, and none panics on any input.
+//! Zero-area faces are kept by every reader: they are valid topology and the topology report
+//! counts them. Each format module documents what it reads, what it writes and what it repairs.
+//!
+//! Writes are atomic: the file is written to a temporary file in the target's directory and then
+//! renamed over the target, so a failed or interrupted write never leaves a half-written file.
+
+pub mod gltf;
+pub mod obj;
+pub mod ply;
+pub mod stl;
+
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use crate::error::{Error, Location, Result};
+use crate::mesh::Mesh;
+
+/// A mesh file format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Format {
+    Obj,
+    Ply,
+    Stl,
+    /// glTF 2.0 JSON (`.gltf`); written with the buffer embedded as a base64 data URI.
+    Gltf,
+    /// Binary glTF 2.0 (`.glb`).
+    Glb,
+}
+
+impl Format {
+    /// The format a path's extension names (case-insensitive).
+    pub fn from_path(path: &Path) -> Result<Format> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        Ok(match ext.as_str() {
+            "obj" => Format::Obj,
+            "ply" => Format::Ply,
+            "stl" => Format::Stl,
+            "gltf" => Format::Gltf,
+            "glb" => Format::Glb,
+            _ => {
+                return Err(Error::UnsupportedFormat {
+                    path: path.to_path_buf(),
+                    ext,
+                });
+            }
+        })
+    }
+
+    /// The usual file extension, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Obj => "obj",
+            Format::Ply => "ply",
+            Format::Stl => "stl",
+            Format::Gltf => "gltf",
+            Format::Glb => "glb",
+        }
+    }
+}
+
+/// Choices for writers whose format has variants. The default is binary for both.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct WriteOptions {
+    /// Write PLY as ascii instead of binary little endian.
+    pub ply_ascii: bool,
+    /// Write STL as ascii instead of binary.
+    pub stl_ascii: bool,
+}
+
+/// Reads a mesh, the format chosen by the file extension.
+pub fn read(path: &Path) -> Result<Mesh> {
+    read_format(path, Format::from_path(path)?)
+}
+
+/// Reads a mesh in the given format, whatever the extension.
+pub fn read_format(path: &Path, format: Format) -> Result<Mesh> {
+    let mesh = match format {
+        Format::Obj => obj::read(path)?,
+        Format::Ply => ply::read(path)?,
+        Format::Stl => stl::read(path)?,
+        Format::Gltf | Format::Glb => gltf::read(path)?,
+    };
+    mesh.validate()
+        .map_err(|e| Error::parse(path, Location::Unknown, e.to_string()))?;
+    Ok(mesh)
+}
+
+/// Writes a mesh with the default options, the format chosen by the file extension.
+pub fn write(path: &Path, mesh: &Mesh) -> Result<()> {
+    write_with(path, mesh, &WriteOptions::default())
+}
+
+/// Writes a mesh, the format chosen by the file extension.
+pub fn write_with(path: &Path, mesh: &Mesh, options: &WriteOptions) -> Result<()> {
+    write_format(path, mesh, Format::from_path(path)?, options)
+}
+
+/// Writes a mesh in the given format, atomically (temporary file in the same directory, then a
+/// rename over `path`). The mesh is validated first.
+pub fn write_format(
+    path: &Path,
+    mesh: &Mesh,
+    format: Format,
+    options: &WriteOptions,
+) -> Result<()> {
+    mesh.validate()?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".meshslim-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|e| Error::io(path, e))?;
+    {
+        let mut w = BufWriter::with_capacity(1 << 16, tmp.as_file_mut());
+        let r = match format {
+            Format::Obj => obj::write_obj(&mut w, mesh),
+            Format::Ply => ply::write_ply(
+                &mut w,
+                mesh,
+                if options.ply_ascii {
+                    ply::PlyEncoding::Ascii
+                } else {
+                    ply::PlyEncoding::BinaryLittleEndian
+                },
+            ),
+            Format::Stl if options.stl_ascii => stl::write_ascii(&mut w, mesh),
+            Format::Stl => stl::write_binary(&mut w, mesh),
+            Format::Gltf => gltf::write_gltf(&mut w, mesh, false),
+            Format::Glb => gltf::write_gltf(&mut w, mesh, true),
+        };
+        r.and_then(|()| w.flush()).map_err(|e| Error::io(path, e))?;
+    }
+    tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
+    // A temporary file is created private (0600); give the result the permissions the target had,
+    // or the usual 0644 for a new file.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(path)
+            .map(|m| m.permissions().mode() & 0o7777)
+            .unwrap_or(0o644);
+        let _ = tmp
+            .as_file()
+            .set_permissions(std::fs::Permissions::from_mode(mode));
+    }
+    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    Ok(())
+}

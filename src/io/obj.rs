@@ -1,0 +1,499 @@
+//! Wavefront OBJ.
+//!
+//! The reader is a line parser of its own rather than `tobj`: tobj duplicates every vertex a
+//! second object/group/material uses, renumbers vertices in order of first use, misaligns
+//! attributes when corners mix forms (`v` and `v/vt`), reports no line numbers and overflows
+//! (a panic in debug builds) on an out-of-range relative texture index. Parsing OBJ is simple
+//! enough that doing it here gives exact round trips and useful errors. (A test checks that this
+//! reader and tobj agree on the triangles of a small file.)
+//!
+//! Supported: `v x y z [w]` (divided by `w`) and `v x y z r g b` (vertex colours, alpha 1);
+//! `vt u [v [w]]`; `vn`; faces `f` with corners `v`, `v/vt`, `v//vn`, `v/vt/vn`, positive or
+//! negative (relative) indices, polygons fan-triangulated; `o` and `g` start a group (the whole
+//! rest of the line is the name; a name seen again reuses its group); `usemtl` selects a material
+//! by name; `mtllib` names are kept verbatim in `material_libs`. The `.mtl` files are never opened,
+//! so a missing one is not an error. Lines (`l`), points (`p`), smoothing groups, free-form geometry
+//! and unknown statements are ignored.
+//!
+//! Vertices: mesh vertex `i` is the file's `i`-th `v` line (unused positions included), carrying
+//! the attributes of the first corner that uses it. A corner that pairs the same position with a
+//! different `vt`/`vn` (an attribute seam) becomes an extra vertex appended after the file's
+//! positions. Corners without `vt`/`vn` in a file that has them get a zero UV / zero normal;
+//! positions without a colour in a file that has some get white. A position no face uses takes the
+//! `vt`/`vn` of the same number when the file has exactly one per position (as `write_obj`
+//! writes), else none.
+//!
+//! Groups and materials: `face_groups`/`face_materials` are `None` when the file has no `o`/`g`
+//! (resp. `usemtl`) statement. Names are numbered in order of their first statement; faces before
+//! the first statement go to a group/material named `default`.
+//!
+//! Errors (all with the line): malformed numbers, non-finite values, index 0, indices out of range
+//! (indices must refer to elements defined before the face, as the format specifies), faces with
+//! fewer than three corners. Zero-area faces are kept.
+
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::{self, BufRead, BufReader, Write};
+use std::path::Path;
+
+use crate::error::{Error, Location, Result};
+use crate::mesh::{Material, Mesh};
+
+const NONE: u32 = u32::MAX;
+/// Tags a seam vertex number in `triangles` while parsing.
+const SEAM: u32 = 1 << 31;
+
+/// Names numbered in order of first appearance.
+#[derive(Default)]
+struct Names {
+    list: Vec<String>,
+    map: HashMap<String, u32>,
+    used: bool,
+}
+
+impl Names {
+    fn id(&mut self, name: &str) -> u32 {
+        if let Some(&i) = self.map.get(name) {
+            return i;
+        }
+        let i = self.list.len() as u32;
+        self.list.push(name.to_string());
+        self.map.insert(name.to_string(), i);
+        i
+    }
+}
+
+/// Reads an OBJ file.
+pub fn read(path: &Path) -> Result<Mesh> {
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    read_from(BufReader::with_capacity(1 << 16, file), path)
+}
+
+fn read_from(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
+    let mut positions: Vec<[f32; 3]> = Vec::new();
+    let mut colors: Vec<[f32; 4]> = Vec::new();
+    let mut any_color = false;
+    let mut texcoords: Vec<[f32; 2]> = Vec::new();
+    let mut normals: Vec<[f32; 3]> = Vec::new();
+    // For each position: the (vt, vn) of the vertex that bears the position's index.
+    let mut pos_key: Vec<[u32; 2]> = Vec::new();
+    let mut pos_used: Vec<bool> = Vec::new();
+    // Attribute seams: extra vertices appended after the file's positions, tagged with SEAM
+    // in `triangles` until the number of positions is known.
+    let mut seams: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut seam_keys: Vec<[u32; 3]> = Vec::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let mut face_groups: Vec<u32> = Vec::new();
+    let mut face_materials: Vec<u32> = Vec::new();
+    let mut groups = Names::default();
+    let mut materials = Names::default();
+    let mut cur_group = NONE;
+    let mut cur_mat = NONE;
+    let mut libs = Vec::new();
+    let mut any_vt_corner = false;
+    let mut any_vn_corner = false;
+    let mut poly: Vec<u32> = Vec::new();
+
+    let mut buf = Vec::new();
+    let mut line_no = 0u64;
+    loop {
+        buf.clear();
+        let n = r
+            .read_until(b'\n', &mut buf)
+            .map_err(|e| Error::io(path, e))?;
+        if n == 0 {
+            break;
+        }
+        line_no += 1;
+        let at = Location::Line(line_no);
+        let err = |m: String| Error::parse(path, at, m);
+        let text = String::from_utf8_lossy(&buf);
+        let line = text.trim();
+        let (kw, rest) = match line.find(|c: char| c.is_ascii_whitespace()) {
+            Some(i) => (&line[..i], line[i..].trim()),
+            None => (line, ""),
+        };
+        let floats = |rest: &str, what: &str| -> Result<Vec<f32>> {
+            rest.split_ascii_whitespace()
+                .map(|t| {
+                    let x: f32 = t
+                        .parse()
+                        .map_err(|_| err(format!("{what}: {t:?} is not a number")))?;
+                    if x.is_finite() {
+                        Ok(x)
+                    } else {
+                        Err(err(format!("{what} has a non-finite value {t}")))
+                    }
+                })
+                .collect()
+        };
+        match kw {
+            "v" => {
+                let what = format!("vertex {}", positions.len() + 1);
+                let f = floats(rest, &what)?;
+                let p = match f.len() {
+                    3 | 6 => [f[0], f[1], f[2]],
+                    4 if f[3] != 0.0 => [f[0] / f[3], f[1] / f[3], f[2] / f[3]],
+                    4 => return Err(err(format!("{what} has w = 0"))),
+                    n => {
+                        return Err(err(format!(
+                            "{what}: expected 3, 4 or 6 numbers, found {n}"
+                        )));
+                    }
+                };
+                if !p.iter().all(|c| c.is_finite()) {
+                    return Err(err(format!("{what} has a non-finite coordinate {p:?}")));
+                }
+                if f.len() == 6 {
+                    if !any_color {
+                        any_color = true;
+                        colors.resize(positions.len(), [1.0; 4]);
+                    }
+                    colors.push([f[3], f[4], f[5], 1.0]);
+                } else if any_color {
+                    colors.push([1.0; 4]);
+                }
+                if positions.len() >= SEAM as usize - 1 {
+                    return Err(err("too many vertices for 32-bit indices".into()));
+                }
+                positions.push(p);
+                pos_key.push([NONE; 2]);
+                pos_used.push(false);
+            }
+            "vt" => {
+                let f = floats(rest, "texture coordinate")?;
+                if f.is_empty() || f.len() > 3 {
+                    return Err(err(format!(
+                        "texture coordinate: expected 1 to 3 numbers, found {}",
+                        f.len()
+                    )));
+                }
+                texcoords.push([f[0], f.get(1).copied().unwrap_or(0.0)]);
+            }
+            "vn" => {
+                let f = floats(rest, "normal")?;
+                if f.len() != 3 {
+                    return Err(err(format!(
+                        "normal: expected 3 numbers, found {}",
+                        f.len()
+                    )));
+                }
+                normals.push([f[0], f[1], f[2]]);
+            }
+            "f" | "fo" => {
+                poly.clear();
+                for c in rest.split_ascii_whitespace() {
+                    let mut parts = c.split('/');
+                    let mut idx = [NONE; 3];
+                    let counts = [positions.len(), texcoords.len(), normals.len()];
+                    let names = ["vertex", "texture coordinate", "normal"];
+                    for k in 0..3 {
+                        let Some(s) = parts.next() else { break };
+                        if s.is_empty() {
+                            if k == 0 {
+                                return Err(err(format!("face corner {c:?} has no vertex index")));
+                            }
+                            continue;
+                        }
+                        let i: i64 = s.parse().map_err(|_| {
+                            err(format!("face corner {c:?}: {s:?} is not an index"))
+                        })?;
+                        let n = counts[k] as i64;
+                        let abs = if i > 0 {
+                            i - 1
+                        } else if i < 0 {
+                            n + i
+                        } else {
+                            return Err(err(format!(
+                                "face corner {c:?}: OBJ indices start at 1, not 0"
+                            )));
+                        };
+                        if abs < 0 || abs >= n {
+                            return Err(err(format!(
+                                "face corner {c:?}: {} index {i} is out of range ({n} {}s defined before this line)",
+                                names[k], names[k]
+                            )));
+                        }
+                        idx[k] = abs as u32;
+                    }
+                    if parts.next().is_some() {
+                        return Err(err(format!(
+                            "face corner {c:?} has more than three indices"
+                        )));
+                    }
+                    any_vt_corner |= idx[1] != NONE;
+                    any_vn_corner |= idx[2] != NONE;
+                    let pos = idx[0] as usize;
+                    let key = [idx[1], idx[2]];
+                    let v = if !pos_used[pos] {
+                        pos_used[pos] = true;
+                        pos_key[pos] = key;
+                        pos as u32
+                    } else if pos_key[pos] == key {
+                        pos as u32
+                    } else {
+                        let next = seam_keys.len() as u32;
+                        let id = *seams.entry(idx).or_insert(next);
+                        if id == next {
+                            if next >= SEAM - 1 {
+                                return Err(err("too many vertices for 32-bit indices".into()));
+                            }
+                            seam_keys.push(idx);
+                        }
+                        id | SEAM
+                    };
+                    poly.push(v);
+                }
+                if poly.len() < 3 {
+                    return Err(err(format!(
+                        "face with {} corners; a face needs at least 3",
+                        poly.len()
+                    )));
+                }
+                for j in 1..poly.len() - 1 {
+                    triangles.push([poly[0], poly[j], poly[j + 1]]);
+                    face_groups.push(cur_group);
+                    face_materials.push(cur_mat);
+                }
+            }
+            "o" | "g" => {
+                groups.used = true;
+                cur_group = groups.id(if rest.is_empty() { "default" } else { rest });
+            }
+            "usemtl" => {
+                materials.used = true;
+                cur_mat = materials.id(if rest.is_empty() { "default" } else { rest });
+            }
+            "mtllib" if !rest.is_empty() => libs.push(rest.to_string()),
+            _ => {}
+        }
+    }
+    if line_no == 0 {
+        return Err(Error::parse(path, Location::Byte(0), "empty file"));
+    }
+    if positions.is_empty() {
+        return Err(Error::parse(
+            path,
+            Location::Line(line_no),
+            "no vertices (`v` lines) found",
+        ));
+    }
+    let np = positions.len() as u32;
+    if (np as u64) + seam_keys.len() as u64 >= u32::MAX as u64 {
+        return Err(Error::parse(
+            path,
+            Location::Line(line_no),
+            "too many vertices for 32-bit indices",
+        ));
+    }
+    for t in &mut triangles {
+        *t = t.map(|v| if v & SEAM != 0 { np + (v & !SEAM) } else { v });
+    }
+    // (position, vt, vn) of every mesh vertex.
+    // A position no face uses takes the vt/vn of the same number when the file has one per
+    // position (as files written by `write_obj` do).
+    let (same_t, same_n) = (texcoords.len() == np as usize, normals.len() == np as usize);
+    let corners_of: Vec<[u32; 3]> = (0..np)
+        .map(|p| match pos_used[p as usize] {
+            true => [p, pos_key[p as usize][0], pos_key[p as usize][1]],
+            false => [
+                p,
+                if same_t { p } else { NONE },
+                if same_n { p } else { NONE },
+            ],
+        })
+        .chain(seam_keys)
+        .collect();
+    let mut mesh = Mesh {
+        positions: corners_of
+            .iter()
+            .map(|c| positions[c[0] as usize])
+            .collect(),
+        triangles,
+        ..Default::default()
+    };
+    if any_vt_corner {
+        mesh.uvs = Some(
+            corners_of
+                .iter()
+                .map(|c| texcoords.get(c[1] as usize).copied().unwrap_or([0.0; 2]))
+                .collect(),
+        );
+    }
+    if any_vn_corner {
+        mesh.normals = Some(
+            corners_of
+                .iter()
+                .map(|c| normals.get(c[2] as usize).copied().unwrap_or([0.0; 3]))
+                .collect(),
+        );
+    }
+    if any_color {
+        mesh.colors = Some(corners_of.iter().map(|c| colors[c[0] as usize]).collect());
+    }
+    if groups.used {
+        let d = if face_groups.contains(&NONE) {
+            groups.id("default")
+        } else {
+            0
+        };
+        mesh.face_groups = Some(
+            face_groups
+                .into_iter()
+                .map(|g| if g == NONE { d } else { g })
+                .collect(),
+        );
+        mesh.groups = groups.list;
+    }
+    if materials.used {
+        let d = if face_materials.contains(&NONE) {
+            materials.id("default")
+        } else {
+            0
+        };
+        mesh.face_materials = Some(
+            face_materials
+                .into_iter()
+                .map(|m| if m == NONE { d } else { m })
+                .collect(),
+        );
+        mesh.materials = materials
+            .list
+            .into_iter()
+            .map(|name| Material { name })
+            .collect();
+    }
+    mesh.material_libs = libs;
+    Ok(mesh)
+}
+
+/// A name as it can stand on one OBJ line.
+fn one_line(name: &str) -> String {
+    let s: String = name
+        .chars()
+        .map(|c| if c == '\n' || c == '\r' { ' ' } else { c })
+        .collect();
+    let s = s.trim();
+    if s.is_empty() {
+        "default".to_string()
+    } else {
+        s.to_string()
+    }
+}
+
+/// Whether the ids `per_face` first appear in the order 0, 1, 2, … and every one of `count` is
+/// used, so that a reader numbering names by first appearance gets the same ids back.
+fn in_first_use_order(per_face: &[u32], count: usize) -> bool {
+    let mut next = 0u32;
+    for &g in per_face {
+        if g == next {
+            next += 1;
+        } else if g > next {
+            return false;
+        }
+    }
+    next as usize == count
+}
+
+/// Writes `mesh` as OBJ: `mtllib` lines, then `v` (with `r g b` when the mesh has colours; alpha
+/// is not representable and is dropped), `vt`, `vn` per vertex, then the faces with `g` and `usemtl`
+/// lines where the group or material changes. When the group (material) ids would not come back
+/// in the same order from first appearance, all names are declared once up front.
+/// Every number is written with Rust's `{}`, which reads back bit-exact.
+pub fn write_obj<W: Write>(w: &mut W, mesh: &Mesh) -> io::Result<()> {
+    use std::fmt::Write as _;
+    let mut out = String::with_capacity(1 << 16);
+    let flush = |out: &mut String, w: &mut W| -> io::Result<()> {
+        w.write_all(out.as_bytes())?;
+        out.clear();
+        Ok(())
+    };
+    out.push_str("# written by meshslim\n");
+    for lib in &mesh.material_libs {
+        let _ = writeln!(out, "mtllib {}", one_line(lib));
+    }
+    for (i, p) in mesh.positions.iter().enumerate() {
+        let _ = write!(out, "v {} {} {}", p[0], p[1], p[2]);
+        if let Some(c) = &mesh.colors {
+            let _ = write!(out, " {} {} {}", c[i][0], c[i][1], c[i][2]);
+        }
+        out.push('\n');
+        if out.len() > 60_000 {
+            flush(&mut out, w)?;
+        }
+    }
+    if let Some(uvs) = &mesh.uvs {
+        for t in uvs {
+            let _ = writeln!(out, "vt {} {}", t[0], t[1]);
+            if out.len() > 60_000 {
+                flush(&mut out, w)?;
+            }
+        }
+    }
+    if let Some(normals) = &mesh.normals {
+        for n in normals {
+            let _ = writeln!(out, "vn {} {} {}", n[0], n[1], n[2]);
+            if out.len() > 60_000 {
+                flush(&mut out, w)?;
+            }
+        }
+    }
+    let mut cur_group = NONE;
+    let mut cur_mat = NONE;
+    if let Some(fg) = &mesh.face_groups {
+        if !in_first_use_order(fg, mesh.groups.len()) {
+            out.push_str("# groups in id order\n");
+            for (i, g) in mesh.groups.iter().enumerate() {
+                let _ = writeln!(out, "g {}", one_line(g));
+                cur_group = i as u32;
+            }
+        }
+    }
+    if let Some(fm) = &mesh.face_materials {
+        if !in_first_use_order(fm, mesh.materials.len()) {
+            out.push_str("# materials in id order\n");
+            for (i, m) in mesh.materials.iter().enumerate() {
+                let _ = writeln!(out, "usemtl {}", one_line(&m.name));
+                cur_mat = i as u32;
+            }
+        }
+    }
+    let (has_t, has_n) = (mesh.uvs.is_some(), mesh.normals.is_some());
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        if let Some(fg) = &mesh.face_groups {
+            if fg[f] != cur_group {
+                cur_group = fg[f];
+                let name = mesh
+                    .groups
+                    .get(cur_group as usize)
+                    .map_or("default", String::as_str);
+                let _ = writeln!(out, "g {}", one_line(name));
+            }
+        }
+        if let Some(fm) = &mesh.face_materials {
+            if fm[f] != cur_mat {
+                cur_mat = fm[f];
+                let name = mesh
+                    .materials
+                    .get(cur_mat as usize)
+                    .map_or("default", |m| m.name.as_str());
+                let _ = writeln!(out, "usemtl {}", one_line(name));
+            }
+        }
+        out.push('f');
+        for &v in t {
+            let i = v as u64 + 1;
+            let _ = match (has_t, has_n) {
+                (false, false) => write!(out, " {i}"),
+                (true, false) => write!(out, " {i}/{i}"),
+                (false, true) => write!(out, " {i}//{i}"),
+                (true, true) => write!(out, " {i}/{i}/{i}"),
+            };
+        }
+        out.push('\n');
+        if out.len() > 60_000 {
+            flush(&mut out, w)?;
+        }
+    }
+    flush(&mut out, w)
+}

@@ -1,0 +1,262 @@
+//! The indexed triangle mesh every backend and format shares.
+//!
+//! Positions are f32 and indices u32, the layout GPU buffers use, so a mesh can be uploaded as is.
+//! Attributes are optional and per vertex; materials and groups are per face. A vertex is one
+//! combination of position and attributes: two vertices may share a position (an attribute seam).
+
+mod generate;
+pub(crate) mod topology;
+pub(crate) mod weld;
+
+pub use generate::*;
+pub use topology::{Topology, topology};
+pub use weld::{WeldResult, weld, weld_positions};
+
+use crate::error::{Error, Result};
+
+/// A named material, as OBJ `usemtl`/glTF materials name them. `library` is the OBJ `mtllib`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Material {
+    pub name: String,
+}
+
+/// An indexed triangle mesh.
+///
+/// Invariants (checked by [`Mesh::validate`], which readers call before returning):
+/// every index < `positions.len()`, every optional attribute array is `positions.len()` long,
+/// every per-face array is `triangles.len()` long, every material/group id is in range.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Mesh {
+    pub positions: Vec<[f32; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    pub normals: Option<Vec<[f32; 3]>>,
+    pub uvs: Option<Vec<[f32; 2]>>,
+    /// Linear RGBA in 0..=1.
+    pub colors: Option<Vec<[f32; 4]>>,
+    /// Per-face index into `materials`.
+    pub face_materials: Option<Vec<u32>>,
+    pub materials: Vec<Material>,
+    /// OBJ `mtllib` file names, written back as they were read.
+    pub material_libs: Vec<String>,
+    /// Per-face index into `groups` (OBJ `o`/`g`, glTF meshes).
+    pub face_groups: Option<Vec<u32>>,
+    pub groups: Vec<String>,
+}
+
+/// Axis-aligned bounding box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+}
+
+impl Aabb {
+    pub fn diagonal(&self) -> f64 {
+        let d = sub64(self.max, self.min);
+        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+    }
+    pub fn center(&self) -> [f64; 3] {
+        [0, 1, 2].map(|i| (self.min[i] as f64 + self.max[i] as f64) * 0.5)
+    }
+}
+
+pub(crate) fn sub64(a: [f32; 3], b: [f32; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|i| a[i] as f64 - b[i] as f64)
+}
+
+pub(crate) fn cross64(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub(crate) fn dot64(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+impl Mesh {
+    /// A mesh of positions and triangles only.
+    pub fn new(positions: Vec<[f32; 3]>, triangles: Vec<[u32; 3]>) -> Self {
+        Mesh {
+            positions,
+            triangles,
+            ..Default::default()
+        }
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    pub fn face_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Checks the structural invariants listed on [`Mesh`] and that every position is finite.
+    pub fn validate(&self) -> Result<()> {
+        let n = self.positions.len();
+        if n > u32::MAX as usize {
+            return Err(Error::InvalidMesh(format!(
+                "{n} vertices exceed the u32 index range"
+            )));
+        }
+        if let Some(i) = self
+            .positions
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(Error::InvalidMesh(format!(
+                "vertex {i} has a non-finite coordinate {:?}",
+                self.positions[i]
+            )));
+        }
+        for (f, t) in self.triangles.iter().enumerate() {
+            if let Some(&v) = t.iter().find(|&&v| v as usize >= n) {
+                return Err(Error::InvalidMesh(format!(
+                    "face {f} refers to vertex {v}, but the mesh has only {n} vertices"
+                )));
+            }
+        }
+        let check_len = |name: &str, len: Option<usize>, want: usize| match len {
+            Some(l) if l != want => Err(Error::InvalidMesh(format!(
+                "{name} has {l} entries, expected {want}"
+            ))),
+            _ => Ok(()),
+        };
+        check_len("normals", self.normals.as_ref().map(Vec::len), n)?;
+        check_len("uvs", self.uvs.as_ref().map(Vec::len), n)?;
+        check_len("colors", self.colors.as_ref().map(Vec::len), n)?;
+        let nf = self.triangles.len();
+        check_len(
+            "face_materials",
+            self.face_materials.as_ref().map(Vec::len),
+            nf,
+        )?;
+        check_len("face_groups", self.face_groups.as_ref().map(Vec::len), nf)?;
+        if let Some(m) = &self.face_materials {
+            if let Some(f) = m.iter().position(|&m| m as usize >= self.materials.len()) {
+                return Err(Error::InvalidMesh(format!(
+                    "face {f} uses material {}, but only {} are defined",
+                    m[f],
+                    self.materials.len()
+                )));
+            }
+        }
+        if let Some(g) = &self.face_groups {
+            if let Some(f) = g.iter().position(|&g| g as usize >= self.groups.len()) {
+                return Err(Error::InvalidMesh(format!(
+                    "face {f} is in group {}, but only {} are defined",
+                    g[f],
+                    self.groups.len()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Bounding box of the positions; `None` for a mesh without vertices.
+    pub fn bounds(&self) -> Option<Aabb> {
+        let first = *self.positions.first()?;
+        let mut b = Aabb {
+            min: first,
+            max: first,
+        };
+        for p in &self.positions {
+            b.min = [0, 1, 2].map(|i| b.min[i].min(p[i]));
+            b.max = [0, 1, 2].map(|i| b.max[i].max(p[i]));
+        }
+        Some(b)
+    }
+
+    /// Twice the area vector (cross product of two edges) of face `f`, in f64.
+    pub fn face_cross(&self, f: usize) -> [f64; 3] {
+        let [a, b, c] = self.triangles[f].map(|v| self.positions[v as usize]);
+        cross64(sub64(b, a), sub64(c, a))
+    }
+
+    pub fn face_area(&self, f: usize) -> f64 {
+        let c = self.face_cross(f);
+        0.5 * dot64(c, c).sqrt()
+    }
+
+    /// Unit normal of face `f`, or `None` when the face has no area.
+    pub fn face_normal(&self, f: usize) -> Option<[f64; 3]> {
+        let c = self.face_cross(f);
+        let l = dot64(c, c).sqrt();
+        (l > 0.0 && l.is_finite()).then(|| c.map(|x| x / l))
+    }
+
+    pub fn surface_area(&self) -> f64 {
+        (0..self.triangles.len()).map(|f| self.face_area(f)).sum()
+    }
+
+    /// Signed volume by the divergence theorem; positive for a closed mesh with outward faces.
+    /// Computed relative to the bounding-box centre so that far-away meshes keep precision.
+    pub fn signed_volume(&self) -> f64 {
+        let Some(b) = self.bounds() else { return 0.0 };
+        let o = b.center();
+        let rel = |v: u32| {
+            let p = self.positions[v as usize];
+            [0, 1, 2].map(|i| p[i] as f64 - o[i])
+        };
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(rel);
+                dot64(a, cross64(b, c)) / 6.0
+            })
+            .sum()
+    }
+
+    /// Recomputes per-vertex normals as the area-weighted mean of the incident face normals.
+    /// Vertices split at a seam keep their own side's normal, since they are separate vertices.
+    pub fn recompute_normals(&mut self) {
+        let mut acc = vec![[0.0f64; 3]; self.positions.len()];
+        for f in 0..self.triangles.len() {
+            let c = self.face_cross(f);
+            for &v in &self.triangles[f] {
+                for i in 0..3 {
+                    acc[v as usize][i] += c[i];
+                }
+            }
+        }
+        self.normals = Some(
+            acc.into_iter()
+                .map(|n| {
+                    let l = dot64(n, n).sqrt();
+                    if l > 0.0 {
+                        n.map(|x| (x / l) as f32)
+                    } else {
+                        [0.0, 0.0, 1.0]
+                    }
+                })
+                .collect(),
+        );
+    }
+
+    /// Drops vertices no face uses, renumbering the rest in order of first use by the faces
+    /// (a cache-friendly order for the output). Attributes follow their vertices.
+    pub fn remove_unused_vertices(&mut self) {
+        let mut map = vec![u32::MAX; self.positions.len()];
+        let mut order = Vec::new();
+        for t in &mut self.triangles {
+            for v in t.iter_mut() {
+                let m = &mut map[*v as usize];
+                if *m == u32::MAX {
+                    *m = order.len() as u32;
+                    order.push(*v);
+                }
+                *v = *m;
+            }
+        }
+        fn pick<T: Copy>(order: &[u32], src: &[T]) -> Vec<T> {
+            order.iter().map(|&v| src[v as usize]).collect()
+        }
+        self.positions = pick(&order, &self.positions);
+        self.normals = self.normals.as_deref().map(|s| pick(&order, s));
+        self.uvs = self.uvs.as_deref().map(|s| pick(&order, s));
+        self.colors = self.colors.as_deref().map(|s| pick(&order, s));
+    }
+}

@@ -1,0 +1,155 @@
+//! Options, report and the entry point shared by every backend.
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use serde::Serialize;
+
+/// Which implementation simplifies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum Backend {
+    /// Greedy quadric edge collapse with a priority queue, in f64: the quality reference.
+    Cpu,
+}
+
+impl Backend {
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Cpu => "cpu",
+        }
+    }
+}
+
+/// How far to simplify. Whichever of the face target and the error bound is met first stops it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimplifyOptions {
+    /// Stop at this many faces (reached exactly or one below: an interior collapse removes two).
+    pub target_faces: usize,
+    /// Stop before a collapse whose error, relative to the bounding-box diagonal, exceeds this.
+    pub max_error: Option<f64>,
+    /// Keep the border exactly: border vertices never move; a border vertex is removed only
+    /// when it lies on the straight line between its two border neighbours, so the outline is
+    /// unchanged.
+    pub lock_border: bool,
+    /// Weight of the border constraint planes relative to the face planes (Hoppe's boundary
+    /// quadrics); larger keeps open borders closer to where they were.
+    pub border_weight: f64,
+    /// A collapse may turn no surrounding face's normal by more than this many degrees.
+    pub max_normal_angle_deg: f64,
+    /// A collapse may not create a face of quality below this (quality = |cross| / longest edge²,
+    /// 0.866 for an equilateral triangle) unless the face was already that thin.
+    pub min_quality: f64,
+    /// Faces below this quality make a collapse proportionally more expensive (MeshLab's
+    /// `QualityThr`, default 0.3); 0 turns the term off, giving textbook QEM order.
+    pub quality_threshold: f64,
+    pub backend: Backend,
+}
+
+impl SimplifyOptions {
+    /// Options for reaching `ratio` of `input_faces`, with the defaults for everything else.
+    pub fn with_ratio(input_faces: usize, ratio: f64) -> Result<Self> {
+        if !(ratio > 0.0 && ratio <= 1.0) {
+            return Err(Error::InvalidOption(format!(
+                "ratio must be in (0, 1], got {ratio}"
+            )));
+        }
+        Ok(Self::with_faces(
+            (input_faces as f64 * ratio).round() as usize
+        ))
+    }
+
+    pub fn with_faces(target_faces: usize) -> Self {
+        SimplifyOptions {
+            target_faces,
+            max_error: None,
+            lock_border: false,
+            border_weight: 1.0,
+            max_normal_angle_deg: 90.0,
+            min_quality: 0.01,
+            quality_threshold: 0.3,
+            backend: Backend::Cpu,
+        }
+    }
+
+    pub(crate) fn check(&self) -> Result<()> {
+        let bad = |m: String| Err(Error::InvalidOption(m));
+        if let Some(e) = self.max_error {
+            if !(e >= 0.0 && e.is_finite()) {
+                return bad(format!("max error must be a finite number >= 0, got {e}"));
+            }
+        }
+        if !(self.border_weight >= 0.0 && self.border_weight.is_finite()) {
+            return bad(format!(
+                "border weight must be >= 0, got {}",
+                self.border_weight
+            ));
+        }
+        if !(self.max_normal_angle_deg > 0.0 && self.max_normal_angle_deg <= 180.0) {
+            return bad(format!(
+                "max normal angle must be in (0, 180], got {}",
+                self.max_normal_angle_deg
+            ));
+        }
+        if !(0.0..1.0).contains(&self.min_quality) || !(0.0..=1.0).contains(&self.quality_threshold)
+        {
+            return bad("min quality and quality threshold must lie in [0, 1)".into());
+        }
+        Ok(())
+    }
+}
+
+/// Why simplification stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StopReason {
+    /// The face target was reached.
+    TargetReached,
+    /// The next cheapest collapse would exceed the error bound.
+    MaxError,
+    /// No collapse is left that keeps the topology and the constraints (flips, needles, locked
+    /// border, seams): the target cannot be reached without breaking them.
+    NoValidCollapse,
+}
+
+impl StopReason {
+    pub fn explain(self) -> &'static str {
+        match self {
+            StopReason::TargetReached => "reached the face target",
+            StopReason::MaxError => "stopped at the maximum error before reaching the face target",
+            StopReason::NoValidCollapse => {
+                "no collapse left that keeps the topology, normals and locked vertices; the target \
+                 cannot be reached without breaking them"
+            }
+        }
+    }
+}
+
+/// What a simplification did.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SimplifyReport {
+    pub backend: Backend,
+    pub input_faces: usize,
+    pub target_faces: usize,
+    pub output_faces: usize,
+    pub input_vertices: usize,
+    pub output_vertices: usize,
+    pub collapses: usize,
+    /// Largest quadric error of an applied collapse, as RMS distance relative to the diagonal.
+    pub max_collapse_error: f64,
+    pub stop_reason: StopReason,
+    /// Faces with a repeated vertex dropped from the input before simplifying.
+    pub dropped_degenerate_faces: usize,
+    /// Vertices kept in place because attributes differ across them (UV, normal or colour seams)
+    /// or because the surface is not manifold there.
+    pub pinned_vertices: usize,
+}
+
+/// Simplifies `mesh` with the backend and targets in `opts`.
+pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<(Mesh, SimplifyReport)> {
+    opts.check()?;
+    mesh.validate()?;
+    match opts.backend {
+        Backend::Cpu => crate::greedy::simplify_greedy(mesh, opts, &mut |_| {}),
+    }
+}
