@@ -22,4 +22,4 @@ pub mod simplify;
 
 pub use error::{Error, Location, Result};
 pub use mesh::{Aabb, Material, Mesh};
-pub use simplify::{Backend, SimplifyOptions, SimplifyReport, StopReason, simplify};
+pub use simplify::{Backend, SimplifyOptions, SimplifyReport, StopReason, simplify, simplify_with_progress};

@@ -147,9 +147,18 @@ pub struct SimplifyReport {
 
 /// Simplifies `mesh` with the backend and targets in `opts`.
 pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<(Mesh, SimplifyReport)> {
+    simplify_with_progress(mesh, opts, &mut |_| {})
+}
+
+/// As [`simplify`], calling `progress` now and then with the fraction of the work done (0..=1).
+pub fn simplify_with_progress(
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport)> {
     opts.check()?;
     mesh.validate()?;
     match opts.backend {
-        Backend::Cpu => crate::greedy::simplify_greedy(mesh, opts, &mut |_| {}),
+        Backend::Cpu => crate::greedy::simplify_greedy(mesh, opts, progress),
     }
 }
