@@ -14,8 +14,8 @@ use crate::mesh::topology::{Dsu, edge_key};
 use crate::mesh::{Mesh, weld, weld::position_classes};
 use crate::quadric::Quadric;
 use crate::simplify::{SimplifyOptions, SimplifyReport, StopReason};
+use radix_heap::RadixHeapMap;
 use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 
 /// How a vertex may take part in collapses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -91,6 +91,7 @@ impl Prepared {
     pub fn new(input: &Mesh, opts: &SimplifyOptions) -> Prepared {
         let mesh = weld(input).mesh;
         let (topo, firsts) = position_classes(&mesh.positions);
+        let (topo, firsts) = spatial_order(&mesh.positions, topo, firsts);
         let nt = firsts.len();
         let mut attr_count = vec![0u32; nt];
         for &t in &topo {
@@ -106,6 +107,11 @@ impl Prepared {
             }
         }
         let dropped_degenerate = mesh.triangles.len() - faces.len();
+        // Faces in the order of their first vertex, so a vertex's faces sit close in memory.
+        let mut order: Vec<u32> = (0..faces.len() as u32).collect();
+        order.sort_by_key(|&f| faces[f as usize].map(|v| topo[v as usize]).into_iter().min());
+        let faces: Vec<[u32; 3]> = order.iter().map(|&f| faces[f as usize]).collect();
+        let face_origin: Vec<u32> = order.iter().map(|&f| face_origin[f as usize]).collect();
 
         let (center, scale) = match mesh.bounds() {
             Some(b) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
@@ -248,6 +254,40 @@ impl Prepared {
     }
 }
 
+/// Renumbers position classes along a Morton (Z-order) curve. The queue visits the mesh in cost
+/// order, effectively at random; with neighbours close in memory, the dozen vertices and faces
+/// one collapse touches share cache lines and pages instead of each being a miss.
+fn spatial_order(positions: &[[f32; 3]], topo: Vec<u32>, firsts: Vec<u32>) -> (Vec<u32>, Vec<u32>) {
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for &v in &firsts {
+        let p = positions[v as usize];
+        lo = [0, 1, 2].map(|i| lo[i].min(p[i]));
+        hi = [0, 1, 2].map(|i| hi[i].max(p[i]));
+    }
+    let spread = (0..3).map(|i| hi[i] - lo[i]).fold(0.0f32, f32::max).max(f32::MIN_POSITIVE);
+    // Spread the low 10 bits of x to every third bit.
+    let part = |x: u32| {
+        let mut x = x & 0x3ff;
+        x = (x | (x << 16)) & 0x030000ff;
+        x = (x | (x << 8)) & 0x0300f00f;
+        x = (x | (x << 4)) & 0x030c30c3;
+        (x | (x << 2)) & 0x09249249
+    };
+    let code = |v: u32| {
+        let p = positions[v as usize];
+        let q = |i: usize| (((p[i] - lo[i]) / spread) * 1023.0) as u32;
+        part(q(0)) | (part(q(1)) << 1) | (part(q(2)) << 2)
+    };
+    let mut order: Vec<u32> = (0..firsts.len() as u32).collect();
+    order.sort_by_key(|&c| (code(firsts[c as usize]), c));
+    let mut rank = vec![0u32; firsts.len()];
+    for (new, &old) in order.iter().enumerate() {
+        rank[old as usize] = new as u32;
+    }
+    let firsts = order.iter().map(|&old| firsts[old as usize]).collect();
+    (topo.into_iter().map(|t| rank[t as usize]).collect(), firsts)
+}
+
 /// A collapse that passed every check: `remove` goes into `keep`, which moves to `pos`.
 #[derive(Debug, Clone, Copy)]
 struct Collapse {
@@ -274,7 +314,25 @@ struct State<'a> {
     scratch: Vec<u32>,
 }
 
-type Entry = Reverse<(u32, u32, u32, u32)>;
+/// The queue: a radix heap (a monotone priority queue) keyed by priority bits, holding
+/// (a, b, stamp). Monotone means no key may be below the last one popped; a collapse can make a
+/// neighbouring edge cheaper than the edge just taken, and such an edge is queued at the current
+/// minimum instead — it is the next one out either way. Pushes are O(1) appends. Measured on the
+/// 1M-triangle igea scan at 10%: std's BinaryHeap spent 3.1 s of 6.5 s in `pop` (5.3M pops).
+struct Queue(RadixHeapMap<Reverse<u32>, (u32, u32, u32)>);
+
+impl Queue {
+    fn push(&mut self, key: u32, a: u32, b: u32, stamp: u32) {
+        let key = match self.0.top() {
+            Some(Reverse(top)) => key.max(top),
+            None => key,
+        };
+        self.0.push(Reverse(key), (a, b, stamp));
+    }
+    fn pop(&mut self) -> Option<(u32, u32, u32, u32)> {
+        self.0.pop().map(|(Reverse(k), (a, b, s))| (k, a, b, s))
+    }
+}
 
 /// Non-negative f64 priorities as f32 bits keep the heap entries 16 bytes; ordering of
 /// non-negative IEEE floats equals ordering of their bit patterns.
@@ -561,11 +619,12 @@ impl<'a> State<'a> {
         let alive = &self.face_alive;
         self.vert_faces[k].retain(|&f| alive[f as usize]);
         self.version[k] = self.version[k].wrapping_add(1);
+        self.version[r] = self.version[r].wrapping_add(1);
         removed
     }
 
     /// Queues every edge around `v` with its cheap lower-bound key.
-    fn push_edges_of(&mut self, v: u32, heap: &mut BinaryHeap<Entry>) {
+    fn push_edges_of(&mut self, v: u32, heap: &mut Queue) {
         let m = self.next_mark();
         self.mark[v as usize] = m;
         for i in 0..self.vert_faces[v as usize].len() {
@@ -575,7 +634,7 @@ impl<'a> State<'a> {
                     self.mark[u as usize] = m;
                     if let Some((_, _, _, err)) = self.placement(v, u) {
                         let (lo, hi) = if v < u { (v, u) } else { (u, v) };
-                        heap.push(Reverse((key(err), lo, hi, self.stamp(lo, hi))));
+                        heap.push(key(err), lo, hi, self.stamp(lo, hi));
                     }
                 }
             }
@@ -640,14 +699,13 @@ pub fn simplify_greedy(
     }
     edges.sort_unstable();
     edges.dedup();
-    let mut entries: Vec<Entry> = Vec::with_capacity(edges.len());
+    let mut heap = Queue(RadixHeapMap::new());
     for e in edges {
         let (a, b) = ((e >> 32) as u32, e as u32);
         if let Some((_, _, _, err)) = s.placement(a, b) {
-            entries.push(Reverse((key(err), a, b, 0)));
+            heap.push(key(err), a, b, 0);
         }
     }
-    let mut heap = BinaryHeap::from(entries);
 
     let target = opts.target_faces;
     let max_err2 = opts.max_error.map(|e| e * e);
@@ -658,16 +716,18 @@ pub fn simplify_greedy(
     let need = nf.saturating_sub(target).max(1) as f32;
     let mut next_report = 0usize;
     while faces > target {
-        let Some(Reverse((k, a, b, stamp))) = heap.pop() else {
+        let Some((k, a, b, stamp)) = heap.pop() else {
             break;
         };
-        if !s.alive[a as usize] || !s.alive[b as usize] || s.stamp(a, b) != stamp {
+        // A removed vertex's version was bumped too, so one comparison retires every entry
+        // whose edge changed or vanished.
+        if s.stamp(a, b) != stamp {
             continue;
         }
         let Some(c) = s.evaluate(a, b) else { continue };
         let full = key(c.priority);
         if full > k {
-            heap.push(Reverse((full, a, b, stamp)));
+            heap.push(full, a, b, stamp);
             continue;
         }
         let q = s.p.quadrics[c.keep as usize].sum(&s.p.quadrics[c.remove as usize]);

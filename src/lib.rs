@@ -13,6 +13,7 @@
 //! - P. Cignoni, C. Montani, C. Rocchini, R. Scopigno. A general method for preserving attribute
 //!   values on simplified meshes / vcglib quadric collapse (triangle-quality weighted priority).
 
+pub mod cli;
 pub mod error;
 pub mod greedy;
 pub mod io;

@@ -1,3 +1,19 @@
-fn main() {
-    println!("Hello, world!");
+//! The `meshslim` binary: parse, run, print the error once, exit with its code.
+//! Everything else lives in the library (`meshslim::cli` for the command-line runners).
+
+use std::process::ExitCode;
+
+use clap::Parser;
+use meshslim::cli::{self, Cli};
+
+fn main() -> ExitCode {
+    // clap prints its own usage errors and exits with 2.
+    let args = Cli::parse();
+    match cli::run(args) {
+        Ok(code) => code,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            cli::exit_code(&err)
+        }
+    }
 }

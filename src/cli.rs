@@ -1,0 +1,910 @@
+//! The `meshslim` command line: clap argument types and the runners behind each subcommand.
+//!
+//! `main.rs` only parses and hands the result to [`run`]; this module converts the arguments to
+//! library options once, calls the library, and prints the result. It is the one place besides
+//! `main.rs` that uses `anyhow`: errors of the library arrive as [`meshslim::Error`] and leave
+//! as messages for the user.
+
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use crate::io::Format;
+use crate::mesh::{self, Mesh};
+use crate::{Backend, SimplifyOptions, SimplifyReport};
+
+// ---------------------------------------------------------------------------------------------
+// Arguments
+// ---------------------------------------------------------------------------------------------
+
+const TOP_AFTER_HELP: &str = "\
+Examples:
+  meshslim simplify builtin:bumpy-sphere bumpy-10.ply --ratio 0.1
+  meshslim simplify scan.ply scan-5k.obj --faces 5000 --stats
+  meshslim info scan.ply
+  meshslim info builtin:torus --json
+
+Run 'meshslim <COMMAND> --help' for every option of a command.";
+
+const SIMPLIFY_AFTER_HELP: &str = "\
+Built-in meshes (IN = builtin:NAME or builtin:NAME:FACES, FACES a minimum face count):
+  sphere        icosphere, 20480 faces
+  uv-sphere     latitude-longitude sphere with poles, 16128 faces
+  torus         torus, 16384 faces
+  double-torus  genus-2 slab with two square holes, sharp edges, 22528 faces
+  cube          cube with flat faces and sharp edges, 19200 faces
+  grid          flat open square grid with a border, 20000 faces
+  noisy-sphere  icosphere with 1% radial noise, 20480 faces
+  bumpy-sphere  smooth bumpy sphere with fine noise, a stand-in for a scan, 327680 faces
+
+Examples:
+  # 10% of a generated 330k-face scan stand-in
+  meshslim simplify builtin:bumpy-sphere bumpy-10.ply --ratio 0.1
+  # a real file to 5000 faces, with the collapse statistics
+  meshslim simplify scan.ply scan-5k.obj --faces 5000 --stats
+  # keep the outline of an open mesh exactly
+  meshslim simplify terrain.obj terrain-small.obj --ratio 0.05 --lock-border
+  # simplify as far as an error of 0.1% of the bounding-box diagonal allows
+  meshslim simplify scan.ply scan-err.ply --faces 0 --max-error 0.001
+  # machine-readable report
+  meshslim simplify builtin:torus torus-half.glb --ratio 0.5 --json";
+
+const INFO_AFTER_HELP: &str = "\
+Examples:
+  meshslim info scan.ply
+  meshslim info simplified.obj --json
+  meshslim info builtin:double-torus";
+
+/// Triangle-mesh simplification by quadric error metrics.
+#[derive(Debug, Parser)]
+#[command(name = "meshslim", version, after_help = TOP_AFTER_HELP)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Simplify a mesh to a face count or a fraction of its faces
+    #[command(after_help = SIMPLIFY_AFTER_HELP)]
+    Simplify(SimplifyArgs),
+    /// Print a mesh's topology report: counts, borders, manifoldness, genus, area, volume
+    #[command(after_help = INFO_AFTER_HELP)]
+    Info(InfoArgs),
+}
+
+/// A mesh to read: a file, or a generated mesh `builtin:NAME[:FACES]`.
+#[derive(Debug, Clone)]
+pub enum Input {
+    File(PathBuf),
+    /// The spec as written (`builtin:torus:5000`) and what it names.
+    Builtin {
+        spec: String,
+        kind: &'static BuiltinMesh,
+        min_faces: Option<usize>,
+    },
+}
+
+impl Input {
+    /// How the user named it, for messages and the JSON report.
+    pub fn display(&self) -> String {
+        match self {
+            Input::File(p) => p.display().to_string(),
+            Input::Builtin { spec, .. } => spec.clone(),
+        }
+    }
+}
+
+impl std::str::FromStr for Input {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s.strip_prefix(BUILTIN_PREFIX) {
+            Some(rest) => {
+                let (kind, min_faces) = parse_builtin(rest)?;
+                Ok(Input::Builtin {
+                    spec: s.to_string(),
+                    kind,
+                    min_faces,
+                })
+            }
+            None if s.is_empty() => Err("the input path is empty".into()),
+            None => Ok(Input::File(PathBuf::from(s))),
+        }
+    }
+}
+
+#[derive(Debug, Args)]
+pub struct SimplifyArgs {
+    /// Input mesh: a .obj, .ply, .stl, .gltf or .glb file, or a generated mesh written
+    /// builtin:NAME or builtin:NAME:FACES (names below)
+    #[arg(value_name = "IN", value_parser = parse_input_arg)]
+    pub input: Option<Input>,
+
+    /// Output file; the format follows its extension (.obj, .ply, .stl, .gltf, .glb). Written
+    /// atomically, and never over the input
+    #[arg(value_name = "OUT")]
+    pub output: Option<PathBuf>,
+
+    /// Keep this fraction of the faces, in (0, 1] [default: 0.1 unless --faces is given]
+    #[arg(short, long, value_name = "R", value_parser = parse_ratio, conflicts_with = "faces")]
+    pub ratio: Option<f64>,
+
+    /// Keep this many faces (reached exactly or one below: an interior collapse removes two).
+    /// 0 simplifies until --max-error or the constraints stop it
+    #[arg(short, long, value_name = "N")]
+    pub faces: Option<usize>,
+
+    /// Stop before a collapse whose error exceeds E, relative to the bounding-box diagonal
+    /// (0.001 = 0.1% of the diagonal), even if the face target is not reached [default: no limit]
+    #[arg(short = 'e', long, value_name = "E", value_parser = parse_non_negative)]
+    pub max_error: Option<f64>,
+
+    /// Keep the border (the outline of an open mesh) exactly: border vertices never move, and one
+    /// is removed only where it lies on the straight line between its border neighbours
+    #[arg(long)]
+    pub lock_border: bool,
+
+    /// Weight of the border constraint planes relative to the face planes (Hoppe's boundary
+    /// quadrics); larger keeps open borders closer to where they were
+    #[arg(long, value_name = "W", default_value_t = 1.0, value_parser = parse_non_negative)]
+    pub border_weight: f64,
+
+    /// Refuse a collapse that turns any surrounding face's normal by more than DEG degrees,
+    /// in (0, 180]
+    #[arg(long = "max-normal-angle", value_name = "DEG", default_value_t = 90.0, value_parser = parse_angle)]
+    pub max_normal_angle: f64,
+
+    /// Collapses creating faces of quality below Q cost proportionally more (MeshLab's
+    /// QualityThr; quality is 0.866 for an equilateral triangle, 0 for a sliver), in [0, 1].
+    /// 0 turns the term off, giving textbook QEM order
+    #[arg(long, value_name = "Q", default_value_t = 0.3, value_parser = parse_unit)]
+    pub quality_threshold: f64,
+
+    /// Which implementation simplifies
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    pub backend: BackendArg,
+
+    /// Print exactly one JSON object with the report on stdout, and nothing else there
+    #[arg(long)]
+    pub json: bool,
+
+    /// Also print the collapse statistics: collapses, pinned vertices, dropped degenerate faces,
+    /// largest collapse error (the JSON report always has them)
+    #[arg(long)]
+    pub stats: bool,
+
+    /// Print nothing but errors (and the JSON report with --json); no progress bars
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// Mesh to describe: a .obj, .ply, .stl, .gltf or .glb file, or builtin:NAME[:FACES]
+    /// (names in 'meshslim simplify --help')
+    #[arg(value_name = "IN", value_parser = parse_input_arg)]
+    pub input: Input,
+
+    /// Print the report as one JSON object on stdout
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Declares [`BackendArg`] and its mapping to [`Backend`]: a new backend is one line here (with
+/// its doc comment, which becomes its `--help` text), named as the library's variant.
+macro_rules! backend_args {
+    ($($(#[doc = $doc:literal])* $variant:ident),* $(,)?) => {
+        /// The `--backend` choices.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+        pub enum BackendArg {
+            $($(#[doc = $doc])* $variant,)*
+        }
+
+        impl From<BackendArg> for Backend {
+            fn from(b: BackendArg) -> Backend {
+                match b {
+                    $(BackendArg::$variant => Backend::$variant,)*
+                }
+            }
+        }
+    };
+}
+
+backend_args! {
+    /// Greedy quadric edge collapse with a priority queue, in f64: the quality reference
+    Cpu,
+}
+
+fn parse_input_arg(s: &str) -> std::result::Result<Input, String> {
+    s.parse()
+}
+
+fn parse_f64(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{s:?} is not a finite number"))
+    }
+}
+
+fn parse_ratio(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v > 0.0 && v <= 1.0 {
+        Ok(v)
+    } else {
+        Err(format!(
+            "the ratio must be in (0, 1], got {v} (use --faces N for a face count)"
+        ))
+    }
+}
+
+fn parse_non_negative(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be >= 0, got {v}"))
+    }
+}
+
+fn parse_angle(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v > 0.0 && v <= 180.0 {
+        Ok(v)
+    } else {
+        Err(format!("the angle must be in (0, 180] degrees, got {v}"))
+    }
+}
+
+fn parse_unit(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("must be in [0, 1], got {v}"))
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Built-in meshes
+// ---------------------------------------------------------------------------------------------
+
+const BUILTIN_PREFIX: &str = "builtin:";
+
+/// Largest FACES accepted in `builtin:NAME:FACES` (a typo should not allocate gigabytes).
+pub const MAX_BUILTIN_FACES: usize = 20_000_000;
+
+/// A generated mesh the command line can use as input.
+#[derive(Debug)]
+pub struct BuiltinMesh {
+    pub name: &'static str,
+    /// Builds the mesh with at least the given number of faces, or its default size.
+    make: fn(Option<usize>) -> Mesh,
+}
+
+/// Smallest `k >= start` with `faces(k) >= min`.
+fn smallest(start: usize, min: usize, faces: impl Fn(usize) -> usize) -> usize {
+    let mut k = start;
+    while faces(k) < min {
+        k += 1;
+    }
+    k
+}
+
+fn icosphere_level(min: Option<usize>) -> u32 {
+    match min {
+        None => 5,
+        Some(n) => smallest(0, n, |l| 20 << (2 * l)) as u32,
+    }
+}
+
+/// The generated meshes, by name. `simplify --help` lists them (a unit test keeps the two in
+/// step).
+pub static BUILTINS: &[BuiltinMesh] = &[
+    BuiltinMesh {
+        name: "sphere",
+        make: |n| mesh::icosphere(icosphere_level(n)),
+    },
+    BuiltinMesh {
+        name: "uv-sphere",
+        // 2·segments·(rings − 1) faces with rings = segments / 2.
+        make: |n| {
+            let half = n.map_or(64, |n| smallest(2, n, |h| 4 * h * (h - 1)));
+            mesh::uv_sphere(2 * half, half)
+        },
+    },
+    BuiltinMesh {
+        name: "torus",
+        // 2·nu·nv faces with nu = 2·nv.
+        make: |n| {
+            let k = n.map_or(64, |n| smallest(3, n, |k| 4 * k * k));
+            mesh::torus(1.0, 0.35, 2 * k, k)
+        },
+    },
+    BuiltinMesh {
+        name: "double-torus",
+        // 176·s² voxel faces, two triangles each.
+        make: |n| mesh::double_torus(n.map_or(8, |n| smallest(1, n, |s| 352 * s * s))),
+    },
+    BuiltinMesh {
+        name: "cube",
+        make: |n| mesh::cube(n.map_or(40, |n| smallest(1, n, |k| 12 * k * k))),
+    },
+    BuiltinMesh {
+        name: "grid",
+        make: |n| mesh::grid(n.map_or(100, |n| smallest(1, n, |k| 2 * k * k))),
+    },
+    BuiltinMesh {
+        name: "noisy-sphere",
+        make: |n| mesh::noisy_sphere(icosphere_level(n), 0.01, 1),
+    },
+    BuiltinMesh {
+        name: "bumpy-sphere",
+        make: |n| mesh::displaced_sphere(n.unwrap_or(200_000), 1),
+    },
+];
+
+/// Parses `NAME` or `NAME:FACES` (without the `builtin:` prefix).
+fn parse_builtin(spec: &str) -> std::result::Result<(&'static BuiltinMesh, Option<usize>), String> {
+    let (name, faces) = match spec.split_once(':') {
+        Some((name, faces)) => (name, Some(faces)),
+        None => (spec, None),
+    };
+    let names = || {
+        BUILTINS
+            .iter()
+            .map(|b| b.name)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let kind = BUILTINS.iter().find(|b| b.name == name).ok_or_else(|| {
+        format!(
+            "unknown built-in mesh {name:?}; the built-in meshes are {}",
+            names()
+        )
+    })?;
+    let min_faces = match faces {
+        None => None,
+        Some(f) => match f.parse::<usize>() {
+            Ok(n) if (1..=MAX_BUILTIN_FACES).contains(&n) => Some(n),
+            _ => {
+                return Err(format!(
+                    "the face count in builtin:{name}:{f} must be a whole number from 1 to \
+                     {MAX_BUILTIN_FACES}"
+                ));
+            }
+        },
+    };
+    Ok((kind, min_faces))
+}
+
+/// The generated mesh a spec names: `builtin:NAME`, `builtin:NAME:FACES` (at least FACES faces),
+/// or the same without the `builtin:` prefix.
+pub fn builtin(spec: &str) -> Result<Mesh> {
+    let rest = spec.strip_prefix(BUILTIN_PREFIX).unwrap_or(spec);
+    let (kind, min_faces) = parse_builtin(rest).map_err(UsageError)?;
+    Ok((kind.make)(min_faces))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Running
+// ---------------------------------------------------------------------------------------------
+
+/// A mistake in how the command was called: reported like clap's own, with exit code 2.
+#[derive(Debug)]
+pub struct UsageError(pub String);
+
+impl std::fmt::Display for UsageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for UsageError {}
+
+/// The exit code for an error [`run`] returned: 2 for bad usage, 1 for everything else.
+pub fn exit_code(err: &anyhow::Error) -> ExitCode {
+    if err.downcast_ref::<UsageError>().is_some() {
+        ExitCode::from(2)
+    } else {
+        ExitCode::FAILURE
+    }
+}
+
+/// The library's errors carry the file and the cause in their message already; passing them on
+/// as messages keeps `{:#}` from printing the cause a second time.
+fn lib(e: crate::Error) -> anyhow::Error {
+    anyhow::Error::msg(e.to_string())
+}
+
+/// What a user who typed `meshslim` or `meshslim simplify` alone needs to get going.
+pub const GETTING_STARTED: &str = "\
+meshslim simplifies triangle meshes.
+
+Try it on a generated mesh (a bumpy 330k-face sphere standing in for a scan):
+  meshslim simplify builtin:bumpy-sphere bumpy-10.ply --ratio 0.1
+
+On your own file, down to 5000 faces (.obj, .ply, .stl, .gltf and .glb are read and written):
+  meshslim simplify scan.ply scan-5k.obj --faces 5000
+
+Look at a mesh (faces, borders, manifoldness, genus, area, volume):
+  meshslim info scan.ply
+
+Learn more:
+  meshslim simplify --help
+  meshslim --help";
+
+/// Runs a parsed command line. Returns the exit code for success or for an input-less call;
+/// an error goes back to `main`, which prints it and exits with [`exit_code`].
+pub fn run(cli: Cli) -> Result<ExitCode> {
+    match cli.command {
+        None => {
+            eprintln!("{GETTING_STARTED}");
+            Ok(ExitCode::from(2))
+        }
+        Some(Command::Simplify(args)) => run_simplify(args),
+        Some(Command::Info(args)) => run_info(args),
+    }
+}
+
+fn load(input: &Input, progress: &Progress) -> Result<Mesh> {
+    match input {
+        Input::File(path) => progress
+            .spinner(format!("reading {}", path.display()), || {
+                crate::io::read(path)
+            })
+            .map_err(lib)
+            .context("cannot read the input"),
+        Input::Builtin {
+            spec,
+            kind,
+            min_faces,
+        } => Ok(progress.spinner(format!("generating {spec}"), || (kind.make)(*min_faces))),
+    }
+}
+
+/// The checks that need no mesh, so that a wrong output path fails before any work.
+fn check_output(input: &Input, output: &Path) -> Result<()> {
+    Format::from_path(output).map_err(lib)?;
+    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.is_dir() {
+            anyhow::bail!(
+                "{}: the output directory {} does not exist",
+                output.display(),
+                dir.display()
+            );
+        }
+    }
+    if let Input::File(input) = input {
+        if output.exists() && same_file(input, output) {
+            return Err(lib(crate::Error::WouldOverwriteInput(input.clone())));
+        }
+    }
+    Ok(())
+}
+
+/// Whether two existing paths name one file: the same canonical path, or (on Unix) the same
+/// inode, which also catches hard links.
+fn same_file(a: &Path, b: &Path) -> bool {
+    if let (Ok(ca), Ok(cb)) = (a.canonicalize(), b.canonicalize()) {
+        if ca == cb {
+            return true;
+        }
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            return ma.dev() == mb.dev() && ma.ino() == mb.ino();
+        }
+    }
+    false
+}
+
+enum Target {
+    Ratio(f64),
+    Faces(usize),
+}
+
+fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
+    let Some(input) = args.input else {
+        eprintln!("{GETTING_STARTED}");
+        return Ok(ExitCode::from(2));
+    };
+    let Some(output) = args.output else {
+        return Err(UsageError(format!(
+            "no output file: write it after the input, as in\n  meshslim simplify {} OUT.ply \
+             [OPTIONS]\n\nFor more information, try 'meshslim simplify --help'.",
+            input.display()
+        ))
+        .into());
+    };
+    check_output(&input, &output)?;
+
+    let target = match (args.ratio, args.faces) {
+        (_, Some(n)) => Target::Faces(n),
+        (Some(r), None) => Target::Ratio(r),
+        (None, None) => Target::Ratio(0.1),
+    };
+    let progress = Progress::new(!(args.quiet || args.json) && std::io::stderr().is_terminal());
+
+    let t = Instant::now();
+    let mesh = load(&input, &progress)?;
+    let load_s = t.elapsed().as_secs_f64();
+
+    let mut opts = match target {
+        Target::Ratio(r) => SimplifyOptions::with_ratio(mesh.face_count(), r).map_err(lib)?,
+        Target::Faces(n) => SimplifyOptions::with_faces(n),
+    };
+    opts.max_error = args.max_error;
+    opts.lock_border = args.lock_border;
+    opts.border_weight = args.border_weight;
+    opts.max_normal_angle_deg = args.max_normal_angle;
+    opts.quality_threshold = args.quality_threshold;
+    opts.backend = args.backend.into();
+
+    let t = Instant::now();
+    let (simplified, report) = progress
+        .bar("simplifying", |set| {
+            crate::simplify_with_progress(&mesh, &opts, &mut |f| set(f))
+        })
+        .map_err(lib)?;
+    let simplify_s = t.elapsed().as_secs_f64();
+    drop(mesh);
+
+    let t = Instant::now();
+    progress
+        .spinner(format!("writing {}", output.display()), || {
+            crate::io::write(&output, &simplified)
+        })
+        .map_err(lib)
+        .context("cannot write the output")?;
+    let save_s = t.elapsed().as_secs_f64();
+
+    let times = Times {
+        load: load_s,
+        simplify: simplify_s,
+        save: save_s,
+    };
+    let out = std::io::stdout();
+    let mut out = out.lock();
+    if args.json {
+        let json = simplify_json(&input, &output, &report, &times);
+        writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
+    } else if !args.quiet {
+        write_summary(&mut out, &input, &output, &report, &times, args.stats)?;
+    }
+    out.flush()?;
+    Ok(ExitCode::SUCCESS)
+}
+
+struct Times {
+    load: f64,
+    simplify: f64,
+    save: f64,
+}
+
+fn simplify_json(input: &Input, output: &Path, r: &SimplifyReport, t: &Times) -> serde_json::Value {
+    serde_json::json!({
+        "input": input.display(),
+        "output": output.display().to_string(),
+        "backend": r.backend,
+        "input_faces": r.input_faces,
+        "input_vertices": r.input_vertices,
+        "target_faces": r.target_faces,
+        "output_faces": r.output_faces,
+        "output_vertices": r.output_vertices,
+        "stop_reason": r.stop_reason,
+        "stop_reason_explained": r.stop_reason.explain(),
+        "collapses": r.collapses,
+        "max_collapse_error": r.max_collapse_error,
+        "pinned_vertices": r.pinned_vertices,
+        "dropped_degenerate_faces": r.dropped_degenerate_faces,
+        "seconds": { "load": t.load, "simplify": t.simplify, "save": t.save },
+    })
+}
+
+fn write_summary(
+    out: &mut impl Write,
+    input: &Input,
+    output: &Path,
+    r: &SimplifyReport,
+    t: &Times,
+    stats: bool,
+) -> std::io::Result<()> {
+    let pct = |n: usize| {
+        if r.input_faces == 0 {
+            100.0
+        } else {
+            100.0 * n as f64 / r.input_faces as f64
+        }
+    };
+    writeln!(
+        out,
+        "input    {}: {} faces, {} vertices",
+        input.display(),
+        r.input_faces,
+        r.input_vertices
+    )?;
+    writeln!(
+        out,
+        "output   {}: {} faces, {} vertices ({:.1}% of the faces; target {})",
+        output.display(),
+        r.output_faces,
+        r.output_vertices,
+        pct(r.output_faces),
+        r.target_faces
+    )?;
+    match r.stop_reason {
+        crate::StopReason::TargetReached => writeln!(out, "result   {}", r.stop_reason.explain())?,
+        reason => writeln!(
+            out,
+            "result   target of {} faces not reached: {}",
+            r.target_faces,
+            reason.explain()
+        )?,
+    }
+    writeln!(
+        out,
+        "time     load {:.3} s, simplify {:.3} s, save {:.3} s (backend {})",
+        t.load,
+        t.simplify,
+        t.save,
+        r.backend.name()
+    )?;
+    if stats {
+        writeln!(out, "collapses           {}", r.collapses)?;
+        writeln!(
+            out,
+            "pinned vertices     {} (kept in place at attribute seams or non-manifold points)",
+            r.pinned_vertices
+        )?;
+        writeln!(
+            out,
+            "dropped degenerate  {} faces with a repeated vertex, removed before simplifying",
+            r.dropped_degenerate_faces
+        )?;
+        writeln!(
+            out,
+            "max collapse error  {:.3e} of the bounding-box diagonal",
+            r.max_collapse_error
+        )?;
+    }
+    Ok(())
+}
+
+fn run_info(args: InfoArgs) -> Result<ExitCode> {
+    let progress = Progress::new(!args.json && std::io::stderr().is_terminal());
+    let mesh = load(&args.input, &progress)?;
+    let topo = progress.spinner("measuring".to_string(), || mesh::topology(&mesh));
+    let diagonal = mesh.bounds().map_or(0.0, |b| b.diagonal());
+    let out = std::io::stdout();
+    let mut out = out.lock();
+    if args.json {
+        let mut json = serde_json::to_value(&topo)?;
+        let obj = json
+            .as_object_mut()
+            .expect("the topology report serializes as an object");
+        let extra = serde_json::json!({
+            "input": args.input.display(),
+            "diagonal": diagonal,
+            "manifold": topo.is_manifold(),
+            "closed": topo.is_closed(),
+            "consistently_oriented": topo.is_consistently_oriented(),
+            "normals": mesh.normals.is_some(),
+            "uvs": mesh.uvs.is_some(),
+            "colors": mesh.colors.is_some(),
+            "materials": mesh.materials.len(),
+            "groups": mesh.groups.len(),
+        });
+        obj.extend(extra.as_object().cloned().unwrap_or_default());
+        writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
+    } else {
+        let t = &topo;
+        let yes_no = |b: bool, yes: &'static str, no: &'static str| if b { yes } else { no };
+        writeln!(out, "{}", args.input.display())?;
+        writeln!(
+            out,
+            "  vertices           {} ({} welded by position)",
+            t.vertices, t.welded_vertices
+        )?;
+        writeln!(out, "  faces              {}", t.faces)?;
+        writeln!(out, "  edges              {}", t.edges)?;
+        writeln!(
+            out,
+            "  boundary           {} edges in {} loops ({})",
+            t.boundary_edges,
+            t.boundary_loops,
+            yes_no(t.is_closed(), "closed", "open")
+        )?;
+        writeln!(
+            out,
+            "  non-manifold       {} edges, {} vertices ({})",
+            t.non_manifold_edges,
+            t.non_manifold_vertices,
+            yes_no(t.is_manifold(), "manifold", "not manifold")
+        )?;
+        writeln!(out, "  components         {}", t.connected_components)?;
+        let genus = t
+            .genus
+            .map_or("undefined (not manifold)".to_string(), |g| g.to_string());
+        writeln!(
+            out,
+            "  euler / genus      {} / {}",
+            t.euler_characteristic, genus
+        )?;
+        if t.is_consistently_oriented() {
+            writeln!(out, "  orientation        consistent")?;
+        } else {
+            writeln!(
+                out,
+                "  orientation        inconsistent: {} edges traversed the same way by both faces",
+                t.inconsistently_oriented_edges
+            )?;
+        }
+        writeln!(out, "  degenerate faces   {}", t.degenerate_faces)?;
+        writeln!(out, "  duplicate faces    {}", t.duplicate_faces)?;
+        writeln!(out, "  area               {:.6}", t.surface_area)?;
+        writeln!(out, "  volume             {:.6} (signed)", t.signed_volume)?;
+        writeln!(
+            out,
+            "  bounding box       {:?} .. {:?}, diagonal {:.6}",
+            t.bounds_min, t.bounds_max, diagonal
+        )?;
+        let attrs: Vec<&str> = [
+            (mesh.normals.is_some(), "normals"),
+            (mesh.uvs.is_some(), "uvs"),
+            (mesh.colors.is_some(), "colors"),
+        ]
+        .into_iter()
+        .filter_map(|(has, name)| has.then_some(name))
+        .collect();
+        writeln!(
+            out,
+            "  attributes         {}",
+            if attrs.is_empty() {
+                "none".to_string()
+            } else {
+                attrs.join(", ")
+            }
+        )?;
+        writeln!(out, "  materials          {}", mesh.materials.len())?;
+        writeln!(out, "  groups             {}", mesh.groups.len())?;
+    }
+    out.flush()?;
+    Ok(ExitCode::SUCCESS)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Progress
+// ---------------------------------------------------------------------------------------------
+
+/// Progress bars on stderr for steps that take long enough to wonder about. A bar starts hidden
+/// and is revealed only once its step has run for [`Progress::DELAY`], so quick steps print
+/// nothing; with `enabled` false (not a terminal, `--quiet`, `--json`) nothing is ever drawn.
+struct Progress {
+    enabled: bool,
+}
+
+impl Progress {
+    const DELAY: Duration = Duration::from_millis(500);
+
+    fn new(enabled: bool) -> Self {
+        Progress { enabled }
+    }
+
+    /// Runs `f` with a spinner (for steps that report no progress of their own).
+    fn spinner<T>(&self, msg: String, f: impl FnOnce() -> T) -> T {
+        let style = ProgressStyle::with_template("{spinner} {msg} {elapsed}")
+            .expect("valid progress template");
+        self.run(None, style, msg, |_| f())
+    }
+
+    /// Runs `f` with a bar; `f` gets a setter for the fraction done (0..=1).
+    fn bar<T>(&self, msg: &str, f: impl FnOnce(&dyn Fn(f32)) -> T) -> T {
+        let style = ProgressStyle::with_template("{msg} [{bar:40}] {percent:>3}% {elapsed}")
+            .expect("valid progress template")
+            .progress_chars("=> ");
+        self.run(Some(1000), style, msg.to_string(), |pb| {
+            f(&|frac: f32| pb.set_position((frac.clamp(0.0, 1.0) * 1000.0) as u64))
+        })
+    }
+
+    fn run<T>(
+        &self,
+        len: Option<u64>,
+        style: ProgressStyle,
+        msg: String,
+        f: impl FnOnce(&ProgressBar) -> T,
+    ) -> T {
+        let pb = ProgressBar::with_draw_target(len, ProgressDrawTarget::hidden())
+            .with_style(style)
+            .with_message(msg);
+        if !self.enabled {
+            return f(&pb);
+        }
+        let (done, wait) = mpsc::channel::<()>();
+        let result = std::thread::scope(|s| {
+            let reveal = pb.clone();
+            s.spawn(move || {
+                // Dropping `done` ends the wait early: the step finished in time, draw nothing.
+                if let Err(mpsc::RecvTimeoutError::Timeout) = wait.recv_timeout(Self::DELAY) {
+                    reveal.set_draw_target(ProgressDrawTarget::stderr());
+                    reveal.enable_steady_tick(Duration::from_millis(100));
+                }
+            });
+            let r = f(&pb);
+            drop(done);
+            r
+        });
+        pb.finish_and_clear();
+        result
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn cli_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn every_builtin_is_listed_in_the_help() {
+        for b in BUILTINS {
+            assert!(
+                SIMPLIFY_AFTER_HELP.contains(&format!("\n  {:<14}", b.name)),
+                "{} missing from the simplify help",
+                b.name
+            );
+        }
+    }
+
+    #[test]
+    fn builtin_defaults_match_the_help() {
+        for b in BUILTINS {
+            let faces = builtin(b.name).unwrap().face_count().to_string();
+            let line = SIMPLIFY_AFTER_HELP
+                .lines()
+                .find(|l| l.starts_with(&format!("  {:<14}", b.name)))
+                .unwrap();
+            assert!(
+                line.ends_with(&format!(" {faces} faces")),
+                "{line}: {faces}"
+            );
+        }
+    }
+
+    #[test]
+    fn builtin_face_count_is_a_minimum() {
+        for b in BUILTINS {
+            for n in [1, 500, 3001] {
+                let m = builtin(&format!("builtin:{}:{n}", b.name)).unwrap();
+                assert!(
+                    m.face_count() >= n,
+                    "{}:{n} gave {}",
+                    b.name,
+                    m.face_count()
+                );
+                m.validate().unwrap();
+            }
+        }
+        assert!(builtin("builtin:nope").is_err());
+        assert!(builtin("builtin:sphere:0").is_err());
+        assert!(builtin("builtin:sphere:x").is_err());
+        assert!(builtin("sphere:99999999999").is_err());
+    }
+}

@@ -1,0 +1,348 @@
+//! The `meshslim` binary end to end: arguments, exit codes, messages, files written.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn meshslim(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_meshslim"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run meshslim")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Asserts the exit code, showing both streams when it differs.
+fn expect_code(o: &Output, code: i32) {
+    assert_eq!(
+        o.status.code(),
+        Some(code),
+        "stdout:\n{}\nstderr:\n{}",
+        stdout(o),
+        stderr(o)
+    );
+}
+
+fn json(o: &Output) -> serde_json::Value {
+    serde_json::from_str(&stdout(o))
+        .unwrap_or_else(|e| panic!("stdout is not one JSON value ({e}):\n{}", stdout(o)))
+}
+
+fn info_faces(path: &Path, dir: &Path) -> u64 {
+    let o = meshslim(&["info", path.to_str().unwrap(), "--json"], dir);
+    expect_code(&o, 0);
+    json(&o)["faces"].as_u64().expect("info --json has faces")
+}
+
+/// 1280 faces: small enough that every test stays fast in any profile.
+const SMALL_SPHERE: &str = "builtin:sphere:1000";
+
+#[test]
+fn simplify_builtin_sphere_to_obj_and_ply_by_ratio_and_faces() {
+    let dir = tempfile::tempdir().unwrap();
+    for (file, flag, value, want) in [
+        ("half.obj", "--ratio", "0.5", 640),
+        ("half.ply", "--ratio", "0.5", 640),
+        ("n300.obj", "--faces", "300", 300),
+        ("n300.ply", "--faces", "300", 300),
+    ] {
+        let o = meshslim(&["simplify", SMALL_SPHERE, file, flag, value], dir.path());
+        expect_code(&o, 0);
+        assert!(
+            stdout(&o).contains("1280 faces"),
+            "the summary names the input faces:\n{}",
+            stdout(&o)
+        );
+        let faces = info_faces(&dir.path().join(file), dir.path());
+        assert!(
+            faces == want || faces + 1 == want,
+            "{file}: {faces} faces, wanted {want} (or one below)"
+        );
+    }
+}
+
+#[test]
+fn default_ratio_is_a_tenth() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(&["simplify", SMALL_SPHERE, "out.ply", "--json"], dir.path());
+    expect_code(&o, 0);
+    assert_eq!(json(&o)["target_faces"], 128);
+}
+
+#[test]
+fn json_report_is_the_only_stdout_and_has_every_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(
+        &[
+            "simplify",
+            SMALL_SPHERE,
+            "out.ply",
+            "--faces",
+            "400",
+            "--json",
+            "--stats",
+        ],
+        dir.path(),
+    );
+    expect_code(&o, 0);
+    let v = json(&o);
+    for key in [
+        "input_faces",
+        "output_faces",
+        "input_vertices",
+        "output_vertices",
+        "target_faces",
+        "backend",
+        "stop_reason",
+        "collapses",
+        "max_collapse_error",
+        "seconds",
+        "input",
+        "output",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key} in {v}");
+    }
+    for key in ["load", "simplify", "save"] {
+        assert!(v["seconds"][key].is_f64(), "seconds.{key} in {v}");
+    }
+    assert_eq!(v["input"], SMALL_SPHERE);
+    assert_eq!(v["output"], "out.ply");
+    assert_eq!(v["backend"], "cpu");
+    assert_eq!(v["input_faces"], 1280);
+    assert_eq!(v["target_faces"], 400);
+    assert_eq!(v["stop_reason"], "target-reached");
+    assert_eq!(
+        info_faces(&dir.path().join("out.ply"), dir.path()),
+        v["output_faces"]
+    );
+}
+
+#[test]
+fn stats_prints_the_report_details() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(
+        &["simplify", SMALL_SPHERE, "out.obj", "--stats"],
+        dir.path(),
+    );
+    expect_code(&o, 0);
+    let out = stdout(&o);
+    for word in [
+        "collapses",
+        "pinned vertices",
+        "degenerate",
+        "max collapse error",
+        "time",
+    ] {
+        assert!(out.contains(word), "{word} missing from:\n{out}");
+    }
+}
+
+#[test]
+fn refuses_to_overwrite_the_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(&["simplify", SMALL_SPHERE, "in.ply"], dir.path());
+    expect_code(&o, 0);
+    let input = dir.path().join("in.ply");
+    let before = std::fs::read(&input).unwrap();
+    // The same file, also written another way.
+    for out in ["in.ply", "./in.ply"] {
+        let o = meshslim(&["simplify", "in.ply", out, "--ratio", "0.5"], dir.path());
+        expect_code(&o, 1);
+        assert!(stderr(&o).contains("in.ply"), "{}", stderr(&o));
+        assert!(stderr(&o).contains("overwrite"), "{}", stderr(&o));
+    }
+    assert_eq!(std::fs::read(&input).unwrap(), before, "the input changed");
+}
+
+#[test]
+fn no_input_prints_getting_started_and_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    for args in [&["simplify"][..], &[][..]] {
+        let o = meshslim(args, dir.path());
+        expect_code(&o, 2);
+        let err = stderr(&o);
+        assert!(
+            err.contains("meshslim simplify builtin:bumpy-sphere bumpy-10.ply --ratio 0.1"),
+            "{err}"
+        );
+        assert!(err.contains("meshslim info"), "{err}");
+        assert!(err.contains("--help"), "{err}");
+        assert!(stdout(&o).is_empty());
+    }
+}
+
+#[test]
+fn input_without_output_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(&["simplify", SMALL_SPHERE], dir.path());
+    expect_code(&o, 2);
+    assert!(stderr(&o).starts_with("error: "), "{}", stderr(&o));
+    assert!(stderr(&o).contains("output"), "{}", stderr(&o));
+}
+
+#[test]
+fn unsupported_output_extension_fails_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(&["simplify", SMALL_SPHERE, "out.xyz"], dir.path());
+    expect_code(&o, 1);
+    assert!(stderr(&o).contains("xyz"), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "nothing may be written"
+    );
+}
+
+#[test]
+fn missing_input_names_the_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(&["simplify", "no-such-mesh.ply", "out.ply"], dir.path());
+    expect_code(&o, 1);
+    assert!(stderr(&o).contains("no-such-mesh.ply"), "{}", stderr(&o));
+    assert!(!dir.path().join("out.ply").exists());
+    let o = meshslim(&["info", "no-such-mesh.obj"], dir.path());
+    expect_code(&o, 1);
+    assert!(stderr(&o).contains("no-such-mesh.obj"), "{}", stderr(&o));
+}
+
+#[test]
+fn corrupt_input_names_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("huge-claim.ply");
+    std::fs::write(
+        &bad,
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+         property float z\nelement face 4000000000\nproperty list uchar int vertex_indices\n\
+         end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+    )
+    .unwrap();
+    let o = meshslim(&["simplify", "huge-claim.ply", "out.ply"], dir.path());
+    expect_code(&o, 1);
+    let err = stderr(&o);
+    assert!(err.contains("huge-claim.ply"), "{err}");
+    assert_eq!(err.matches("error:").count(), 1, "printed once: {err}");
+    assert!(!dir.path().join("out.ply").exists());
+}
+
+#[test]
+fn out_of_range_ratio_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    for r in ["0", "1.5", "-0.1", "nan"] {
+        let o = meshslim(
+            &["simplify", SMALL_SPHERE, "out.ply", &format!("--ratio={r}")],
+            dir.path(),
+        );
+        expect_code(&o, 2);
+        assert!(stderr(&o).contains("ratio"), "{}", stderr(&o));
+    }
+    let o = meshslim(
+        &[
+            "simplify",
+            SMALL_SPHERE,
+            "out.ply",
+            "--ratio",
+            "0.5",
+            "--faces",
+            "10",
+        ],
+        dir.path(),
+    );
+    expect_code(&o, 2);
+    assert!(!dir.path().join("out.ply").exists());
+}
+
+#[test]
+fn unknown_builtin_is_a_usage_error_listing_the_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(&["simplify", "builtin:teapot", "out.ply"], dir.path());
+    expect_code(&o, 2);
+    for name in ["sphere", "bumpy-sphere", "double-torus"] {
+        assert!(stderr(&o).contains(name), "{}", stderr(&o));
+    }
+}
+
+#[test]
+fn info_reports_topology_of_a_builtin() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(&["info", "builtin:torus:1000", "--json"], dir.path());
+    expect_code(&o, 0);
+    let v = json(&o);
+    assert_eq!(v["genus"], 1);
+    assert_eq!(v["boundary_loops"], 0);
+    assert_eq!(v["normals"], false);
+    let o = meshslim(&["info", "builtin:grid:200"], dir.path());
+    expect_code(&o, 0);
+    let out = stdout(&o);
+    for word in [
+        "faces",
+        "boundary",
+        "genus",
+        "orientation",
+        "area",
+        "volume",
+        "diagonal",
+    ] {
+        assert!(out.contains(word), "{word} missing from:\n{out}");
+    }
+}
+
+#[test]
+fn help_teaches() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(&["simplify", "--help"], dir.path());
+    expect_code(&o, 0);
+    let help = stdout(&o);
+    for word in [
+        "Examples:",
+        "bumpy-sphere",
+        "double-torus",
+        "bounding-box diagonal",
+        "QualityThr",
+        "[default: 0.3]",
+        "--lock-border",
+    ] {
+        assert!(help.contains(word), "{word} missing from:\n{help}");
+    }
+    let o = meshslim(&["info", "--help"], dir.path());
+    expect_code(&o, 0);
+    assert!(stdout(&o).contains("Examples:"));
+}
+
+#[test]
+fn shared_horse_to_ten_percent() {
+    let horse = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/models/horse.ply");
+    if !horse.exists() {
+        eprintln!("note: {} not found; skipping", horse.display());
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(
+        &[
+            "simplify",
+            horse.to_str().unwrap(),
+            "horse-10.ply",
+            "--ratio",
+            "0.1",
+            "--json",
+        ],
+        dir.path(),
+    );
+    expect_code(&o, 0);
+    let v = json(&o);
+    let input = v["input_faces"].as_u64().unwrap();
+    let target = (input as f64 * 0.1).round() as u64;
+    assert_eq!(v["target_faces"], target);
+    let faces = info_faces(&dir.path().join("horse-10.ply"), dir.path());
+    assert_eq!(v["output_faces"], faces);
+    assert!(
+        faces == target || faces + 1 == target,
+        "{faces} vs {target}"
+    );
+}
