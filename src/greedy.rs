@@ -82,6 +82,8 @@ pub(crate) struct Prepared {
     pub quadrics: Vec<Quadric>,
     pub mobility: Vec<Mobility>,
     pub border: Vec<bool>,
+    /// More than one attribute vertex at this position.
+    pub seam: Vec<bool>,
     pub center: [f64; 3],
     pub scale: f64,
     pub dropped_degenerate: usize,
@@ -108,8 +110,13 @@ impl Prepared {
         }
         let dropped_degenerate = mesh.triangles.len() - faces.len();
         // Faces in the order of their first vertex, so a vertex's faces sit close in memory.
-        let mut order: Vec<u32> = (0..faces.len() as u32).collect();
-        order.sort_by_key(|&f| faces[f as usize].map(|v| topo[v as usize]).into_iter().min());
+        let mut order: Vec<(u32, u32)> = faces
+            .iter()
+            .enumerate()
+            .map(|(f, t)| (t.map(|v| topo[v as usize]).into_iter().min().unwrap_or(0), f as u32))
+            .collect();
+        order.sort_unstable();
+        let order: Vec<u32> = order.into_iter().map(|(_, f)| f).collect();
         let faces: Vec<[u32; 3]> = order.iter().map(|&f| faces[f as usize]).collect();
         let face_origin: Vec<u32> = order.iter().map(|&f| face_origin[f as usize]).collect();
 
@@ -243,6 +250,7 @@ impl Prepared {
             quadrics,
             mobility,
             border,
+            seam: attr_count.iter().map(|&c| c > 1).collect(),
             center,
             scale,
             dropped_degenerate,
@@ -278,8 +286,9 @@ fn spatial_order(positions: &[[f32; 3]], topo: Vec<u32>, firsts: Vec<u32>) -> (V
         let q = |i: usize| (((p[i] - lo[i]) / spread) * 1023.0) as u32;
         part(q(0)) | (part(q(1)) << 1) | (part(q(2)) << 2)
     };
-    let mut order: Vec<u32> = (0..firsts.len() as u32).collect();
-    order.sort_by_key(|&c| (code(firsts[c as usize]), c));
+    let mut keyed: Vec<(u32, u32)> = (0..firsts.len() as u32).map(|c| (code(firsts[c as usize]), c)).collect();
+    keyed.sort_unstable();
+    let order: Vec<u32> = keyed.into_iter().map(|(_, c)| c).collect();
     let mut rank = vec![0u32; firsts.len()];
     for (new, &old) in order.iter().enumerate() {
         rank[old as usize] = new as u32;
@@ -300,12 +309,15 @@ struct Collapse {
     keep_attr: u32,
 }
 
+type FaceList = Vec<u32>;
+
 struct State<'a> {
     opts: &'a SimplifyOptions,
     p: Prepared,
     topo_faces: Vec<[u32; 3]>,
     face_alive: Vec<bool>,
-    vert_faces: Vec<Vec<u32>>,
+    /// Live (and some dead, pruned lazily) faces around each vertex.
+    vert_faces: Vec<FaceList>,
     alive: Vec<bool>,
     version: Vec<u32>,
     mark: Vec<u32>,
@@ -513,20 +525,23 @@ impl<'a> State<'a> {
         // the last collapses of tiny components.
         // (Covered by the tetrahedral check above for closed components.)
 
-        // Attribute vertex of `keep` that the removed vertex's corners take: the one `keep` uses
-        // in the faces on the edge, which must agree.
-        let mut keep_attr = u32::MAX;
-        for &f in &self.vert_faces[r] {
-            if !self.face_alive[f as usize] {
-                continue;
-            }
-            let t = self.topo_faces[f as usize];
-            if let Some(i) = t.iter().position(|&u| u == keep) {
-                let av = self.p.faces[f as usize][i];
-                if keep_attr != u32::MAX && keep_attr != av {
-                    return None;
+        // Attribute vertex of `keep` that the removed vertex's corners take: its only one, or for
+        // a seam vertex the one it uses in the faces on the edge, which must agree.
+        let mut keep_attr = self.p.first_attr[k];
+        if self.p.seam[k] {
+            keep_attr = u32::MAX;
+            for &f in &self.vert_faces[r] {
+                if !self.face_alive[f as usize] {
+                    continue;
                 }
-                keep_attr = av;
+                let t = self.topo_faces[f as usize];
+                if let Some(i) = t.iter().position(|&u| u == keep) {
+                    let av = self.p.faces[f as usize][i];
+                    if keep_attr != u32::MAX && keep_attr != av {
+                        return None;
+                    }
+                    keep_attr = av;
+                }
             }
         }
 
@@ -593,7 +608,7 @@ impl<'a> State<'a> {
         self.alive[r] = false;
         let remove_attr = self.p.first_attr[r];
         let mut removed = 0;
-        let moved: Vec<u32> = std::mem::take(&mut self.vert_faces[r]);
+        let moved: FaceList = std::mem::take(&mut self.vert_faces[r]);
         for &f in &moved {
             let fu = f as usize;
             if !self.face_alive[fu] {
@@ -617,7 +632,7 @@ impl<'a> State<'a> {
             self.vert_faces[k].push(f);
         }
         let alive = &self.face_alive;
-        self.vert_faces[k].retain(|&f| alive[f as usize]);
+        self.vert_faces[k].retain(|f| alive[*f as usize]);
         self.version[k] = self.version[k].wrapping_add(1);
         self.version[r] = self.version[r].wrapping_add(1);
         removed
@@ -662,9 +677,9 @@ pub fn simplify_greedy(
             counts[v as usize] += 1;
         }
     }
-    let mut vert_faces: Vec<Vec<u32>> = counts
+    let mut vert_faces: Vec<FaceList> = counts
         .iter()
-        .map(|&c| Vec::with_capacity(c as usize))
+        .map(|&c| FaceList::with_capacity(c as usize))
         .collect();
     for (f, t) in topo_faces.iter().enumerate() {
         for &v in t {
