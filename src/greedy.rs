@@ -89,9 +89,26 @@ pub(crate) struct Prepared {
     pub dropped_degenerate: usize,
 }
 
+/// What a sub-problem of the partitioned greedy inherits from the whole mesh: its frame, its
+/// quadrics (per vertex of the sub-mesh) and the vertices it must keep in place.
+pub(crate) struct Inherited<'x> {
+    pub center: [f64; 3],
+    pub scale: f64,
+    pub quadrics: &'x [Quadric],
+    pub pinned: &'x [bool],
+}
+
 impl Prepared {
     pub fn new(input: &Mesh, opts: &SimplifyOptions) -> Prepared {
-        let mesh = weld(input).mesh;
+        Self::build(weld(input).mesh, opts, None)
+    }
+
+    /// Prepares an already welded mesh; with `inherited`, quadrics, frame and pins come from it.
+    pub(crate) fn build(
+        mesh: Mesh,
+        opts: &SimplifyOptions,
+        inherited: Option<&Inherited>,
+    ) -> Prepared {
         let (topo, firsts) = position_classes(&mesh.positions);
         let (topo, firsts) = spatial_order(&mesh.positions, topo, firsts);
         let nt = firsts.len();
@@ -113,17 +130,23 @@ impl Prepared {
         let mut order: Vec<(u32, u32)> = faces
             .iter()
             .enumerate()
-            .map(|(f, t)| (t.map(|v| topo[v as usize]).into_iter().min().unwrap_or(0), f as u32))
+            .map(|(f, t)| {
+                (
+                    t.map(|v| topo[v as usize]).into_iter().min().unwrap_or(0),
+                    f as u32,
+                )
+            })
             .collect();
         order.sort_unstable();
         let order: Vec<u32> = order.into_iter().map(|(_, f)| f).collect();
         let faces: Vec<[u32; 3]> = order.iter().map(|&f| faces[f as usize]).collect();
         let face_origin: Vec<u32> = order.iter().map(|&f| face_origin[f as usize]).collect();
 
-        let (center, scale) = match mesh.bounds() {
-            Some(b) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
-            Some(b) => (b.center(), 1.0),
-            None => ([0.0; 3], 1.0),
+        let (center, scale) = match (inherited, mesh.bounds()) {
+            (Some(h), _) => (h.center, h.scale),
+            (None, Some(b)) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
+            (None, Some(b)) => (b.center(), 1.0),
+            (None, None) => ([0.0; 3], 1.0),
         };
         let pos: Vec<[f64; 3]> = firsts
             .iter()
@@ -135,7 +158,8 @@ impl Prepared {
 
         let tf = |f: &[u32; 3]| f.map(|v| topo[v as usize]);
         let mut quadrics = vec![Quadric::default(); nt];
-        for f in &faces {
+        let fresh = inherited.is_none();
+        for f in faces.iter().filter(|_| fresh) {
             let t = tf(f);
             let [p0, p1, p2] = t.map(|v| pos[v as usize]);
             let c = cross(sub(p1, p0), sub(p2, p0));
@@ -196,7 +220,7 @@ impl Prepared {
                     let e = sub(pos[b as usize], pos[a as usize]);
                     let n = cross(e, fnrm);
                     let (ln, le2) = (norm(n), dot(e, e));
-                    if ln > 0.0 && opts.border_weight > 0.0 {
+                    if fresh && ln > 0.0 && opts.border_weight > 0.0 {
                         let n = n.map(|x| x / ln);
                         let q = Quadric::from_plane(
                             n,
@@ -240,6 +264,14 @@ impl Prepared {
                 }
             }
         }
+        if let Some(h) = inherited {
+            for (v, &t) in topo.iter().enumerate() {
+                quadrics[t as usize] = h.quadrics[v];
+                if h.pinned[v] {
+                    mobility[t as usize] = Mobility::Pinned;
+                }
+            }
+        }
         Prepared {
             mesh,
             topo,
@@ -272,7 +304,10 @@ fn spatial_order(positions: &[[f32; 3]], topo: Vec<u32>, firsts: Vec<u32>) -> (V
         lo = [0, 1, 2].map(|i| lo[i].min(p[i]));
         hi = [0, 1, 2].map(|i| hi[i].max(p[i]));
     }
-    let spread = (0..3).map(|i| hi[i] - lo[i]).fold(0.0f32, f32::max).max(f32::MIN_POSITIVE);
+    let spread = (0..3)
+        .map(|i| hi[i] - lo[i])
+        .fold(0.0f32, f32::max)
+        .max(f32::MIN_POSITIVE);
     // Spread the low 10 bits of x to every third bit.
     let part = |x: u32| {
         let mut x = x & 0x3ff;
@@ -286,7 +321,9 @@ fn spatial_order(positions: &[[f32; 3]], topo: Vec<u32>, firsts: Vec<u32>) -> (V
         let q = |i: usize| (((p[i] - lo[i]) / spread) * 1023.0) as u32;
         part(q(0)) | (part(q(1)) << 1) | (part(q(2)) << 2)
     };
-    let mut keyed: Vec<(u32, u32)> = (0..firsts.len() as u32).map(|c| (code(firsts[c as usize]), c)).collect();
+    let mut keyed: Vec<(u32, u32)> = (0..firsts.len() as u32)
+        .map(|c| (code(firsts[c as usize]), c))
+        .collect();
     keyed.sort_unstable();
     let order: Vec<u32> = keyed.into_iter().map(|(_, c)| c).collect();
     let mut rank = vec![0u32; firsts.len()];
@@ -324,6 +361,11 @@ struct State<'a> {
     mark_gen: u32,
     cos_max_angle: f64,
     scratch: Vec<u32>,
+    /// Live faces.
+    faces: usize,
+    collapses: usize,
+    max_collapse_err2: f64,
+    hit_max_error: bool,
 }
 
 /// The queue: a radix heap (a monotone priority queue) keyed by priority bits, holding
@@ -657,128 +699,185 @@ impl<'a> State<'a> {
     }
 }
 
+impl<'a> State<'a> {
+    /// Sets up the collapse state and queues every unique edge once, keyed by its quadric error.
+    fn new(p: Prepared, opts: &'a SimplifyOptions) -> (State<'a>, Queue) {
+        let nt = p.pos.len();
+        let nf = p.faces.len();
+        let topo_faces: Vec<[u32; 3]> = p
+            .faces
+            .iter()
+            .map(|f| f.map(|v| p.topo[v as usize]))
+            .collect();
+        let mut counts = vec![0u32; nt];
+        for t in &topo_faces {
+            for &v in t {
+                counts[v as usize] += 1;
+            }
+        }
+        let mut vert_faces: Vec<FaceList> = counts
+            .iter()
+            .map(|&c| FaceList::with_capacity(c as usize))
+            .collect();
+        for (f, t) in topo_faces.iter().enumerate() {
+            for &v in t {
+                vert_faces[v as usize].push(f as u32);
+            }
+        }
+        let s = State {
+            opts,
+            p,
+            topo_faces,
+            face_alive: vec![true; nf],
+            vert_faces,
+            alive: vec![true; nt],
+            version: vec![0; nt],
+            mark: vec![0; nt],
+            mark_gen: 0,
+            cos_max_angle: opts.max_normal_angle_deg.to_radians().cos(),
+            scratch: Vec::new(),
+            faces: nf,
+            collapses: 0,
+            max_collapse_err2: 0.0,
+            hit_max_error: false,
+        };
+        let mut edges: Vec<u64> = Vec::with_capacity(nf * 3);
+        for t in &s.topo_faces {
+            for i in 0..3 {
+                edges.push(edge_key(t[i], t[(i + 1) % 3]));
+            }
+        }
+        edges.sort_unstable();
+        edges.dedup();
+        let mut heap = Queue(RadixHeapMap::new());
+        for e in edges {
+            let (a, b) = ((e >> 32) as u32, e as u32);
+            if let Some((_, _, _, err)) = s.placement(a, b) {
+                heap.push(key(err), a, b, 0);
+            }
+        }
+        (s, heap)
+    }
+
+    /// Collapses the cheapest valid edges until `target` faces remain, the queue runs dry, or
+    /// the cheapest key exceeds `key_limit` (that entry stays queued). Returns true when it
+    /// stopped at the key limit.
+    fn run(
+        &mut self,
+        heap: &mut Queue,
+        target: usize,
+        key_limit: u32,
+        progress: &mut dyn FnMut(usize),
+    ) -> bool {
+        let max_err2 = self.opts.max_error.map(|e| e * e);
+        let mut next_report = self.collapses;
+        while self.faces > target {
+            let Some((k, a, b, stamp)) = heap.pop() else {
+                return false;
+            };
+            if k > key_limit {
+                heap.push(k, a, b, stamp);
+                return true;
+            }
+            // A removed vertex's version was bumped too, so one comparison retires every entry
+            // whose edge changed or vanished.
+            if self.stamp(a, b) != stamp {
+                continue;
+            }
+            let Some(c) = self.evaluate(a, b) else {
+                continue;
+            };
+            let full = key(c.priority);
+            if full > k {
+                heap.push(full, a, b, stamp);
+                continue;
+            }
+            let q = self.p.quadrics[c.keep as usize].sum(&self.p.quadrics[c.remove as usize]);
+            let err2 = if q.weight > 0.0 {
+                c.error / q.weight
+            } else {
+                0.0
+            };
+            if max_err2.is_some_and(|m| err2 > m) {
+                // Quadrics only grow, so this edge will not become acceptable again.
+                self.hit_max_error = true;
+                continue;
+            }
+            // An interior collapse removes two faces; never go more than one below the target.
+            let on_edge = self.vert_faces[c.remove as usize]
+                .iter()
+                .filter(|&&f| {
+                    self.face_alive[f as usize] && self.topo_faces[f as usize].contains(&c.keep)
+                })
+                .count();
+            if self.faces - on_edge + 1 < target {
+                continue;
+            }
+            self.faces -= self.apply(&c);
+            self.collapses += 1;
+            self.max_collapse_err2 = self.max_collapse_err2.max(err2);
+            self.push_edges_of(c.keep, heap);
+            if self.collapses >= next_report {
+                progress(self.faces);
+                next_report = self.collapses + 4096;
+            }
+        }
+        false
+    }
+}
+
+/// Meshes at least this large are simplified in [`REGIONS`] parts at once (see
+/// [`simplify_greedy`]); smaller ones in one sequential run.
+const PARTITION_MIN_FACES: usize = 100_000;
+/// Fixed, not the thread count, so the result is the same on every machine.
+const REGIONS: usize = 8;
+
 /// Greedy simplification; `progress` receives the fraction of the needed collapses done.
+///
+/// Large meshes are simplified in two phases, so that both cores (or more) work. Phase 1 cuts
+/// the vertices into [`REGIONS`] runs of the Morton order (compact patches); each region runs
+/// its own greedy queue on its faces, with the vertices on faces that cross regions pinned, so
+/// regions never touch each other's data. The regions advance together through rising cost
+/// ceilings (doubling each epoch): within a ceiling each region takes its cheapest collapses in
+/// order, which is what one global queue would take across the mesh, up to the order between
+/// independent regions, which does not change the result. Phase 1 stops once the mesh is within
+/// 20% of the target; phase 2 runs one sequential queue over the whole reduced mesh, region
+/// borders included, with the quadrics accumulated so far, down to the exact target.
 pub fn simplify_greedy(
     input: &Mesh,
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
-    let prepared = Prepared::new(input, opts);
-    let nt = prepared.pos.len();
-    let nf = prepared.faces.len();
-    let topo_faces: Vec<[u32; 3]> = prepared
-        .faces
-        .iter()
-        .map(|f| f.map(|v| prepared.topo[v as usize]))
-        .collect();
-    let mut counts = vec![0u32; nt];
-    for t in &topo_faces {
-        for &v in t {
-            counts[v as usize] += 1;
-        }
-    }
-    let mut vert_faces: Vec<FaceList> = counts
-        .iter()
-        .map(|&c| FaceList::with_capacity(c as usize))
-        .collect();
-    for (f, t) in topo_faces.iter().enumerate() {
-        for &v in t {
-            vert_faces[v as usize].push(f as u32);
-        }
-    }
-    let pinned_vertices = prepared
+    let p = Prepared::new(input, opts);
+    let pinned_vertices = p
         .mobility
         .iter()
         .filter(|&&m| m == Mobility::Pinned)
         .count();
-    let mut s = State {
-        opts,
-        p: prepared,
-        topo_faces,
-        face_alive: vec![true; nf],
-        vert_faces,
-        alive: vec![true; nt],
-        version: vec![0; nt],
-        mark: vec![0; nt],
-        mark_gen: 0,
-        cos_max_angle: opts.max_normal_angle_deg.to_radians().cos(),
-        scratch: Vec::new(),
-    };
-
-    // Initial queue: each unique edge once, keyed by its quadric error.
-    let mut edges: Vec<u64> = Vec::with_capacity(nf * 3);
-    for t in &s.topo_faces {
-        for i in 0..3 {
-            edges.push(edge_key(t[i], t[(i + 1) % 3]));
-        }
-    }
-    edges.sort_unstable();
-    edges.dedup();
-    let mut heap = Queue(RadixHeapMap::new());
-    for e in edges {
-        let (a, b) = ((e >> 32) as u32, e as u32);
-        if let Some((_, _, _, err)) = s.placement(a, b) {
-            heap.push(key(err), a, b, 0);
-        }
-    }
-
+    let nf = p.faces.len();
     let target = opts.target_faces;
-    let max_err2 = opts.max_error.map(|e| e * e);
-    let mut faces = nf;
-    let mut collapses = 0;
-    let mut max_collapse_err2: f64 = 0.0;
-    let mut hit_max_error = false;
     let need = nf.saturating_sub(target).max(1) as f32;
-    let mut next_report = 0usize;
-    while faces > target {
-        let Some((k, a, b, stamp)) = heap.pop() else {
-            break;
-        };
-        // A removed vertex's version was bumped too, so one comparison retires every entry
-        // whose edge changed or vanished.
-        if s.stamp(a, b) != stamp {
-            continue;
-        }
-        let Some(c) = s.evaluate(a, b) else { continue };
-        let full = key(c.priority);
-        if full > k {
-            heap.push(full, a, b, stamp);
-            continue;
-        }
-        let q = s.p.quadrics[c.keep as usize].sum(&s.p.quadrics[c.remove as usize]);
-        let err2 = if q.weight > 0.0 {
-            c.error / q.weight
-        } else {
-            0.0
-        };
-        if let Some(m) = max_err2 {
-            if err2 > m {
-                hit_max_error = true;
-                continue;
-            }
-        }
-        // An interior collapse removes two faces; never go more than one below the target.
-        let on_edge = s.vert_faces[c.remove as usize]
-            .iter()
-            .filter(|&&f| s.face_alive[f as usize] && s.topo_faces[f as usize].contains(&c.keep))
-            .count();
-        if faces - on_edge + 1 < target {
-            continue;
-        }
-        faces -= s.apply(&c);
-        collapses += 1;
-        max_collapse_err2 = max_collapse_err2.max(err2);
-        s.push_edges_of(c.keep, &mut heap);
-        if collapses >= next_report {
-            progress((nf - faces) as f32 / need);
-            next_report = collapses + 4096;
-        }
-    }
+    let regions = opts.partitions.unwrap_or(if nf >= PARTITION_MIN_FACES {
+        REGIONS
+    } else {
+        1
+    });
+    let (p, phase1) = if regions > 1 && target < nf {
+        partitioned_phase(p, opts, regions, &mut |faces| {
+            progress((nf - faces) as f32 / need)
+        })
+    } else {
+        (p, PhaseStats::default())
+    };
+    let (mut s, mut heap) = State::new(p, opts);
+    s.run(&mut heap, target, u32::MAX, &mut |faces| {
+        progress((nf - faces) as f32 / need)
+    });
     progress(1.0);
 
-    let stop_reason = if faces <= target {
+    let stop_reason = if s.faces <= target {
         StopReason::TargetReached
-    } else if hit_max_error {
+    } else if s.hit_max_error || phase1.hit_max_error {
         StopReason::MaxError
     } else {
         StopReason::NoValidCollapse
@@ -791,13 +890,227 @@ pub fn simplify_greedy(
         output_faces: out.triangles.len(),
         input_vertices: input.positions.len(),
         output_vertices: out.positions.len(),
-        collapses,
-        max_collapse_error: max_collapse_err2.sqrt(),
+        collapses: s.collapses + phase1.collapses,
+        max_collapse_error: s.max_collapse_err2.max(phase1.max_collapse_err2).sqrt(),
         stop_reason,
         dropped_degenerate_faces: s.p.dropped_degenerate,
         pinned_vertices,
     };
     Ok((out, report))
+}
+
+#[derive(Default)]
+struct PhaseStats {
+    collapses: usize,
+    max_collapse_err2: f64,
+    hit_max_error: bool,
+}
+
+/// Phase 1 of [`simplify_greedy`]: returns the whole mesh, reduced, prepared for phase 2.
+fn partitioned_phase(
+    p: Prepared,
+    opts: &SimplifyOptions,
+    regions: usize,
+    progress: &mut dyn FnMut(usize),
+) -> (Prepared, PhaseStats) {
+    use rayon::prelude::*;
+    let nt = p.pos.len();
+    let nf = p.faces.len();
+    let region_of = |t: u32| (t as usize * regions / nt.max(1)) as u32;
+    let face_region: Vec<u32> = p
+        .faces
+        .iter()
+        .map(|f| {
+            let r = f.map(|v| region_of(p.topo[v as usize]));
+            if r[0] == r[1] && r[1] == r[2] {
+                r[0]
+            } else {
+                u32::MAX
+            }
+        })
+        .collect();
+    // Vertices of faces that cross regions stay put in phase 1.
+    let mut frontier = vec![false; nt];
+    for (f, &r) in face_region.iter().enumerate() {
+        if r == u32::MAX {
+            for v in p.faces[f] {
+                frontier[p.topo[v as usize] as usize] = true;
+            }
+        }
+    }
+    let cut_faces = face_region.iter().filter(|&&r| r == u32::MAX).count();
+    let ratio = opts.target_faces as f64 / nf as f64;
+
+    // Each region's sub-mesh: its own faces and the crossing faces that touch it, on local
+    // vertex ids, inheriting the whole mesh's quadrics, frame and pins.
+    struct Region<'a> {
+        state: State<'a>,
+        heap: Queue,
+        /// Local attribute vertex → vertex of the whole (welded) mesh.
+        global: Vec<u32>,
+        /// Sub-mesh face → face of the whole mesh.
+        face_global: Vec<u32>,
+        floor: usize,
+        own_cut: usize,
+    }
+    let mut subs: Vec<Region> = (0..regions as u32)
+        .into_par_iter()
+        .map(|r| {
+            let mut local = vec![u32::MAX; p.mesh.positions.len()];
+            let mut global = Vec::new();
+            let mut tris = Vec::new();
+            let mut face_global = Vec::new();
+            let mut own = 0usize;
+            for (f, &fr) in face_region.iter().enumerate() {
+                let touches = fr == r
+                    || (fr == u32::MAX
+                        && p.faces[f]
+                            .iter()
+                            .any(|&v| region_of(p.topo[v as usize]) == r));
+                if !touches {
+                    continue;
+                }
+                own += (fr == r) as usize;
+                tris.push(p.faces[f].map(|v| {
+                    if local[v as usize] == u32::MAX {
+                        local[v as usize] = global.len() as u32;
+                        global.push(v);
+                    }
+                    local[v as usize]
+                }));
+                face_global.push(f as u32);
+            }
+            let mesh = Mesh::new(
+                global
+                    .iter()
+                    .map(|&v| p.mesh.positions[v as usize])
+                    .collect(),
+                tris,
+            );
+            let quadrics: Vec<Quadric> = global
+                .iter()
+                .map(|&v| p.quadrics[p.topo[v as usize] as usize])
+                .collect();
+            let pinned: Vec<bool> = global
+                .iter()
+                .map(|&v| {
+                    let t = p.topo[v as usize] as usize;
+                    frontier[t] || p.mobility[t] == Mobility::Pinned
+                })
+                .collect();
+            let h = Inherited {
+                center: p.center,
+                scale: p.scale,
+                quadrics: &quadrics,
+                pinned: &pinned,
+            };
+            let sub = Prepared::build(mesh, opts, Some(&h));
+            let own_cut = face_global.len() - own;
+            // Pinned frontier vertices cannot thin out; if the interior were simplified far
+            // below their density, its faces would fan out from them into long slivers. So a
+            // region stops where its frontier would be a quarter of its vertices (a closed
+            // triangle mesh has about two faces per vertex) and phase 2 takes it from there.
+            let own_frontier = (0..nt)
+                .filter(|&t| frontier[t] && region_of(t as u32) == r)
+                .count();
+            let floor = own_cut + ((own as f64 * ratio).ceil() as usize).max(8 * own_frontier);
+            let (state, heap) = State::new(sub, opts);
+            Region {
+                state,
+                heap,
+                global,
+                face_global,
+                floor,
+                own_cut,
+            }
+        })
+        .collect();
+
+    // Epochs of doubling cost ceilings, from far below the cheapest edge.
+    let stop_at = (opts.target_faces as f64 * 1.2) as usize;
+    let total = |subs: &[Region]| {
+        subs.iter()
+            .map(|s| s.state.faces - s.own_cut)
+            .sum::<usize>()
+            + cut_faces
+    };
+    let mut ceiling = 1e-30f32;
+    loop {
+        let limit = ceiling.to_bits();
+        let more: Vec<bool> = subs
+            .par_iter_mut()
+            .map(|s| s.state.run(&mut s.heap, s.floor, limit, &mut |_| {}))
+            .collect();
+        let faces = total(&subs);
+        progress(faces);
+        if faces <= stop_at || !more.iter().any(|&m| m) || !ceiling.is_finite() {
+            break;
+        }
+        ceiling *= 2.0;
+    }
+
+    // Reassemble the whole mesh from the regions' live faces and the crossing faces.
+    let mut stats = PhaseStats::default();
+    let mut positions = p.mesh.positions.clone();
+    let mut quadrics: Vec<Quadric> = (0..positions.len())
+        .map(|v| p.quadrics[p.topo[v] as usize])
+        .collect();
+    let mut tris = Vec::new();
+    let mut origin = Vec::new();
+    for (f, &r) in face_region.iter().enumerate() {
+        if r == u32::MAX {
+            tris.push(p.faces[f]);
+            origin.push(p.face_origin[f]);
+        }
+    }
+    for (r, sub) in subs.iter().enumerate() {
+        let st = &sub.state;
+        stats.collapses += st.collapses;
+        stats.max_collapse_err2 = stats.max_collapse_err2.max(st.max_collapse_err2);
+        stats.hit_max_error |= st.hit_max_error;
+        for (lv, &gv) in sub.global.iter().enumerate() {
+            let t = st.p.topo[lv] as usize;
+            if region_of(p.topo[gv as usize]) == r as u32 && st.alive[t] {
+                positions[gv as usize] = st.p.denormalize(st.p.pos[t]);
+                quadrics[gv as usize] = st.p.quadrics[t];
+            }
+        }
+        for (sf, &alive) in st.face_alive.iter().enumerate() {
+            let gf = sub.face_global[st.p.face_origin[sf] as usize] as usize;
+            if alive && face_region[gf] == r as u32 {
+                tris.push(st.p.faces[sf].map(|lv| sub.global[lv as usize]));
+                origin.push(p.face_origin[gf]);
+            }
+        }
+    }
+    let mut mesh = p.mesh.clone_without_geometry();
+    mesh.positions = positions;
+    mesh.normals = p.mesh.normals.clone();
+    mesh.uvs = p.mesh.uvs.clone();
+    mesh.colors = p.mesh.colors.clone();
+    mesh.face_materials = p
+        .mesh
+        .face_materials
+        .as_ref()
+        .map(|m| origin.iter().map(|&o| m[o as usize]).collect());
+    mesh.face_groups = p
+        .mesh
+        .face_groups
+        .as_ref()
+        .map(|g| origin.iter().map(|&o| g[o as usize]).collect());
+    mesh.triangles = tris;
+    let pinned: Vec<bool> = (0..mesh.positions.len())
+        .map(|v| p.mobility[p.topo[v] as usize] == Mobility::Pinned)
+        .collect();
+    let h = Inherited {
+        center: p.center,
+        scale: p.scale,
+        quadrics: &quadrics,
+        pinned: &pinned,
+    };
+    let mut whole = Prepared::build(mesh, opts, Some(&h));
+    whole.dropped_degenerate = p.dropped_degenerate;
+    (whole, stats)
 }
 
 /// The output mesh: live faces with their materials and groups, positions moved back out of the

@@ -44,6 +44,10 @@ pub struct SimplifyOptions {
     /// `QualityThr`, default 0.3); 0 turns the term off, giving textbook QEM order.
     pub quality_threshold: f64,
     pub backend: Backend,
+    /// `cpu` backend: how many regions large meshes are split into for the parallel first
+    /// phase; `None` picks 8 for meshes of 100,000 faces or more and 1 (purely sequential)
+    /// below. The result depends on this number, never on the number of threads.
+    pub partitions: Option<usize>,
 }
 
 impl SimplifyOptions {
@@ -69,6 +73,7 @@ impl SimplifyOptions {
             min_quality: 0.01,
             quality_threshold: 0.3,
             backend: Backend::Cpu,
+            partitions: None,
         }
     }
 
@@ -94,6 +99,9 @@ impl SimplifyOptions {
         if !(0.0..1.0).contains(&self.min_quality) || !(0.0..=1.0).contains(&self.quality_threshold)
         {
             return bad("min quality and quality threshold must lie in [0, 1)".into());
+        }
+        if self.partitions == Some(0) {
+            return bad("partitions must be at least 1".into());
         }
         Ok(())
     }

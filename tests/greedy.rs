@@ -191,3 +191,54 @@ fn shared_models_keep_their_invariants() {
         }
     }
 }
+
+/// The parallel first phase (regions of the Morton order simplified at once, region borders
+/// pinned) must keep every invariant the sequential run keeps.
+#[test]
+fn partitioned_run_keeps_invariants() {
+    let mut meshes = generated_meshes();
+    // Regions big enough that phase 1 does most of the work, as on real scans.
+    meshes.push(("big_noisy_sphere", mesh::noisy_sphere(6, 0.002, 3)));
+    for (name, m) in meshes {
+        for ratio in [0.1, 0.01] {
+            let mut opts = SimplifyOptions::with_ratio(m.triangles.len(), ratio).unwrap();
+            opts.partitions = Some(8);
+            let (out, report) = simplify(&m, &opts).unwrap();
+            check_invariants(&format!("{name} at {ratio}, 8 regions"), &m, &out, &report);
+        }
+    }
+}
+
+/// Mean distance of the output's vertices from the unit sphere the input samples.
+fn radial_error(m: &Mesh) -> f64 {
+    m.positions
+        .iter()
+        .map(|p| {
+            ((p[0] as f64).powi(2) + (p[1] as f64).powi(2) + (p[2] as f64).powi(2)).sqrt() - 1.0
+        })
+        .map(f64::abs)
+        .sum::<f64>()
+        / m.positions.len() as f64
+}
+
+#[test]
+fn partitioned_run_is_as_good_as_sequential_and_deterministic() {
+    let m = mesh::icosphere(6);
+    let run = |partitions| {
+        let mut opts = SimplifyOptions::with_ratio(m.triangles.len(), 0.02).unwrap();
+        opts.partitions = Some(partitions);
+        simplify(&m, &opts).unwrap().0
+    };
+    let (seq, par) = (run(1), run(8));
+    assert!(seq.triangles.len().abs_diff(par.triangles.len()) <= 1);
+    let (es, ep) = (radial_error(&seq), radial_error(&par));
+    assert!(
+        ep <= es * 1.25,
+        "8 regions: mean radial error {ep:.3e}, sequential {es:.3e}"
+    );
+    assert_eq!(
+        par,
+        run(8),
+        "the same input and options must give the same mesh"
+    );
+}
