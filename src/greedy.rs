@@ -89,26 +89,9 @@ pub(crate) struct Prepared {
     pub dropped_degenerate: usize,
 }
 
-/// What a sub-problem of the partitioned greedy inherits from the whole mesh: its frame, its
-/// quadrics (per vertex of the sub-mesh) and the vertices it must keep in place.
-pub(crate) struct Inherited<'x> {
-    pub center: [f64; 3],
-    pub scale: f64,
-    pub quadrics: &'x [Quadric],
-    pub pinned: &'x [bool],
-}
-
 impl Prepared {
     pub fn new(input: &Mesh, opts: &SimplifyOptions) -> Prepared {
-        Self::build(weld(input).mesh, opts, None)
-    }
-
-    /// Prepares an already welded mesh; with `inherited`, quadrics, frame and pins come from it.
-    pub(crate) fn build(
-        mesh: Mesh,
-        opts: &SimplifyOptions,
-        inherited: Option<&Inherited>,
-    ) -> Prepared {
+        let mesh = weld(input).mesh;
         let (topo, firsts) = position_classes(&mesh.positions);
         let (topo, firsts) = spatial_order(&mesh.positions, topo, firsts);
         let nt = firsts.len();
@@ -142,11 +125,10 @@ impl Prepared {
         let faces: Vec<[u32; 3]> = order.iter().map(|&f| faces[f as usize]).collect();
         let face_origin: Vec<u32> = order.iter().map(|&f| face_origin[f as usize]).collect();
 
-        let (center, scale) = match (inherited, mesh.bounds()) {
-            (Some(h), _) => (h.center, h.scale),
-            (None, Some(b)) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
-            (None, Some(b)) => (b.center(), 1.0),
-            (None, None) => ([0.0; 3], 1.0),
+        let (center, scale) = match mesh.bounds() {
+            Some(b) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
+            Some(b) => (b.center(), 1.0),
+            None => ([0.0; 3], 1.0),
         };
         let pos: Vec<[f64; 3]> = firsts
             .iter()
@@ -158,8 +140,7 @@ impl Prepared {
 
         let tf = |f: &[u32; 3]| f.map(|v| topo[v as usize]);
         let mut quadrics = vec![Quadric::default(); nt];
-        let fresh = inherited.is_none();
-        for f in faces.iter().filter(|_| fresh) {
+        for f in &faces {
             let t = tf(f);
             let [p0, p1, p2] = t.map(|v| pos[v as usize]);
             let c = cross(sub(p1, p0), sub(p2, p0));
@@ -220,7 +201,7 @@ impl Prepared {
                     let e = sub(pos[b as usize], pos[a as usize]);
                     let n = cross(e, fnrm);
                     let (ln, le2) = (norm(n), dot(e, e));
-                    if fresh && ln > 0.0 && opts.border_weight > 0.0 {
+                    if ln > 0.0 && opts.border_weight > 0.0 {
                         let n = n.map(|x| x / ln);
                         let q = Quadric::from_plane(
                             n,
@@ -264,14 +245,6 @@ impl Prepared {
                 }
             }
         }
-        if let Some(h) = inherited {
-            for (v, &t) in topo.iter().enumerate() {
-                quadrics[t as usize] = h.quadrics[v];
-                if h.pinned[v] {
-                    mobility[t as usize] = Mobility::Pinned;
-                }
-            }
-        }
         Prepared {
             mesh,
             topo,
@@ -287,6 +260,66 @@ impl Prepared {
             scale,
             dropped_degenerate,
         }
+    }
+
+    /// The sub-problem made of `faces` (indices into `self.faces`): its own dense topological
+    /// ids in the same (Morton) order, everything else copied, `pin` (per topological vertex of
+    /// the whole) added to the pinned vertices. Attribute vertex ids stay those of the whole
+    /// mesh, and `face_origin` holds each face's index in `self.faces`, so results map straight
+    /// back. Returns the sub-problem and its local → whole topological vertex map.
+    pub(crate) fn subset(&self, faces: &[u32], pin: &[bool]) -> (Prepared, Vec<u32>) {
+        let mut topo_global: Vec<u32> = faces
+            .iter()
+            .flat_map(|&f| self.faces[f as usize].map(|v| self.topo[v as usize]))
+            .collect();
+        topo_global.sort_unstable();
+        topo_global.dedup();
+        let local = |t: u32| {
+            topo_global
+                .binary_search(&t)
+                .expect("vertex of a listed face") as u32
+        };
+        // Attribute vertices keep their global ids; `topo` must cover them all, so it is sized
+        // for the whole mesh with unused entries left at 0.
+        let mut topo = vec![0u32; self.topo.len()];
+        let mut first_attr = vec![u32::MAX; topo_global.len()];
+        for &f in faces {
+            for v in self.faces[f as usize] {
+                let lt = local(self.topo[v as usize]);
+                topo[v as usize] = lt;
+                if first_attr[lt as usize] == u32::MAX
+                    || v == self.first_attr[topo_global[lt as usize] as usize]
+                {
+                    first_attr[lt as usize] = v;
+                }
+            }
+        }
+        let pick = |lt: usize| topo_global[lt] as usize;
+        let n = topo_global.len();
+        let sub = Prepared {
+            mesh: Mesh::default(),
+            topo,
+            first_attr,
+            faces: faces.iter().map(|&f| self.faces[f as usize]).collect(),
+            face_origin: faces.to_vec(),
+            pos: (0..n).map(|l| self.pos[pick(l)]).collect(),
+            quadrics: (0..n).map(|l| self.quadrics[pick(l)]).collect(),
+            mobility: (0..n)
+                .map(|l| {
+                    if pin[pick(l)] {
+                        Mobility::Pinned
+                    } else {
+                        self.mobility[pick(l)]
+                    }
+                })
+                .collect(),
+            border: (0..n).map(|l| self.border[pick(l)]).collect(),
+            seam: (0..n).map(|l| self.seam[pick(l)]).collect(),
+            center: self.center,
+            scale: self.scale,
+            dropped_degenerate: 0,
+        };
+        (sub, topo_global)
     }
 
     pub fn denormalize(&self, p: [f64; 3]) -> [f32; 3] {
@@ -908,7 +941,7 @@ struct PhaseStats {
 
 /// Phase 1 of [`simplify_greedy`]: returns the whole mesh, reduced, prepared for phase 2.
 fn partitioned_phase(
-    p: Prepared,
+    mut p: Prepared,
     opts: &SimplifyOptions,
     regions: usize,
     progress: &mut dyn FnMut(usize),
@@ -917,11 +950,10 @@ fn partitioned_phase(
     let nt = p.pos.len();
     let nf = p.faces.len();
     let region_of = |t: u32| (t as usize * regions / nt.max(1)) as u32;
-    let face_region: Vec<u32> = p
-        .faces
-        .iter()
+    let face_topo = |f: usize| p.faces[f].map(|v| p.topo[v as usize]);
+    let face_region: Vec<u32> = (0..nf)
         .map(|f| {
-            let r = f.map(|v| region_of(p.topo[v as usize]));
+            let r = face_topo(f).map(region_of);
             if r[0] == r[1] && r[1] == r[2] {
                 r[0]
             } else {
@@ -933,93 +965,55 @@ fn partitioned_phase(
     let mut frontier = vec![false; nt];
     for (f, &r) in face_region.iter().enumerate() {
         if r == u32::MAX {
-            for v in p.faces[f] {
-                frontier[p.topo[v as usize] as usize] = true;
+            for t in face_topo(f) {
+                frontier[t as usize] = true;
             }
         }
     }
     let cut_faces = face_region.iter().filter(|&&r| r == u32::MAX).count();
     let ratio = opts.target_faces as f64 / nf as f64;
 
-    // Each region's sub-mesh: its own faces and the crossing faces that touch it, on local
-    // vertex ids, inheriting the whole mesh's quadrics, frame and pins.
     struct Region<'a> {
         state: State<'a>,
         heap: Queue,
-        /// Local attribute vertex → vertex of the whole (welded) mesh.
-        global: Vec<u32>,
-        /// Sub-mesh face → face of the whole mesh.
-        face_global: Vec<u32>,
+        /// Local topological vertex → topological vertex of the whole mesh.
+        topo_global: Vec<u32>,
         floor: usize,
         own_cut: usize,
     }
+    let p_ref = &p;
     let mut subs: Vec<Region> = (0..regions as u32)
         .into_par_iter()
         .map(|r| {
-            let mut local = vec![u32::MAX; p.mesh.positions.len()];
-            let mut global = Vec::new();
-            let mut tris = Vec::new();
-            let mut face_global = Vec::new();
-            let mut own = 0usize;
-            for (f, &fr) in face_region.iter().enumerate() {
-                let touches = fr == r
-                    || (fr == u32::MAX
-                        && p.faces[f]
-                            .iter()
-                            .any(|&v| region_of(p.topo[v as usize]) == r));
-                if !touches {
-                    continue;
-                }
-                own += (fr == r) as usize;
-                tris.push(p.faces[f].map(|v| {
-                    if local[v as usize] == u32::MAX {
-                        local[v as usize] = global.len() as u32;
-                        global.push(v);
-                    }
-                    local[v as usize]
-                }));
-                face_global.push(f as u32);
-            }
-            let mesh = Mesh::new(
-                global
-                    .iter()
-                    .map(|&v| p.mesh.positions[v as usize])
-                    .collect(),
-                tris,
-            );
-            let quadrics: Vec<Quadric> = global
-                .iter()
-                .map(|&v| p.quadrics[p.topo[v as usize] as usize])
-                .collect();
-            let pinned: Vec<bool> = global
-                .iter()
-                .map(|&v| {
-                    let t = p.topo[v as usize] as usize;
-                    frontier[t] || p.mobility[t] == Mobility::Pinned
+            // The region's own faces and the crossing faces that touch it.
+            let faces: Vec<u32> = (0..nf as u32)
+                .filter(|&f| {
+                    let fr = face_region[f as usize];
+                    fr == r
+                        || (fr == u32::MAX
+                            && face_topo(f as usize).iter().any(|&t| region_of(t) == r))
                 })
                 .collect();
-            let h = Inherited {
-                center: p.center,
-                scale: p.scale,
-                quadrics: &quadrics,
-                pinned: &pinned,
-            };
-            let sub = Prepared::build(mesh, opts, Some(&h));
-            let own_cut = face_global.len() - own;
+            let own = faces
+                .iter()
+                .filter(|&&f| face_region[f as usize] == r)
+                .count();
+            let own_cut = faces.len() - own;
+            let (sub, topo_global) = p_ref.subset(&faces, &frontier);
             // Pinned frontier vertices cannot thin out; if the interior were simplified far
             // below their density, its faces would fan out from them into long slivers. So a
             // region stops where its frontier would be a quarter of its vertices (a closed
             // triangle mesh has about two faces per vertex) and phase 2 takes it from there.
-            let own_frontier = (0..nt)
-                .filter(|&t| frontier[t] && region_of(t as u32) == r)
+            let own_frontier = topo_global
+                .iter()
+                .filter(|&&t| frontier[t as usize] && region_of(t) == r)
                 .count();
             let floor = own_cut + ((own as f64 * ratio).ceil() as usize).max(8 * own_frontier);
             let (state, heap) = State::new(sub, opts);
             Region {
                 state,
                 heap,
-                global,
-                face_global,
+                topo_global,
                 floor,
                 own_cut,
             }
@@ -1049,17 +1043,13 @@ fn partitioned_phase(
         ceiling *= 2.0;
     }
 
-    // Reassemble the whole mesh from the regions' live faces and the crossing faces.
+    // Write the regions back into the whole mesh: moved vertices, merged quadrics, live faces.
     let mut stats = PhaseStats::default();
-    let mut positions = p.mesh.positions.clone();
-    let mut quadrics: Vec<Quadric> = (0..positions.len())
-        .map(|v| p.quadrics[p.topo[v] as usize])
-        .collect();
-    let mut tris = Vec::new();
-    let mut origin = Vec::new();
+    let mut faces: Vec<[u32; 3]> = Vec::new();
+    let mut origin: Vec<u32> = Vec::new();
     for (f, &r) in face_region.iter().enumerate() {
         if r == u32::MAX {
-            tris.push(p.faces[f]);
+            faces.push(p.faces[f]);
             origin.push(p.face_origin[f]);
         }
     }
@@ -1068,49 +1058,27 @@ fn partitioned_phase(
         stats.collapses += st.collapses;
         stats.max_collapse_err2 = stats.max_collapse_err2.max(st.max_collapse_err2);
         stats.hit_max_error |= st.hit_max_error;
-        for (lv, &gv) in sub.global.iter().enumerate() {
-            let t = st.p.topo[lv] as usize;
-            if region_of(p.topo[gv as usize]) == r as u32 && st.alive[t] {
-                positions[gv as usize] = st.p.denormalize(st.p.pos[t]);
-                quadrics[gv as usize] = st.p.quadrics[t];
+        for (lt, &gt) in sub.topo_global.iter().enumerate() {
+            if region_of(gt) == r as u32 && st.alive[lt] {
+                let g = gt as usize;
+                p.pos[g] = st.p.pos[lt];
+                p.quadrics[g] = st.p.quadrics[lt];
+                p.border[g] = st.p.border[lt];
             }
         }
         for (sf, &alive) in st.face_alive.iter().enumerate() {
-            let gf = sub.face_global[st.p.face_origin[sf] as usize] as usize;
+            // A sub-problem's faces carry their attribute vertices of the whole mesh and, as
+            // origin, their index in the whole mesh's face list.
+            let gf = st.p.face_origin[sf] as usize;
             if alive && face_region[gf] == r as u32 {
-                tris.push(st.p.faces[sf].map(|lv| sub.global[lv as usize]));
+                faces.push(st.p.faces[sf]);
                 origin.push(p.face_origin[gf]);
             }
         }
     }
-    let mut mesh = p.mesh.clone_without_geometry();
-    mesh.positions = positions;
-    mesh.normals = p.mesh.normals.clone();
-    mesh.uvs = p.mesh.uvs.clone();
-    mesh.colors = p.mesh.colors.clone();
-    mesh.face_materials = p
-        .mesh
-        .face_materials
-        .as_ref()
-        .map(|m| origin.iter().map(|&o| m[o as usize]).collect());
-    mesh.face_groups = p
-        .mesh
-        .face_groups
-        .as_ref()
-        .map(|g| origin.iter().map(|&o| g[o as usize]).collect());
-    mesh.triangles = tris;
-    let pinned: Vec<bool> = (0..mesh.positions.len())
-        .map(|v| p.mobility[p.topo[v] as usize] == Mobility::Pinned)
-        .collect();
-    let h = Inherited {
-        center: p.center,
-        scale: p.scale,
-        quadrics: &quadrics,
-        pinned: &pinned,
-    };
-    let mut whole = Prepared::build(mesh, opts, Some(&h));
-    whole.dropped_degenerate = p.dropped_degenerate;
-    (whole, stats)
+    p.faces = faces;
+    p.face_origin = origin;
+    (p, stats)
 }
 
 /// The output mesh: live faces with their materials and groups, positions moved back out of the
