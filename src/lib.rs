@@ -13,6 +13,7 @@
 //! - P. Cignoni, C. Montani, C. Rocchini, R. Scopigno. A general method for preserving attribute
 //!   values on simplified meshes / vcglib quadric collapse (triangle-quality weighted priority).
 
+pub mod bench;
 pub mod cli;
 pub mod error;
 pub mod greedy;
@@ -23,4 +24,6 @@ pub mod simplify;
 
 pub use error::{Error, Location, Result};
 pub use mesh::{Aabb, Material, Mesh};
-pub use simplify::{Backend, SimplifyOptions, SimplifyReport, StopReason, simplify, simplify_with_progress};
+pub use simplify::{
+    Backend, SimplifyOptions, SimplifyReport, StopReason, simplify, simplify_with_progress,
+};
