@@ -666,7 +666,7 @@ fn write_summary(
         writeln!(out, "collapses           {}", r.collapses)?;
         writeln!(
             out,
-            "pinned vertices     {} (kept in place at attribute seams or non-manifold points)",
+            "pinned vertices     {} (kept in place: non-manifold points, seams on a locked border)",
             r.pinned_vertices
         )?;
         writeln!(

@@ -28,6 +28,10 @@ pub(crate) enum Mobility {
     /// A border vertex under `lock_border`: keeps its position, and may be removed only by sliding
     /// along a straight stretch of border onto a border neighbour.
     LockedBorder,
+    /// On an attribute seam (a UV, normal or colour discontinuity): keeps its position, and may be
+    /// removed only by sliding along the seam onto a seam neighbour, each side of the seam
+    /// taking that neighbour's attributes on its side. Seams thin out without tearing.
+    Seam,
 }
 
 /// Quality of a triangle as |cross| / longest edge²: 0 for a needle or sliver, √3/2 ≈ 0.866 for
@@ -167,7 +171,7 @@ impl Prepared {
             .iter()
             .map(|&c| {
                 if c > 1 {
-                    Mobility::Pinned
+                    Mobility::Seam
                 } else {
                     Mobility::Free
                 }
@@ -216,6 +220,34 @@ impl Prepared {
                     let (f1, f2) = (half[i].1, half[i + 1].1);
                     corner_dsu.union(corner(f1, a), corner(f2, a));
                     corner_dsu.union(corner(f1, b), corner(f2, b));
+                    // A seam edge (the faces disagree on an endpoint's attribute vertex) gets a
+                    // constraint plane like a border, so the seam keeps its course.
+                    let attr = |fi: u32, v: u32| faces[fi as usize][(corner(fi, v) % 3) as usize];
+                    if (attr(f1, a) != attr(f2, a) || attr(f1, b) != attr(f2, b))
+                        && opts.border_weight > 0.0
+                    {
+                        let normal = |fi: u32| {
+                            let [p0, p1, p2] = tf(&faces[fi as usize]).map(|v| pos[v as usize]);
+                            let c = cross(sub(p1, p0), sub(p2, p0));
+                            let l = norm(c);
+                            if l > 0.0 { c.map(|x| x / l) } else { c }
+                        };
+                        let (n1, n2) = (normal(f1), normal(f2));
+                        let avg = [0, 1, 2].map(|k| n1[k] + n2[k]);
+                        let e = sub(pos[b as usize], pos[a as usize]);
+                        let n = cross(e, avg);
+                        let (ln, le2) = (norm(n), dot(e, e));
+                        if ln > 0.0 {
+                            let n = n.map(|x| x / ln);
+                            let q = Quadric::from_plane(
+                                n,
+                                -dot(n, pos[a as usize]),
+                                opts.border_weight * le2,
+                            );
+                            quadrics[a as usize].add(&q);
+                            quadrics[b as usize].add(&q);
+                        }
+                    }
                 }
                 _ => {
                     mobility[a as usize] = Mobility::Pinned;
@@ -240,8 +272,11 @@ impl Prepared {
         }
         if opts.lock_border {
             for v in 0..nt {
-                if border[v] && mobility[v] == Mobility::Free {
-                    mobility[v] = Mobility::LockedBorder;
+                if border[v] {
+                    mobility[v] = match mobility[v] {
+                        Mobility::Free => Mobility::LockedBorder,
+                        _ => Mobility::Pinned,
+                    };
                 }
             }
         }
@@ -375,8 +410,9 @@ struct Collapse {
     pos: [f64; 3],
     error: f64,
     priority: f64,
-    /// Attribute vertex of `keep` that the removed vertex's corners take.
-    keep_attr: u32,
+    /// (attribute vertex of `remove`, attribute vertex of `keep` its corners take); the second
+    /// pair is used only when a seam vertex slides along its seam (one pair per side).
+    attr_map: [(u32, u32); 2],
 }
 
 type FaceList = Vec<u32>;
@@ -446,7 +482,7 @@ impl<'a> State<'a> {
         let (ma, mb) = (self.p.mobility[a as usize], self.p.mobility[b as usize]);
         let q = self.p.quadrics[a as usize].sum(&self.p.quadrics[b as usize]);
         let (pa, pb) = (self.p.pos[a as usize], self.p.pos[b as usize]);
-        use Mobility::{Free, LockedBorder, Pinned};
+        use Mobility::{Free, LockedBorder, Pinned, Seam};
         match (ma, mb) {
             (Free, Free) => {
                 let (pos, err) = match q.optimum() {
@@ -468,9 +504,21 @@ impl<'a> State<'a> {
                     };
                 Some((keep, remove, pos, err))
             }
-            (Pinned | LockedBorder, Free) => Some((a, b, pa, q.eval(pa))),
-            (Free, Pinned | LockedBorder) => Some((b, a, pb, q.eval(pb))),
+            (Pinned | LockedBorder | Seam, Free) => Some((a, b, pa, q.eval(pa))),
+            (Free, Pinned | LockedBorder | Seam) => Some((b, a, pb, q.eval(pb))),
             (Pinned, Pinned) => None,
+            (Seam, Seam | Pinned) | (Pinned, Seam) => {
+                for (keep, remove) in [(a, b), (b, a)] {
+                    if self.p.mobility[remove as usize] == Seam
+                        && self.seam_slide(remove, keep).is_some()
+                    {
+                        let pk = self.p.pos[keep as usize];
+                        return Some((keep, remove, pk, q.eval(pk)));
+                    }
+                }
+                None
+            }
+            (Seam, LockedBorder) | (LockedBorder, Seam) => None,
             (Pinned | LockedBorder, LockedBorder) | (LockedBorder, Pinned) => {
                 // A locked border may shed a vertex that lies on the straight line between its
                 // border neighbours: the outline does not change.
@@ -485,6 +533,41 @@ impl<'a> State<'a> {
                 None
             }
         }
+    }
+
+    /// When seam vertex `v` can slide along edge `(v, toward)`: `v` is interior, has exactly two
+    /// attribute vertices, and the two faces on the edge use different attribute vertices at both
+    /// ends — the edge is the seam. Returns `[(v's attribute, toward's attribute); 2]`, one pair
+    /// per side of the seam.
+    fn seam_slide(&self, v: u32, toward: u32) -> Option<[(u32, u32); 2]> {
+        if self.p.border[v as usize] {
+            return None;
+        }
+        let mut sides = [(u32::MAX, u32::MAX); 2];
+        let mut n = 0;
+        let mut attrs = [u32::MAX; 2];
+        for &f in &self.vert_faces[v as usize] {
+            if !self.face_alive[f as usize] {
+                continue;
+            }
+            let t = self.topo_faces[f as usize];
+            let av = self.p.faces[f as usize][t.iter().position(|&u| u == v)?];
+            if attrs[0] == u32::MAX || attrs[0] == av {
+                attrs[0] = av;
+            } else if attrs[1] == u32::MAX || attrs[1] == av {
+                attrs[1] = av;
+            } else {
+                return None; // three or more attribute vertices: a seam junction stays
+            }
+            if let Some(i) = t.iter().position(|&u| u == toward) {
+                if n == 2 {
+                    return None;
+                }
+                sides[n] = (av, self.p.faces[f as usize][i]);
+                n += 1;
+            }
+        }
+        (n == 2 && sides[0].0 != sides[1].0 && sides[0].1 != sides[1].1).then_some(sides)
     }
 
     /// True when `v` is a border vertex, `(v, toward)` a border edge, and `v` lies on the segment
@@ -600,11 +683,17 @@ impl<'a> State<'a> {
         // the last collapses of tiny components.
         // (Covered by the tetrahedral check above for closed components.)
 
-        // Attribute vertex of `keep` that the removed vertex's corners take: its only one, or for
-        // a seam vertex the one it uses in the faces on the edge, which must agree.
-        let mut keep_attr = self.p.first_attr[k];
-        if self.p.seam[k] {
-            keep_attr = u32::MAX;
+        // Attribute vertices of `keep` that the removed vertex's corners take: its only one, or
+        // for a seam vertex the one it uses in the faces on the edge, which must agree — unless
+        // the removed vertex slides along the seam, when each side maps to its own.
+        let mut attr_map = [
+            (self.p.first_attr[r], self.p.first_attr[k]),
+            (u32::MAX, u32::MAX),
+        ];
+        if self.p.mobility[r] == Mobility::Seam {
+            attr_map = self.seam_slide(remove, keep)?;
+        } else if self.p.seam[k] {
+            let mut keep_attr = u32::MAX;
             for &f in &self.vert_faces[r] {
                 if !self.face_alive[f as usize] {
                     continue;
@@ -618,6 +707,7 @@ impl<'a> State<'a> {
                     keep_attr = av;
                 }
             }
+            attr_map[0].1 = keep_attr;
         }
 
         // Faces that move: the normal may not turn more than the limit, no needle may appear,
@@ -669,7 +759,7 @@ impl<'a> State<'a> {
             pos,
             error,
             priority,
-            keep_attr,
+            attr_map,
         })
     }
 
@@ -681,7 +771,6 @@ impl<'a> State<'a> {
         self.p.quadrics[k].add(&qr);
         self.p.border[k] |= self.p.border[r];
         self.alive[r] = false;
-        let remove_attr = self.p.first_attr[r];
         let mut removed = 0;
         let moved: FaceList = std::mem::take(&mut self.vert_faces[r]);
         for &f in &moved {
@@ -697,11 +786,14 @@ impl<'a> State<'a> {
             for i in 0..3 {
                 if self.topo_faces[fu][i] == c.remove {
                     self.topo_faces[fu][i] = c.keep;
-                    debug_assert_eq!(
-                        self.p.faces[fu][i], remove_attr,
-                        "a free vertex has one attribute vertex"
-                    );
-                    self.p.faces[fu][i] = c.keep_attr;
+                    let old = self.p.faces[fu][i];
+                    let (_, new) = c
+                        .attr_map
+                        .iter()
+                        .copied()
+                        .find(|&(from, _)| from == old)
+                        .expect("every attribute vertex of the removed vertex is mapped");
+                    self.p.faces[fu][i] = new;
                 }
             }
             self.vert_faces[k].push(f);

@@ -148,8 +148,8 @@ pub struct SimplifyReport {
     pub stop_reason: StopReason,
     /// Faces with a repeated vertex dropped from the input before simplifying.
     pub dropped_degenerate_faces: usize,
-    /// Vertices kept in place because attributes differ across them (UV, normal or colour seams)
-    /// or because the surface is not manifold there.
+    /// Vertices kept in place: where the surface is not manifold, and (with `lock_border`)
+    /// attribute seams that reach the border. Seam vertices elsewhere slide along their seam.
     pub pinned_vertices: usize,
 }
 
