@@ -80,6 +80,10 @@ pub(crate) struct Prepared {
     pub faces: Vec<[u32; 3]>,
     /// Index of each kept face in `mesh.triangles` (for materials and groups).
     pub face_origin: Vec<u32>,
+    /// Unit normal of each face as it was in the input (zero for a face without area). A face
+    /// keeps its identity through collapses, so checking new normals against it bounds the
+    /// drift that many small turns could add up to.
+    pub ref_normal: Vec<[f32; 3]>,
     /// Normalized positions per topological vertex: centred on the bounding box, divided by its
     /// diagonal, so errors are relative to the diagonal and f32 GPU twins keep precision.
     pub pos: Vec<[f64; 3]>,
@@ -99,10 +103,6 @@ impl Prepared {
         let (topo, firsts) = position_classes(&mesh.positions);
         let (topo, firsts) = spatial_order(&mesh.positions, topo, firsts);
         let nt = firsts.len();
-        let mut attr_count = vec![0u32; nt];
-        for &t in &topo {
-            attr_count[t as usize] += 1;
-        }
         let mut faces = Vec::with_capacity(mesh.triangles.len());
         let mut face_origin = Vec::with_capacity(mesh.triangles.len());
         for (f, t) in mesh.triangles.iter().enumerate() {
@@ -113,6 +113,18 @@ impl Prepared {
             }
         }
         let dropped_degenerate = mesh.triangles.len() - faces.len();
+        // Attribute vertices per position, counting only those the kept faces use: an unused
+        // vertex with other attributes at the same point must not make a seam.
+        let mut used = vec![false; mesh.positions.len()];
+        for f in &faces {
+            for &v in f {
+                used[v as usize] = true;
+            }
+        }
+        let mut attr_count = vec![0u32; nt];
+        for (v, &t) in topo.iter().enumerate() {
+            attr_count[t as usize] += used[v] as u32;
+        }
         // Faces in the order of their first vertex, so a vertex's faces sit close in memory.
         let mut order: Vec<(u32, u32)> = faces
             .iter()
@@ -138,11 +150,25 @@ impl Prepared {
             .iter()
             .map(|&v| {
                 let p = mesh.positions[v as usize];
+                // Keep in step with `Prepared::normalize`.
                 [0, 1, 2].map(|i| (p[i] as f64 - center[i]) * scale)
             })
             .collect();
 
         let tf = |f: &[u32; 3]| f.map(|v| topo[v as usize]);
+        let ref_normal: Vec<[f32; 3]> = faces
+            .iter()
+            .map(|f| {
+                let [p0, p1, p2] = tf(f).map(|v| pos[v as usize]);
+                let c = cross(sub(p1, p0), sub(p2, p0));
+                let l = norm(c);
+                if l > 0.0 {
+                    c.map(|x| (x / l) as f32)
+                } else {
+                    [0.0; 3]
+                }
+            })
+            .collect();
         let mut quadrics = vec![Quadric::default(); nt];
         for f in &faces {
             let t = tf(f);
@@ -286,6 +312,7 @@ impl Prepared {
             first_attr: firsts,
             faces,
             face_origin,
+            ref_normal,
             pos,
             quadrics,
             mobility,
@@ -337,6 +364,7 @@ impl Prepared {
             first_attr,
             faces: faces.iter().map(|&f| self.faces[f as usize]).collect(),
             face_origin: faces.to_vec(),
+            ref_normal: faces.iter().map(|&f| self.ref_normal[f as usize]).collect(),
             pos: (0..n).map(|l| self.pos[pick(l)]).collect(),
             quadrics: (0..n).map(|l| self.quadrics[pick(l)]).collect(),
             mobility: (0..n)
@@ -355,6 +383,12 @@ impl Prepared {
             dropped_degenerate: 0,
         };
         (sub, topo_global)
+    }
+
+    /// Into the normalized frame; the same arithmetic as the set-up, so a vertex that never
+    /// moved compares equal.
+    pub fn normalize(&self, p: [f32; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|i| (p[i] as f64 - self.center[i]) * self.scale)
     }
 
     pub fn denormalize(&self, p: [f64; 3]) -> [f32; 3] {
@@ -664,6 +698,22 @@ impl<'a> State<'a> {
         if edge_faces == 2 && self.p.border[k] && self.p.border[r] {
             return None;
         }
+        // A border edge whose face has its other two edges on the border too is a lone
+        // triangle: collapsing it would delete a whole component (the link condition with the
+        // border closed by a dummy vertex forbids it).
+        if edge_faces == 1 {
+            let c = opposite[0];
+            let border_edge = |s: &Self, v: usize| {
+                s.vert_faces[v]
+                    .iter()
+                    .filter(|&&f| s.face_alive[f as usize] && s.topo_faces[f as usize].contains(&c))
+                    .count()
+                    == 1
+            };
+            if border_edge(self, k) && border_edge(self, r) {
+                return None;
+            }
+        }
         // A tetrahedral fan: faces (keep, c, d) and (remove, c, d) would become one face twice.
         if edge_faces == 2 {
             let [c, d] = opposite;
@@ -737,6 +787,10 @@ impl<'a> State<'a> {
                     return None;
                 }
                 if l_old > 0.0 && dot(n_old, n_new) < self.cos_max_angle * l_old * l_new {
+                    return None;
+                }
+                let n_ref = self.p.ref_normal[f as usize].map(f64::from);
+                if dot(n_ref, n_new) < self.cos_max_angle * l_new && n_ref != [0.0; 3] {
                     return None;
                 }
                 let q_new = triangle_quality(new[0], new[1], new[2]);
@@ -866,22 +920,29 @@ impl<'a> State<'a> {
             max_collapse_err2: 0.0,
             hit_max_error: false,
         };
-        let mut edges: Vec<u64> = Vec::with_capacity(nf * 3);
-        for t in &s.topo_faces {
-            for i in 0..3 {
-                edges.push(edge_key(t[i], t[(i + 1) % 3]));
+        let mut heap = Queue(RadixHeapMap::new());
+        s.queue_all_edges(&mut heap);
+        (s, heap)
+    }
+
+    /// Queues every unique edge of the live faces once, keyed by its quadric error.
+    fn queue_all_edges(&self, heap: &mut Queue) {
+        let mut edges: Vec<u64> = Vec::with_capacity(self.faces * 3);
+        for (f, t) in self.topo_faces.iter().enumerate() {
+            if self.face_alive[f] {
+                for i in 0..3 {
+                    edges.push(edge_key(t[i], t[(i + 1) % 3]));
+                }
             }
         }
         edges.sort_unstable();
         edges.dedup();
-        let mut heap = Queue(RadixHeapMap::new());
         for e in edges {
             let (a, b) = ((e >> 32) as u32, e as u32);
-            if let Some((_, _, _, err)) = s.placement(a, b) {
-                heap.push(key(err), a, b, 0);
+            if let Some((_, _, _, err)) = self.placement(a, b) {
+                heap.push(key(err), a, b, self.stamp(a, b));
             }
         }
-        (s, heap)
     }
 
     /// Collapses the cheapest valid edges until `target` faces remain, the queue runs dry, or
@@ -896,8 +957,20 @@ impl<'a> State<'a> {
     ) -> bool {
         let max_err2 = self.opts.max_error.map(|e| e * e);
         let mut next_report = self.collapses;
+        let mut seeded_at = self.collapses;
         while self.faces > target {
             let Some((k, a, b, stamp)) = heap.pop() else {
+                // An edge refused earlier (a flip, the link condition) can have become valid
+                // through collapses around it that did not touch its endpoints: before giving
+                // up, queue every live edge once more if anything changed since the last time.
+                if self.collapses > seeded_at {
+                    seeded_at = self.collapses;
+                    self.queue_all_edges(heap);
+                    if heap.0.is_empty() {
+                        return false;
+                    }
+                    continue;
+                }
                 return false;
             };
             if k > key_limit {
@@ -928,16 +1001,8 @@ impl<'a> State<'a> {
                 self.hit_max_error = true;
                 continue;
             }
-            // An interior collapse removes two faces; never go more than one below the target.
-            let on_edge = self.vert_faces[c.remove as usize]
-                .iter()
-                .filter(|&&f| {
-                    self.face_alive[f as usize] && self.topo_faces[f as usize].contains(&c.keep)
-                })
-                .count();
-            if self.faces - on_edge + 1 < target {
-                continue;
-            }
+            // At most two faces go per collapse and faces > target, so the result is at worst one
+            // below the target.
             self.faces -= self.apply(&c);
             self.collapses += 1;
             self.max_collapse_err2 = self.max_collapse_err2.max(err2);
@@ -1139,10 +1204,12 @@ fn partitioned_phase(
     let mut stats = PhaseStats::default();
     let mut faces: Vec<[u32; 3]> = Vec::new();
     let mut origin: Vec<u32> = Vec::new();
+    let mut ref_normal: Vec<[f32; 3]> = Vec::new();
     for (f, &r) in face_region.iter().enumerate() {
         if r == u32::MAX {
             faces.push(p.faces[f]);
             origin.push(p.face_origin[f]);
+            ref_normal.push(p.ref_normal[f]);
         }
     }
     for (r, sub) in subs.iter().enumerate() {
@@ -1165,11 +1232,13 @@ fn partitioned_phase(
             if alive && face_region[gf] == r as u32 {
                 faces.push(st.p.faces[sf]);
                 origin.push(p.face_origin[gf]);
+                ref_normal.push(p.ref_normal[gf]);
             }
         }
     }
     p.faces = faces;
     p.face_origin = origin;
+    p.ref_normal = ref_normal;
     (p, stats)
 }
 
@@ -1187,7 +1256,9 @@ pub(crate) fn build_output(
     out.colors = p.mesh.colors.clone();
     for (v, pos) in out.positions.iter_mut().enumerate() {
         let t = p.topo[v] as usize;
-        if vertex_alive[t] {
+        // Only moved vertices go back through the frame: a round trip through f64 could shift
+        // a vertex that stayed (a locked border, a seam) by one float step.
+        if vertex_alive[t] && p.pos[t] != p.normalize(*pos) {
             *pos = p.denormalize(p.pos[t]);
         }
     }

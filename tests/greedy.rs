@@ -161,27 +161,23 @@ fn shared_models_keep_their_invariants() {
         println!("note: ../shared/models not found; skipping the real-scan checks");
         return;
     };
-    for name in [
+    let models = [
         "fandisk.obj",
         "suzanne.obj",
         "teapot.obj",
         "spot/spot_triangulated.obj",
         "stanford-bunny.obj",
-    ] {
-        let path = dir.join(name);
-        let m = meshslim::io::read(&path).unwrap();
+        "horse.ply",
+        "nefertiti.obj",
+        "igea.ply",
+    ];
+    for name in models {
+        let m = meshslim::io::read(&dir.join(name)).unwrap();
         for ratio in [0.1, 0.01] {
             let opts = SimplifyOptions::with_ratio(m.triangles.len(), ratio).unwrap();
             let (out, report) = simplify(&m, &opts).unwrap();
             let label = format!("{name} at {ratio}");
-            let o = topology(&out);
-            out.validate().unwrap();
-            assert_eq!(o.degenerate_faces, 0, "{label}");
-            assert_eq!(
-                o.euler_characteristic,
-                topology(&m).euler_characteristic,
-                "{label}: {report:?}"
-            );
+            check_invariants(&label, &m, &out, &report);
             println!(
                 "{label}: {} -> {} faces ({:?})",
                 m.triangles.len(),
@@ -230,6 +226,18 @@ fn partitioned_run_is_as_good_as_sequential_and_deterministic() {
         simplify(&m, &opts).unwrap().0
     };
     let (seq, par) = (run(1), run(8));
+    // The same mesh whatever the number of threads.
+    let pool = |n| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .unwrap()
+    };
+    assert_eq!(
+        pool(1).install(|| run(8)),
+        pool(4).install(|| run(8)),
+        "depends on the thread count"
+    );
     assert!(seq.triangles.len().abs_diff(par.triangles.len()) <= 1);
     let (es, ep) = (radial_error(&seq), radial_error(&par));
     assert!(
@@ -294,4 +302,22 @@ fn uv_seams_slide_without_tearing() {
             .count();
         assert!(seam >= 3, "the seam vanished ({seam} split vertices left)");
     }
+}
+
+/// ```text
+///   +---+       a lone triangle beside a closed sphere: collapsing any of its edges would
+///   | /         delete a component, so it stays, and the sphere stops at a tetrahedron
+///   +
+/// ```
+#[test]
+fn lone_triangle_and_small_components_survive() {
+    let mut m = mesh::icosphere(2);
+    let base = m.positions.len() as u32;
+    m.positions
+        .extend([[3.0, 0.0, 0.0], [4.0, 0.0, 0.0], [3.0, 1.0, 0.0]]);
+    m.triangles.push([base, base + 1, base + 2]);
+    let (out, report) = simplify(&m, &SimplifyOptions::with_faces(0)).unwrap();
+    check_invariants("sphere and triangle at 0 faces", &m, &out, &report);
+    assert_eq!(report.stop_reason, StopReason::NoValidCollapse);
+    assert_eq!(out.triangles.len(), 4 + 1);
 }

@@ -210,8 +210,8 @@ fn read_from(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
                         };
                         if abs < 0 || abs >= n {
                             return Err(err(format!(
-                                "face corner {c:?}: {} index {i} is out of range ({n} {}s defined before this line)",
-                                names[k], names[k]
+                                "face corner {c:?}: {} index {i} is out of range (only {n} defined before this line)",
+                                names[k]
                             )));
                         }
                         idx[k] = abs as u32;
