@@ -150,8 +150,8 @@ pub struct SimplifyArgs {
     #[arg(long)]
     pub lock_border: bool,
 
-    /// Weight of the border constraint planes relative to the face planes (Hoppe's boundary
-    /// quadrics); larger keeps open borders closer to where they were
+    /// Weight of the border and attribute-seam constraint planes relative to the face planes
+    /// (Hoppe's boundary quadrics); larger keeps open borders and seams closer to where they were
     #[arg(long, value_name = "W", default_value_t = 1.0, value_parser = parse_non_negative)]
     pub border_weight: f64,
 

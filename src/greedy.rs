@@ -228,16 +228,8 @@ impl Prepared {
                     let t = tf(&faces[half[i].1 as usize]);
                     let [p0, p1, p2] = t.map(|v| pos[v as usize]);
                     let fnrm = cross(sub(p1, p0), sub(p2, p0));
-                    let e = sub(pos[b as usize], pos[a as usize]);
-                    let n = cross(e, fnrm);
-                    let (ln, le2) = (norm(n), dot(e, e));
-                    if ln > 0.0 && opts.border_weight > 0.0 {
-                        let n = n.map(|x| x / ln);
-                        let q = Quadric::from_plane(
-                            n,
-                            -dot(n, pos[a as usize]),
-                            opts.border_weight * le2,
-                        );
+                    let (pa, pb) = (pos[a as usize], pos[b as usize]);
+                    if let Some(q) = edge_constraint(pa, pb, fnrm, opts.border_weight) {
                         quadrics[a as usize].add(&q);
                         quadrics[b as usize].add(&q);
                     }
@@ -260,16 +252,8 @@ impl Prepared {
                         };
                         let (n1, n2) = (normal(f1), normal(f2));
                         let avg = [0, 1, 2].map(|k| n1[k] + n2[k]);
-                        let e = sub(pos[b as usize], pos[a as usize]);
-                        let n = cross(e, avg);
-                        let (ln, le2) = (norm(n), dot(e, e));
-                        if ln > 0.0 {
-                            let n = n.map(|x| x / ln);
-                            let q = Quadric::from_plane(
-                                n,
-                                -dot(n, pos[a as usize]),
-                                opts.border_weight * le2,
-                            );
+                        let (pa, pb) = (pos[a as usize], pos[b as usize]);
+                        if let Some(q) = edge_constraint(pa, pb, avg, opts.border_weight) {
                             quadrics[a as usize].add(&q);
                             quadrics[b as usize].add(&q);
                         }
@@ -394,6 +378,18 @@ impl Prepared {
     pub fn denormalize(&self, p: [f64; 3]) -> [f32; 3] {
         [0, 1, 2].map(|i| (p[i] / self.scale + self.center[i]) as f32)
     }
+}
+
+/// Hoppe's edge constraint: the plane through edge (pa, pb) perpendicular to the surface
+/// (normal `surface`), weighted by the squared edge length so it scales like a face area.
+fn edge_constraint(pa: [f64; 3], pb: [f64; 3], surface: [f64; 3], weight: f64) -> Option<Quadric> {
+    let e = sub(pb, pa);
+    let n = cross(e, surface);
+    let l = norm(n);
+    (l > 0.0 && weight > 0.0).then(|| {
+        let n = n.map(|x| x / l);
+        Quadric::from_plane(n, -dot(n, pa), weight * dot(e, e))
+    })
 }
 
 /// Renumbers position classes along a Morton (Z-order) curve. The queue visits the mesh in cost

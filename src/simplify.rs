@@ -32,8 +32,8 @@ pub struct SimplifyOptions {
     /// when it lies on the straight line between its two border neighbours, so the outline is
     /// unchanged.
     pub lock_border: bool,
-    /// Weight of the border constraint planes relative to the face planes (Hoppe's boundary
-    /// quadrics); larger keeps open borders closer to where they were.
+    /// Weight of the border and attribute-seam constraint planes relative to the face planes
+    /// (Hoppe's boundary quadrics); larger keeps open borders and seams closer to where they were.
     pub border_weight: f64,
     /// A collapse may turn no surrounding face's normal by more than this many degrees.
     pub max_normal_angle_deg: f64,
