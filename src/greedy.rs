@@ -1277,3 +1277,56 @@ pub(crate) fn build_output(
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// ```text
+    ///           C
+    ///           |\
+    ///           | \        the centre c of a flat fan; B sits just above the segment c–A.
+    ///   D ----- c  B-A     Moving c onto A drags face (c, B, C) across the line B–C: it
+    ///           |  /       folds over. Moving c onto D folds nothing.
+    ///           E
+    /// ```
+    #[test]
+    fn collapse_refuses_flip() {
+        let ring = [
+            [1.0, 0.0],
+            [0.2, 0.05],
+            [0.0, 1.0],
+            [-1.0, 0.0],
+            [0.0, -1.0],
+        ];
+        let mut pos = vec![[0.0f32, 0.0, 0.0]];
+        pos.extend(ring.iter().map(|p| [p[0] as f32, p[1] as f32, 0.0]));
+        let n = ring.len() as u32;
+        let m = Mesh::new(
+            pos.clone(),
+            (0..n).map(|i| [0, 1 + i, 1 + (i + 1) % n]).collect(),
+        );
+        let mut opts = SimplifyOptions::with_faces(4);
+        opts.lock_border = true;
+        let p = Prepared::new(&m, &opts);
+        // Topological ids are in Morton order: find them by position.
+        let id = |q: [f32; 3]| p.pos.iter().position(|&x| x == p.normalize(q)).unwrap() as u32;
+        let (centre, folding, harmless) = (id(pos[0]), id(pos[1]), id(pos[4]));
+        let (mut s, _) = State::new(p, &opts);
+        assert!(
+            s.evaluate(centre, folding).is_none(),
+            "the folding collapse was allowed"
+        );
+        let c = s
+            .evaluate(centre, harmless)
+            .expect("the harmless collapse was refused");
+        assert_eq!((c.keep, c.remove), (harmless, centre));
+        // With the normal limit lifted, the folding collapse goes through: it is the flip
+        // check, not some other rule, that refuses it.
+        let mut lax = opts.clone();
+        lax.max_normal_angle_deg = 180.0;
+        lax.min_quality = 0.0;
+        let (mut s, _) = State::new(Prepared::new(&m, &lax), &lax);
+        assert!(s.evaluate(centre, folding).is_some());
+    }
+}
