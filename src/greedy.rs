@@ -15,6 +15,7 @@ use crate::mesh::{Mesh, weld, weld::position_classes};
 use crate::quadric::Quadric;
 use crate::simplify::{SimplifyOptions, SimplifyReport, StopReason};
 use radix_heap::RadixHeapMap;
+use rayon::prelude::*;
 use std::cmp::Reverse;
 
 /// How a vertex may take part in collapses.
@@ -136,7 +137,7 @@ impl Prepared {
                 )
             })
             .collect();
-        order.sort_unstable();
+        order.par_sort_unstable();
         let order: Vec<u32> = order.into_iter().map(|(_, f)| f).collect();
         let faces: Vec<[u32; 3]> = order.iter().map(|&f| faces[f as usize]).collect();
         let face_origin: Vec<u32> = order.iter().map(|&f| face_origin[f as usize]).collect();
@@ -156,33 +157,33 @@ impl Prepared {
             .collect();
 
         let tf = |f: &[u32; 3]| f.map(|v| topo[v as usize]);
-        let ref_normal: Vec<[f32; 3]> = faces
-            .iter()
+        // Per face, in parallel: its plane quadric (area-weighted) and its unit normal, kept as
+        // the face's reference; then gathered per vertex in face order, so the sums do not
+        // depend on the thread count.
+        let per_face: Vec<(Option<Quadric>, [f32; 3])> = faces
+            .par_iter()
             .map(|f| {
                 let [p0, p1, p2] = tf(f).map(|v| pos[v as usize]);
                 let c = cross(sub(p1, p0), sub(p2, p0));
-                let l = norm(c);
-                if l > 0.0 {
-                    c.map(|x| (x / l) as f32)
+                let len = norm(c);
+                if len > 0.0 {
+                    let n = c.map(|x| x / len);
+                    let q = Quadric::from_plane(n, -dot(n, p0), 0.5 * len);
+                    (Some(q), n.map(|x| x as f32))
                 } else {
-                    [0.0; 3]
+                    (None, [0.0; 3])
                 }
             })
             .collect();
         let mut quadrics = vec![Quadric::default(); nt];
-        for f in &faces {
-            let t = tf(f);
-            let [p0, p1, p2] = t.map(|v| pos[v as usize]);
-            let c = cross(sub(p1, p0), sub(p2, p0));
-            let len = norm(c);
-            if len > 0.0 {
-                let n = c.map(|x| x / len);
-                let q = Quadric::from_plane(n, -dot(n, p0), 0.5 * len);
-                for v in t {
-                    quadrics[v as usize].add(&q);
+        for (f, (q, _)) in faces.iter().zip(&per_face) {
+            if let Some(q) = q {
+                for v in tf(f) {
+                    quadrics[v as usize].add(q);
                 }
             }
         }
+        let ref_normal: Vec<[f32; 3]> = per_face.into_iter().map(|(_, n)| n).collect();
 
         // Edges with their face counts: 1 = border, 2 = manifold, more = non-manifold.
         let mut half: Vec<(u64, u32)> = Vec::with_capacity(faces.len() * 3);
@@ -192,7 +193,7 @@ impl Prepared {
                 half.push((edge_key(t[i], t[(i + 1) % 3]), fi as u32));
             }
         }
-        half.sort_unstable();
+        half.par_sort_unstable();
         let mut mobility: Vec<Mobility> = attr_count
             .iter()
             .map(|&c| {
@@ -422,7 +423,7 @@ fn spatial_order(positions: &[[f32; 3]], topo: Vec<u32>, firsts: Vec<u32>) -> (V
     let mut keyed: Vec<(u32, u32)> = (0..firsts.len() as u32)
         .map(|c| (code(firsts[c as usize]), c))
         .collect();
-    keyed.sort_unstable();
+    keyed.par_sort_unstable();
     let order: Vec<u32> = keyed.into_iter().map(|(_, c)| c).collect();
     let mut rank = vec![0u32; firsts.len()];
     for (new, &old) in order.iter().enumerate() {
@@ -446,6 +447,10 @@ struct Collapse {
 }
 
 type FaceList = Vec<u32>;
+
+/// `topo_faces` entry of a removed face. The hot loops test this instead of `face_alive`: the
+/// face's vertices are read next anyway, so liveness costs no extra cache line.
+const DEAD: u32 = u32::MAX;
 
 struct State<'a> {
     opts: &'a SimplifyOptions,
@@ -577,7 +582,7 @@ impl<'a> State<'a> {
         let mut n = 0;
         let mut attrs = [u32::MAX; 2];
         for &f in &self.vert_faces[v as usize] {
-            if !self.face_alive[f as usize] {
+            if self.topo_faces[f as usize][0] == DEAD {
                 continue;
             }
             let t = self.topo_faces[f as usize];
@@ -625,7 +630,7 @@ impl<'a> State<'a> {
     fn border_neighbours(&self, v: u32) -> Vec<u32> {
         let mut count: Vec<(u32, u32)> = Vec::new();
         for &f in &self.vert_faces[v as usize] {
-            if !self.face_alive[f as usize] {
+            if self.topo_faces[f as usize][0] == DEAD {
                 continue;
             }
             for &u in &self.topo_faces[f as usize] {
@@ -654,7 +659,7 @@ impl<'a> State<'a> {
         // opposite the edge in its faces (Dey et al. 1999), which keeps a manifold manifold.
         let m = self.next_mark();
         for &f in &self.vert_faces[k] {
-            if self.face_alive[f as usize] {
+            if self.topo_faces[f as usize][0] != DEAD {
                 for &u in &self.topo_faces[f as usize] {
                     self.mark[u as usize] = m;
                 }
@@ -664,7 +669,7 @@ impl<'a> State<'a> {
         let mut opposite = [u32::MAX; 2];
         self.scratch.clear();
         for &f in &self.vert_faces[r] {
-            if !self.face_alive[f as usize] {
+            if self.topo_faces[f as usize][0] == DEAD {
                 continue;
             }
             let t = self.topo_faces[f as usize];
@@ -702,7 +707,7 @@ impl<'a> State<'a> {
             let border_edge = |s: &Self, v: usize| {
                 s.vert_faces[v]
                     .iter()
-                    .filter(|&&f| s.face_alive[f as usize] && s.topo_faces[f as usize].contains(&c))
+                    .filter(|&&f| s.topo_faces[f as usize].contains(&c)) // dead faces hold no vertex
                     .count()
                     == 1
             };
@@ -710,24 +715,6 @@ impl<'a> State<'a> {
                 return None;
             }
         }
-        // A tetrahedral fan: faces (keep, c, d) and (remove, c, d) would become one face twice.
-        if edge_faces == 2 {
-            let [c, d] = opposite;
-            let has = |s: &Self, v: usize| {
-                s.vert_faces[v].iter().any(|&f| {
-                    s.face_alive[f as usize] && {
-                        let t = s.topo_faces[f as usize];
-                        t.contains(&c) && t.contains(&d)
-                    }
-                })
-            };
-            if has(self, k) && has(self, r) {
-                return None;
-            }
-        }
-        // A closed surface must not shrink below a tetrahedron; the link condition alone allows
-        // the last collapses of tiny components.
-        // (Covered by the tetrahedral check above for closed components.)
 
         // Attribute vertices of `keep` that the removed vertex's corners take: its only one, or
         // for a seam vertex the one it uses in the faces on the edge, which must agree — unless
@@ -741,7 +728,7 @@ impl<'a> State<'a> {
         } else if self.p.seam[k] {
             let mut keep_attr = u32::MAX;
             for &f in &self.vert_faces[r] {
-                if !self.face_alive[f as usize] {
+                if self.topo_faces[f as usize][0] == DEAD {
                     continue;
                 }
                 let t = self.topo_faces[f as usize];
@@ -759,14 +746,25 @@ impl<'a> State<'a> {
         // Faces that move: the normal may not turn more than the limit, no needle may appear,
         // and the worst resulting quality scales the priority.
         let mut min_quality = f64::INFINITY;
-        for (moved, other) in [(k, r), (r, k)] {
+        // A tetrahedral fan: faces (keep, c, d) and (remove, c, d) would become one face twice.
+        // Both are among the faces visited here (neither contains the edge).
+        let tetra = if edge_faces == 2 {
+            opposite
+        } else {
+            [u32::MAX; 2]
+        };
+        let mut on_cd = [false; 2];
+        for (side, (moved, other)) in [(k, r), (r, k)].into_iter().enumerate() {
             for &f in &self.vert_faces[moved] {
-                if !self.face_alive[f as usize] {
+                if self.topo_faces[f as usize][0] == DEAD {
                     continue;
                 }
                 let t = self.topo_faces[f as usize];
                 if t.contains(&(other as u32)) {
                     continue;
+                }
+                if t.contains(&tetra[0]) && t.contains(&tetra[1]) {
+                    on_cd[side] = true;
                 }
                 let old = t.map(|u| self.p.pos[u as usize]);
                 let new = t.map(|u| {
@@ -797,6 +795,9 @@ impl<'a> State<'a> {
                 min_quality = min_quality.min(q_new);
             }
         }
+        if on_cd == [true, true] {
+            return None;
+        }
         let qt = self.opts.quality_threshold;
         let priority = if qt > 0.0 && min_quality < qt {
             error * qt / min_quality.max(1e-12)
@@ -825,11 +826,12 @@ impl<'a> State<'a> {
         let moved: FaceList = std::mem::take(&mut self.vert_faces[r]);
         for &f in &moved {
             let fu = f as usize;
-            if !self.face_alive[fu] {
+            if self.topo_faces[fu][0] == DEAD {
                 continue;
             }
             if self.topo_faces[fu].contains(&c.keep) {
                 self.face_alive[fu] = false;
+                self.topo_faces[fu] = [DEAD; 3];
                 removed += 1;
                 continue;
             }
@@ -848,8 +850,8 @@ impl<'a> State<'a> {
             }
             self.vert_faces[k].push(f);
         }
-        let alive = &self.face_alive;
-        self.vert_faces[k].retain(|f| alive[*f as usize]);
+        let topo_faces = &self.topo_faces;
+        self.vert_faces[k].retain(|f| topo_faces[*f as usize][0] != DEAD);
         self.version[k] = self.version[k].wrapping_add(1);
         self.version[r] = self.version[r].wrapping_add(1);
         removed
@@ -931,7 +933,7 @@ impl<'a> State<'a> {
                 }
             }
         }
-        edges.sort_unstable();
+        edges.par_sort_unstable();
         edges.dedup();
         for e in edges {
             let (a, b) = ((e >> 32) as u32, e as u32);
