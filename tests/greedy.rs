@@ -308,6 +308,11 @@ fn uv_seams_slide_without_tearing() {
             })
             .count();
         assert!(seam >= 3, "the seam vanished ({seam} split vertices left)");
+        // ... and it thinned out: it started with one vertex per ring, 24.
+        assert!(
+            seam < 24,
+            "the seam kept all its {seam} vertices: seam vertices do not slide"
+        );
     }
 }
 

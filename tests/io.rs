@@ -1,6 +1,8 @@
 //! File-format layer: round trips for every format and variant, OBJ and PLY parsing details,
 //! hostile inputs, and (when present) the reference models in `shared/models`.
 
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
 use std::path::{Path, PathBuf};
 
 use meshslim::io::{self, Format, WriteOptions};
@@ -8,6 +10,43 @@ use meshslim::{Material, Mesh};
 
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
+}
+
+/// Counts the bytes each thread has allocated and not freed, and the peak since the last reset,
+/// so a test can show that a header's claims are not allocated before the data is there.
+struct CountingAlloc;
+
+thread_local! {
+    static LIVE: Cell<isize> = const { Cell::new(0) };
+    static PEAK: Cell<isize> = const { Cell::new(0) };
+}
+
+// SAFETY: every call forwards to `System` with the caller's own layout and pointer, so the
+// allocator contract is System's; the bookkeeping only touches const-initialised thread-locals,
+// which never allocate (`try_with` ignores threads being torn down).
+unsafe impl GlobalAlloc for CountingAlloc {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = LIVE.try_with(|l| {
+            l.set(l.get() + layout.size() as isize);
+            let _ = PEAK.try_with(|p| p.set(p.get().max(l.get())));
+        });
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        let _ = LIVE.try_with(|l| l.set(l.get() - layout.size() as isize));
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static ALLOC: CountingAlloc = CountingAlloc;
+
+/// Peak bytes this thread held while running `f`, above what it held before.
+fn peak_alloc<T>(f: impl FnOnce() -> T) -> (T, usize) {
+    let base = LIVE.with(Cell::get);
+    PEAK.with(|p| p.set(base));
+    let out = f();
+    (out, (PEAK.with(Cell::get) - base).max(0) as usize)
 }
 
 /// A small closed mesh (an octahedron) with every attribute, two groups and two materials,
@@ -549,10 +588,13 @@ fn hostile_ply() {
     let mut huge = binary_ply_header(3, 4_000_000_000);
     huge.extend_from_slice(&good[hl..]);
     std::fs::write(&path, &huge).unwrap();
-    let t = std::time::Instant::now();
-    let msg = assert_read_err(&path, "byte offset");
+    let (msg, peak) = peak_alloc(|| assert_read_err(&path, "byte offset"));
     assert!(msg.contains("4000000000 face"), "{msg}");
-    assert!(t.elapsed().as_millis() < 100);
+    assert!(
+        peak < 1 << 20,
+        "allocated {peak} bytes for a {} byte file",
+        huge.len()
+    );
     // The same in ascii.
     let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
                 element face 4000000000\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
@@ -851,9 +893,17 @@ fn corrupted_files_never_panic() {
                 }
             }
             std::fs::write(&path, &b).unwrap();
-            if let Ok(m) = io::read(&path) {
+            let (result, peak) = peak_alloc(|| io::read(&path));
+            if let Ok(m) = result {
                 m.validate().unwrap();
             }
+            // The files are a few kilobytes: a reader that believed a corrupted count would
+            // reach far past this.
+            assert!(
+                peak < 16 << 20,
+                "{ext}: {peak} bytes allocated for a {} byte file",
+                b.len()
+            );
         }
     }
 }
@@ -954,4 +1004,12 @@ fn ply_throughput() {
         let s = t.elapsed().as_secs_f64() / reps as f64;
         println!("{name}: {:.1} ms, {:.0} MB/s", s * 1e3, bytes / s / 1e6);
     }
+}
+
+/// The counter behind the allocation bounds above does see allocations.
+#[test]
+fn allocation_counter_counts() {
+    let (v, peak) = peak_alloc(|| vec![1u8; 3 << 20]);
+    assert!(peak >= 3 << 20, "{peak}");
+    drop(v);
 }
