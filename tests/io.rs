@@ -986,26 +986,6 @@ fn reference_models() {
     assert!(horse.normals.is_some());
 }
 
-/// Release-mode PLY throughput on the reference scans:
-/// `cargo test --release --test io -- --ignored --nocapture ply_throughput`
-#[test]
-#[ignore]
-fn ply_throughput() {
-    let Some(dir) = models_dir() else { return };
-    for name in ["horse.ply", "igea.ply"] {
-        let path = dir.join(name);
-        let bytes = std::fs::metadata(&path).unwrap().len() as f64;
-        io::read(&path).unwrap();
-        let reps = 20;
-        let t = std::time::Instant::now();
-        for _ in 0..reps {
-            std::hint::black_box(io::ply::read(&path).unwrap());
-        }
-        let s = t.elapsed().as_secs_f64() / reps as f64;
-        println!("{name}: {:.1} ms, {:.0} MB/s", s * 1e3, bytes / s / 1e6);
-    }
-}
-
 /// The counter behind the allocation bounds above does see allocations.
 #[test]
 fn allocation_counter_counts() {

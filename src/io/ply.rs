@@ -23,10 +23,9 @@
 //! header errors line numbers. Non-finite vertex coordinates and out-of-range indices are errors
 //! that name the vertex or face.
 //!
-//! Throughput (release build, warm page cache, this 2-core machine, 20 reads each):
-//! horse.ply (2.4 MB, binary LE, `uchar int` face lists) 310-415 MB/s, igea.ply (3.1 MB,
-//! binary LE, one tristrips element) 370-440 MB/s, measured with
-//! `cargo test --release --test io -- --ignored --nocapture ply_throughput`.
+//! Throughput (release build, warm page cache, this 2-core machine, `cargo bench --bench io`):
+//! horse.ply (2.4 MB, binary LE, `uchar int` face lists) 370 MiB/s, igea.ply (3.1 MB,
+//! binary LE, one tristrips element) 430 MiB/s.
 //! A 100 MB binary PLY therefore reads in about a quarter of a second.
 //!
 //! Writer: binary little endian by default, or ascii / big endian through [`write_ply`]; normals,
