@@ -29,6 +29,7 @@ Examples:
   meshslim simplify scan.ply scan-5k.obj --faces 5000 --stats
   meshslim info scan.ply
   meshslim info builtin:torus --json
+  meshslim compare scan.ply scan-5k.obj
 
 Run 'meshslim <COMMAND> --help' for every option of a command.";
 
@@ -61,6 +62,17 @@ Examples:
   meshslim info simplified.obj --json
   meshslim info builtin:double-torus";
 
+const COMPARE_AFTER_HELP: &str = "\
+Distances are Metro's (as MeshLab's Hausdorff Distance filter): points sampled uniformly by
+area on the faces of each mesh, plus every vertex and edge midpoint for the maximum, each
+measured to the closest point of the other mesh. Relative figures are fractions of A's
+bounding-box diagonal; the two-sided mean is the average of the two directions' means.
+
+Examples:
+  meshslim compare scan.ply scan-5k.obj
+  meshslim compare scan.ply scan-5k.obj --samples 1000000 --seed 7
+  meshslim compare builtin:sphere builtin:sphere:500 --json";
+
 /// Triangle-mesh simplification by quadric error metrics.
 #[derive(Debug, Parser)]
 #[command(name = "meshslim", version, after_help = TOP_AFTER_HELP)]
@@ -77,6 +89,10 @@ pub enum Command {
     /// Print a mesh's topology report: counts, borders, manifoldness, genus, area, volume
     #[command(after_help = INFO_AFTER_HELP)]
     Info(InfoArgs),
+    /// Measure how far mesh B is from mesh A (Metro/Hausdorff distance both ways), and the
+    /// change in area, volume, triangle quality and topology
+    #[command(after_help = COMPARE_AFTER_HELP)]
+    Compare(CompareArgs),
 }
 
 /// A mesh to read: a file, or a generated mesh `builtin:NAME[:FACES]`.
@@ -192,6 +208,30 @@ pub struct InfoArgs {
     pub input: Input,
 
     /// Print the report as one JSON object on stdout
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// The reference mesh (the original): a file or builtin:NAME[:FACES]
+    #[arg(value_name = "A", value_parser = parse_input_arg)]
+    pub a: Input,
+
+    /// The mesh to measure against A (the simplified one)
+    #[arg(value_name = "B", value_parser = parse_input_arg)]
+    pub b: Input,
+
+    /// Points sampled on the faces in each direction [default: at least one per face of the
+    /// denser mesh and ten per face of the coarser one]
+    #[arg(short = 'n', long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub samples: Option<u64>,
+
+    /// Seed of the sample positions: the same seed gives the same figures
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    pub seed: u64,
+
+    /// Print one JSON object with every figure on stdout
     #[arg(long)]
     pub json: bool,
 }
@@ -454,6 +494,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         }
         Some(Command::Simplify(args)) => run_simplify(args),
         Some(Command::Info(args)) => run_info(args),
+        Some(Command::Compare(args)) => run_compare(args),
     }
 }
 
@@ -783,6 +824,192 @@ fn run_info(args: InfoArgs) -> Result<ExitCode> {
     }
     out.flush()?;
     Ok(ExitCode::SUCCESS)
+}
+
+fn run_compare(args: CompareArgs) -> Result<ExitCode> {
+    let progress = Progress::new(!args.json && std::io::stderr().is_terminal());
+    let t = Instant::now();
+    let a = load(&args.a, &progress)?;
+    let b = load(&args.b, &progress)?;
+    let load_s = t.elapsed().as_secs_f64();
+    let opts = crate::metrics::CompareOptions {
+        samples: args.samples.map(|n| n as usize),
+        seed: args.seed,
+        ..Default::default()
+    };
+    let t = Instant::now();
+    let c = progress
+        .spinner("measuring".to_string(), || {
+            crate::metrics::compare(&a, &b, &opts)
+        })
+        .map_err(lib)
+        .with_context(|| {
+            format!(
+                "cannot compare {} with {}",
+                args.a.display(),
+                args.b.display()
+            )
+        })?;
+    let compare_s = t.elapsed().as_secs_f64();
+    let out = std::io::stdout();
+    let mut out = out.lock();
+    if args.json {
+        let mut json = serde_json::to_value(&c)?;
+        let obj = json
+            .as_object_mut()
+            .expect("the comparison serializes as an object");
+        let extra = serde_json::json!({
+            "a": args.a.display(),
+            "b": args.b.display(),
+            "seconds": { "load": load_s, "compare": compare_s },
+        });
+        obj.extend(extra.as_object().cloned().unwrap_or_default());
+        writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
+    } else {
+        write_comparison(&mut out, &args.a, &args.b, &c, load_s, compare_s)?;
+    }
+    out.flush()?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn write_comparison(
+    out: &mut impl Write,
+    a: &Input,
+    b: &Input,
+    c: &crate::metrics::Comparison,
+    load_s: f64,
+    compare_s: f64,
+) -> std::io::Result<()> {
+    let d = &c.distance;
+    writeln!(
+        out,
+        "A  {}: {} faces, {} vertices",
+        a.display(),
+        c.faces_a,
+        c.vertices_a
+    )?;
+    writeln!(
+        out,
+        "B  {}: {} faces, {} vertices",
+        b.display(),
+        c.faces_b,
+        c.vertices_b
+    )?;
+    writeln!(
+        out,
+        "\ndistance (absolute, and relative to A's bounding-box diagonal {:.6})",
+        d.diagonal
+    )?;
+    writeln!(
+        out,
+        "  {:<10} {:>22} {:>22} {:>22}  samples (faces + vertices + edges)",
+        "", "max (Hausdorff)", "mean", "RMS"
+    )?;
+    let cell = |abs: f64, rel: f64| format!("{abs:.4e} ({rel:.3e})");
+    for (name, s) in [("A -> B", &d.a_to_b), ("B -> A", &d.b_to_a)] {
+        writeln!(
+            out,
+            "  {:<10} {:>22} {:>22} {:>22}  {} + {} + {}",
+            name,
+            cell(s.max, s.max_rel),
+            cell(s.mean, s.mean_rel),
+            cell(s.rms, s.rms_rel),
+            s.face_samples,
+            s.vertex_samples,
+            s.edge_samples
+        )?;
+    }
+    let t = &d.two_sided;
+    writeln!(
+        out,
+        "  {:<10} {:>22} {:>22} {:>22}  (max of both; mean of the two means)",
+        "both",
+        cell(t.max, t.max_rel),
+        cell(t.mean, t.mean_rel),
+        cell(t.rms, t.rms_rel)
+    )?;
+    let pct = |r: Option<f64>| r.map_or("n/a".to_string(), |r| format!("{:+.4}%", 100.0 * r));
+    writeln!(out)?;
+    writeln!(
+        out,
+        "area     {:.6} -> {:.6} ({})",
+        c.area.a,
+        c.area.b,
+        pct(c.area.relative)
+    )?;
+    writeln!(
+        out,
+        "volume   {:.6} -> {:.6} ({}, signed)",
+        c.volume.a,
+        c.volume.b,
+        pct(c.volume.relative)
+    )?;
+    let q = &c.quality_b;
+    writeln!(
+        out,
+        "\ntriangle quality of B: min angle {:.2} deg, mean smallest angle {:.2} deg, {} degenerate",
+        q.min_angle_deg, q.mean_min_angle_deg, q.degenerate_faces
+    )?;
+    writeln!(
+        out,
+        "  aspect ratio (circumradius / 2 inradius, 1 = equilateral):"
+    )?;
+    let mut lower = 1.0;
+    for bin in &q.aspect_ratio_histogram {
+        let range = match bin.upper {
+            Some(u) => format!("[{lower}, {u})"),
+            None => format!(">= {lower}"),
+        };
+        writeln!(out, "    {range:<12} {}", bin.count)?;
+        lower = bin.upper.unwrap_or(lower);
+    }
+    let tp = &c.topology;
+    writeln!(
+        out,
+        "\ntopology           {:>8} {:>8} {:>8}",
+        "A", "B", "B - A"
+    )?;
+    let rows = [
+        (
+            "euler",
+            tp.a.euler_characteristic,
+            tp.b.euler_characteristic,
+            tp.difference.euler_characteristic,
+        ),
+        (
+            "boundary loops",
+            tp.a.boundary_loops,
+            tp.b.boundary_loops,
+            tp.difference.boundary_loops,
+        ),
+        (
+            "non-manifold edges",
+            tp.a.non_manifold_edges,
+            tp.b.non_manifold_edges,
+            tp.difference.non_manifold_edges,
+        ),
+        (
+            "non-manifold verts",
+            tp.a.non_manifold_vertices,
+            tp.b.non_manifold_vertices,
+            tp.difference.non_manifold_vertices,
+        ),
+        (
+            "components",
+            tp.a.connected_components,
+            tp.b.connected_components,
+            tp.difference.connected_components,
+        ),
+    ];
+    for (name, x, y, dxy) in rows {
+        writeln!(out, "  {name:<18} {x:>6} {y:>8} {dxy:>+8}")?;
+    }
+    writeln!(
+        out,
+        "\ntime     load {load_s:.3} s, compare {compare_s:.3} s (seed {})",
+        c.seed
+    )?;
+    Ok(())
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -19,6 +19,7 @@ pub mod error;
 pub mod greedy;
 pub mod io;
 pub mod mesh;
+pub mod metrics;
 pub mod quadric;
 pub mod simplify;
 

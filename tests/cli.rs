@@ -346,3 +346,122 @@ fn shared_horse_to_ten_percent() {
         "{faces} vs {target}"
     );
 }
+
+#[test]
+fn compare_json_has_every_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(
+        &[
+            "compare",
+            SMALL_SPHERE,
+            "builtin:sphere:300",
+            "--samples",
+            "5000",
+            "--seed",
+            "3",
+            "--json",
+        ],
+        dir.path(),
+    );
+    expect_code(&o, 0);
+    let v = json(&o);
+    for key in [
+        "a",
+        "b",
+        "faces_a",
+        "faces_b",
+        "vertices_a",
+        "vertices_b",
+        "seed",
+        "distance",
+        "area",
+        "volume",
+        "quality_b",
+        "topology",
+        "seconds",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key} in {v}");
+    }
+    for dir_key in ["a_to_b", "b_to_a"] {
+        let d = &v["distance"][dir_key];
+        for key in [
+            "max",
+            "mean",
+            "rms",
+            "max_rel",
+            "mean_rel",
+            "rms_rel",
+            "face_samples",
+            "vertex_samples",
+            "edge_samples",
+            "vertex_distance_sum_rel",
+        ] {
+            assert!(d[key].is_number(), "distance.{dir_key}.{key} in {v}");
+        }
+        assert_eq!(d["face_samples"], 5000);
+    }
+    for key in ["max", "mean", "rms", "max_rel", "mean_rel", "rms_rel"] {
+        assert!(v["distance"]["two_sided"][key].is_f64(), "two_sided.{key}");
+    }
+    assert!(v["distance"]["diagonal"].is_f64());
+    for key in ["a", "b", "relative"] {
+        assert!(
+            v["area"][key].is_f64() && v["volume"][key].is_f64(),
+            "{key}"
+        );
+    }
+    let q = &v["quality_b"];
+    for key in ["min_angle_deg", "mean_min_angle_deg", "max_aspect_ratio"] {
+        assert!(q[key].is_f64(), "quality_b.{key} in {q}");
+    }
+    assert_eq!(q["degenerate_faces"], 0);
+    let bins = q["aspect_ratio_histogram"].as_array().unwrap();
+    let total: u64 = bins.iter().map(|b| b["count"].as_u64().unwrap()).sum();
+    assert_eq!(total, v["faces_b"].as_u64().unwrap());
+    for side in ["a", "b", "difference"] {
+        for key in [
+            "euler_characteristic",
+            "boundary_loops",
+            "non_manifold_edges",
+            "non_manifold_vertices",
+            "connected_components",
+        ] {
+            assert!(v["topology"][side][key].is_i64(), "topology.{side}.{key}");
+        }
+    }
+    assert_eq!(v["topology"]["difference"]["euler_characteristic"], 0);
+    assert_eq!(v["a"], SMALL_SPHERE);
+    assert_eq!(v["seed"], 3);
+}
+
+#[test]
+fn compare_prints_a_table_and_names_a_missing_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(&["compare", SMALL_SPHERE, "builtin:sphere:300"], dir.path());
+    expect_code(&o, 0);
+    let out = stdout(&o);
+    for word in [
+        "A -> B",
+        "B -> A",
+        "Hausdorff",
+        "mean",
+        "RMS",
+        "area",
+        "volume",
+        "min angle",
+        "aspect ratio",
+        "euler",
+        "boundary loops",
+    ] {
+        assert!(out.contains(word), "{word} missing from:\n{out}");
+    }
+    let o = meshslim(&["compare", SMALL_SPHERE, "no-such-mesh.ply"], dir.path());
+    expect_code(&o, 1);
+    assert!(stderr(&o).contains("no-such-mesh.ply"), "{}", stderr(&o));
+    assert_eq!(stderr(&o).matches("error:").count(), 1, "{}", stderr(&o));
+    let o = meshslim(
+        &["compare", SMALL_SPHERE, SMALL_SPHERE, "--samples", "0"],
+        dir.path(),
+    );
+    expect_code(&o, 2);
+}

@@ -1,0 +1,405 @@
+//! How far a simplified mesh is from its original, and what else changed.
+//!
+//! The distance is Metro's (P. Cignoni, C. Rocchini, R. Scopigno, "Metro: Measuring Error on
+//! Simplified Surfaces", Computer Graphics Forum 1998), the measure MeshLab's "Hausdorff
+//! Distance" filter implements: points sampled uniformly by area on the faces of one mesh, each
+//! point's distance to the closest point of the other mesh's surface, in both directions.
+//! On top of the random face samples every vertex and every edge midpoint is measured, so that
+//! the maximum (usually at a vertex) is not missed; the mean and RMS use the face samples only,
+//! so that they estimate the mean over the surface as MeshLab's do.
+//!
+//! Deterministic: the samples depend on the seed alone, and the sums are formed in fixed chunks
+//! added in a fixed order, so the figures do not depend on the number of threads.
+//!
+//! ```
+//! use meshslim::metrics::{compare, CompareOptions};
+//! use meshslim::mesh::icosphere;
+//! let c = compare(&icosphere(3), &icosphere(2), &CompareOptions::default()).unwrap();
+//! assert!(c.distance.two_sided.max_rel > 0.0 && c.distance.two_sided.max_rel < 0.05);
+//! ```
+
+mod bvh;
+mod distance;
+
+pub use bvh::{Hit, TriangleBvh, point_triangle_dist2};
+pub use distance::DirectionStats;
+
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::mesh::{Mesh, Topology, topology};
+
+/// What to sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompareOptions {
+    /// Face samples in each direction; `None`: one per face on the denser mesh and ten per face
+    /// on the coarser one (each mesh's samples scale with its own faces, as Metro's and
+    /// MeshLab's do; see [`CompareOptions::face_samples`]).
+    pub samples: Option<usize>,
+    /// Seed of the sample positions; the same seed gives the same figures.
+    pub seed: u64,
+    /// Also measure every vertex and every edge midpoint (for the maximum).
+    pub vertices_and_edges: bool,
+}
+
+impl Default for CompareOptions {
+    fn default() -> Self {
+        CompareOptions {
+            samples: None,
+            seed: 1,
+            vertices_and_edges: true,
+        }
+    }
+}
+
+impl CompareOptions {
+    /// Face samples on a mesh of `faces` faces compared with one of `other` faces: `samples`
+    /// when set, else `faces` on the denser of the two (one per face) and `10 · faces` on the
+    /// coarser (or on either, when they have as many faces), and never fewer than
+    /// `10 · min(faces, other)`, so that a denser mesh less than ten times as dense as the
+    /// other still gets ten samples per face of the coarser one.
+    pub fn face_samples(&self, faces: usize, other: usize) -> usize {
+        self.samples.unwrap_or(if faces > other {
+            faces.max(10 * other)
+        } else {
+            10 * faces
+        })
+    }
+}
+
+/// Both directions of the distance, and the two combined.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Distance {
+    /// Bounding-box diagonal of A, the unit of every `*_rel` figure.
+    pub diagonal: f64,
+    /// Samples on A (the reference), distances to B.
+    pub a_to_b: DirectionStats,
+    /// Samples on B, distances to A.
+    pub b_to_a: DirectionStats,
+    /// Both directions: `max` is the larger maximum (the Hausdorff distance); `mean` is the
+    /// plain average of the two directions' means, (mean(A→B) + mean(B→A)) / 2, not weighted by
+    /// sample counts; `rms` is sqrt((rms(A→B)² + rms(B→A)²) / 2). MeshLab's filter reports each
+    /// direction separately; this is how `benches/meshlab_compare.py` combines them.
+    pub two_sided: TwoSided,
+}
+
+/// The two directions combined (see [`Distance::two_sided`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TwoSided {
+    pub max: f64,
+    pub mean: f64,
+    pub rms: f64,
+    pub max_rel: f64,
+    pub mean_rel: f64,
+    pub rms_rel: f64,
+}
+
+/// A measure of A and of B, and B's change relative to A.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Change {
+    pub a: f64,
+    pub b: f64,
+    /// (b − a) / |a|; `None` when a is 0.
+    pub relative: Option<f64>,
+}
+
+impl Change {
+    fn new(a: f64, b: f64) -> Change {
+        Change {
+            a,
+            b,
+            relative: (a != 0.0).then(|| (b - a) / a.abs()),
+        }
+    }
+}
+
+/// Upper bounds of the aspect-ratio histogram's bins; the last bin is everything above the last
+/// bound, degenerate faces included.
+pub const ASPECT_RATIO_BINS: [f64; 7] = [1.5, 2.0, 3.0, 5.0, 10.0, 100.0, f64::INFINITY];
+
+/// Triangle shape of B.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TriangleQuality {
+    /// Smallest interior angle over the faces with area, in degrees (60 for equilateral).
+    pub min_angle_deg: f64,
+    /// Mean over the faces with area of each face's smallest angle, in degrees.
+    pub mean_min_angle_deg: f64,
+    /// Faces of zero area (or a repeated vertex): counted in the last histogram bin.
+    pub degenerate_faces: usize,
+    /// Aspect ratio = circumradius / (2 · inradius): 1 for an equilateral triangle, growing
+    /// without bound for slivers. Faces per bin; bin i holds ratios in
+    /// [`ASPECT_RATIO_BINS`][i − 1] (1 for i = 0) up to but excluding `ASPECT_RATIO_BINS`[i].
+    pub aspect_ratio_histogram: Vec<HistogramBin>,
+    /// Largest aspect ratio; `None` (JSON null) when a face is degenerate (infinite).
+    pub max_aspect_ratio: Option<f64>,
+}
+
+/// One bin of a histogram: values below `upper` (and at or above the previous bin's upper).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HistogramBin {
+    /// `None` for the last, open bin.
+    pub upper: Option<f64>,
+    pub count: usize,
+}
+
+/// The topology figures a simplifier should keep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct TopologyCounts {
+    pub euler_characteristic: i64,
+    pub boundary_loops: i64,
+    pub non_manifold_edges: i64,
+    pub non_manifold_vertices: i64,
+    pub connected_components: i64,
+}
+
+impl TopologyCounts {
+    fn of(t: &Topology) -> TopologyCounts {
+        TopologyCounts {
+            euler_characteristic: t.euler_characteristic,
+            boundary_loops: t.boundary_loops as i64,
+            non_manifold_edges: t.non_manifold_edges as i64,
+            non_manifold_vertices: t.non_manifold_vertices as i64,
+            connected_components: t.connected_components as i64,
+        }
+    }
+    fn minus(self, o: TopologyCounts) -> TopologyCounts {
+        TopologyCounts {
+            euler_characteristic: self.euler_characteristic - o.euler_characteristic,
+            boundary_loops: self.boundary_loops - o.boundary_loops,
+            non_manifold_edges: self.non_manifold_edges - o.non_manifold_edges,
+            non_manifold_vertices: self.non_manifold_vertices - o.non_manifold_vertices,
+            connected_components: self.connected_components - o.connected_components,
+        }
+    }
+}
+
+/// A's and B's topology and the difference B − A (all zero when the topology is kept).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TopologyDelta {
+    pub a: TopologyCounts,
+    pub b: TopologyCounts,
+    pub difference: TopologyCounts,
+    /// Genus of each, `None` where the surface is not manifold.
+    pub genus_a: Option<i64>,
+    pub genus_b: Option<i64>,
+}
+
+impl TopologyDelta {
+    /// True when B has A's Euler characteristic, boundary loops, components and non-manifold
+    /// counts.
+    pub fn unchanged(&self) -> bool {
+        self.a == self.b
+    }
+}
+
+/// Everything `meshslim compare` reports.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Comparison {
+    pub faces_a: usize,
+    pub faces_b: usize,
+    pub vertices_a: usize,
+    pub vertices_b: usize,
+    pub seed: u64,
+    pub distance: Distance,
+    pub area: Change,
+    /// Signed volume (meaningful for closed, consistently oriented meshes).
+    pub volume: Change,
+    pub quality_b: TriangleQuality,
+    pub topology: TopologyDelta,
+}
+
+/// Compares B with A, the reference: the Metro distance both ways, area and volume change,
+/// B's triangle quality and the topology delta.
+///
+/// Errors when either mesh has no faces, or fails [`Mesh::validate`].
+pub fn compare(a: &Mesh, b: &Mesh, opts: &CompareOptions) -> Result<Comparison> {
+    for (name, m) in [("A", a), ("B", b)] {
+        m.validate()
+            .map_err(|e| Error::InvalidMesh(format!("mesh {name}: {e}")))?;
+        if m.triangles.is_empty() {
+            return Err(Error::InvalidMesh(format!(
+                "mesh {name} has no faces: there is no surface to measure a distance to"
+            )));
+        }
+    }
+    if opts.samples == Some(0) {
+        return Err(Error::InvalidOption(
+            "the number of samples must be at least 1".into(),
+        ));
+    }
+    let diagonal = a.bounds().map_or(0.0, |bb| bb.diagonal());
+    let (fa, fb) = (a.face_count(), b.face_count());
+    let (na, nb) = (opts.face_samples(fa, fb), opts.face_samples(fb, fa));
+    // The two directions use different streams of the one seed.
+    let seed_ab = opts.seed;
+    let seed_ba = opts.seed ^ 0xA076_1D64_78BD_642F;
+
+    let ((ta, tb), (a_to_b, b_to_a)) = rayon::join(
+        || rayon::join(|| topology(a), || topology(b)),
+        || {
+            let (bvh_a, bvh_b) = rayon::join(|| TriangleBvh::new(a), || TriangleBvh::new(b));
+            rayon::join(
+                || {
+                    distance::one_direction(
+                        a,
+                        &bvh_b,
+                        na,
+                        opts.vertices_and_edges,
+                        seed_ab,
+                        diagonal,
+                    )
+                },
+                || {
+                    distance::one_direction(
+                        b,
+                        &bvh_a,
+                        nb,
+                        opts.vertices_and_edges,
+                        seed_ba,
+                        diagonal,
+                    )
+                },
+            )
+        },
+    );
+    let rel = |v: f64| if diagonal > 0.0 { v / diagonal } else { 0.0 };
+    let max = a_to_b.max.max(b_to_a.max);
+    let mean = 0.5 * (a_to_b.mean + b_to_a.mean);
+    let rms = (0.5 * (a_to_b.rms * a_to_b.rms + b_to_a.rms * b_to_a.rms)).sqrt();
+    let two_sided = TwoSided {
+        max,
+        mean,
+        rms,
+        max_rel: rel(max),
+        mean_rel: rel(mean),
+        rms_rel: rel(rms),
+    };
+    let (ca, cb) = (TopologyCounts::of(&ta), TopologyCounts::of(&tb));
+    Ok(Comparison {
+        faces_a: a.face_count(),
+        faces_b: b.face_count(),
+        vertices_a: a.vertex_count(),
+        vertices_b: b.vertex_count(),
+        seed: opts.seed,
+        distance: Distance {
+            diagonal,
+            a_to_b,
+            b_to_a,
+            two_sided,
+        },
+        area: Change::new(ta.surface_area, tb.surface_area),
+        volume: Change::new(ta.signed_volume, tb.signed_volume),
+        quality_b: triangle_quality(b),
+        topology: TopologyDelta {
+            a: ca,
+            b: cb,
+            difference: cb.minus(ca),
+            genus_a: ta.genus,
+            genus_b: tb.genus,
+        },
+    })
+}
+
+/// Smallest angle (degrees) and aspect ratio of one face; `None` when it has no area.
+fn face_shape(p: [[f64; 3]; 3]) -> Option<(f64, f64)> {
+    let e = |i: usize, j: usize| [0, 1, 2].map(|k| p[j][k] - p[i][k]);
+    let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let (ab, bc, ca) = (e(0, 1), e(1, 2), e(2, 0));
+    let (la, lb, lc) = (len(ab), len(bc), len(ca));
+    let cross = crate::mesh::cross64(ab, [-ca[0], -ca[1], -ca[2]]);
+    let twice_area = len(cross);
+    if twice_area <= 0.0 || !twice_area.is_finite() {
+        return None;
+    }
+    // The smallest angle is opposite the shortest edge: sin = 2·area / (product of the others).
+    let (short, o1, o2) = if la <= lb && la <= lc {
+        (la, lb, lc)
+    } else if lb <= lc {
+        (lb, la, lc)
+    } else {
+        (lc, la, lb)
+    };
+    // atan2 of (sin, cos) is accurate for tiny and near-right angles alike.
+    let cos = (o1 * o1 + o2 * o2 - short * short) / (2.0 * o1 * o2);
+    let sin = twice_area / (o1 * o2);
+    let angle = sin.atan2(cos).to_degrees();
+    // R / (2r) = abc·s / (8·K²), with s the semi-perimeter and K the area.
+    let k = 0.5 * twice_area;
+    let s = 0.5 * (la + lb + lc);
+    let aspect = la * lb * lc * s / (8.0 * k * k);
+    Some((angle, aspect))
+}
+
+/// B's triangle quality: minimum angle and aspect-ratio histogram.
+pub fn triangle_quality(m: &Mesh) -> TriangleQuality {
+    let mut counts = [0usize; ASPECT_RATIO_BINS.len()];
+    let mut min_angle = f64::INFINITY;
+    let mut angle_sum = 0.0;
+    let mut good = 0usize;
+    let mut degenerate = 0usize;
+    let mut max_aspect: f64 = 1.0;
+    for t in &m.triangles {
+        let p = t.map(|v| m.positions[v as usize].map(|c| c as f64));
+        match face_shape(p) {
+            Some((angle, aspect)) => {
+                min_angle = min_angle.min(angle);
+                angle_sum += angle;
+                good += 1;
+                max_aspect = max_aspect.max(aspect);
+                let bin = ASPECT_RATIO_BINS
+                    .iter()
+                    .position(|&u| aspect < u)
+                    .unwrap_or(ASPECT_RATIO_BINS.len() - 1);
+                counts[bin] += 1;
+            }
+            None => {
+                degenerate += 1;
+                counts[ASPECT_RATIO_BINS.len() - 1] += 1;
+            }
+        }
+    }
+    if degenerate > 0 {
+        max_aspect = f64::INFINITY;
+    }
+    TriangleQuality {
+        min_angle_deg: if good > 0 { min_angle } else { 0.0 },
+        mean_min_angle_deg: if good > 0 {
+            angle_sum / good as f64
+        } else {
+            0.0
+        },
+        degenerate_faces: degenerate,
+        aspect_ratio_histogram: ASPECT_RATIO_BINS
+            .iter()
+            .zip(counts)
+            .map(|(&u, count)| HistogramBin {
+                upper: u.is_finite().then_some(u),
+                count,
+            })
+            .collect(),
+        max_aspect_ratio: max_aspect.is_finite().then_some(max_aspect),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn equilateral_triangle_has_60_degrees_and_aspect_1() {
+        let h = 3f64.sqrt() / 2.0;
+        let (angle, aspect) =
+            face_shape([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, h, 0.0]]).unwrap();
+        assert!((angle - 60.0).abs() < 1e-9, "{angle}");
+        assert!((aspect - 1.0).abs() < 1e-12, "{aspect}");
+        // Right isosceles: 45 degrees, R/(2r) = (sqrt(2)/2) / (2 · (1 - sqrt(2)/2)) = (1 + sqrt(2))/2.
+        let (angle, aspect) =
+            face_shape([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]).unwrap();
+        assert!((angle - 45.0).abs() < 1e-9, "{angle}");
+        assert!(
+            (aspect - (1.0 + 2f64.sqrt()) / 2.0).abs() < 1e-12,
+            "{aspect}"
+        );
+        assert!(face_shape([[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]).is_none());
+    }
+}
