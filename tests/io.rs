@@ -831,6 +831,24 @@ fn hostile_gltf() {
     let glb = dir.path().join("t.glb");
     std::fs::write(&glb, b"glTF\x02\0\0\0\xff\xff\0\0").unwrap();
     assert_read_err(&glb, "byte offset 8");
+
+    // A node tree that references its children four times at every level: 4^8 instances of a
+    // 200-triangle grid, 13M triangles from 4 KB of buffers. Refused before it is expanded.
+    let grid = dir.path().join("grid.gltf");
+    io::write(&grid, &meshslim::mesh::grid(10)).unwrap();
+    let mut d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&grid).unwrap()).unwrap();
+    let mut nodes: Vec<serde_json::Value> = (0..8)
+        .map(|i| serde_json::json!({ "children": [i + 1, i + 1, i + 1, i + 1] }))
+        .collect();
+    nodes.push(serde_json::json!({ "mesh": 0 }));
+    d["nodes"] = serde_json::Value::Array(nodes);
+    d["scenes"] = serde_json::json!([{ "nodes": [0] }]);
+    d["scene"] = serde_json::json!(0);
+    std::fs::write(&grid, serde_json::to_string(&d).unwrap()).unwrap();
+    let (msg, peak) = peak_alloc(|| assert_read_err(&grid, "unknown"));
+    assert!(msg.contains("refusing to expand"), "{msg}");
+    assert!(peak < 256 << 20, "{peak} bytes");
 }
 
 /// Corrupted files of every format give `Ok` or `Err`, never a panic or a runaway allocation.

@@ -253,6 +253,21 @@ impl Doc<'_> {
         Error::parse(self.path, Location::Unknown, m)
     }
 
+    /// Instancing lets a tiny file place one mesh a million times: what the scene expands to is
+    /// bounded by the data actually present. 64 elements per buffer byte is far beyond any real
+    /// scene's instancing, and with the 1M floor a few GiB at most.
+    fn check_expansion(&self, total: usize, what: &str) -> Result<()> {
+        let data: usize = self.buffers.iter().map(Vec::len).sum();
+        let limit = data.saturating_mul(64).max(1 << 20);
+        if total > limit {
+            return Err(self.err(format!(
+                "the scene instantiates more than {limit} {what} from {data} bytes of buffers; \
+                 refusing to expand it further"
+            )));
+        }
+        Ok(())
+    }
+
     /// The bytes of accessor `i` and its layout: (data, stride, element size, count).
     fn accessor_bytes(
         &self,
@@ -613,6 +628,7 @@ fn add_mesh(doc: &Doc, mi: usize, m: &Mat, out: &mut Out) -> Result<()> {
                 if base + count >= u32::MAX as usize {
                     return Err(doc.err("too many vertices for 32-bit indices"));
                 }
+                doc.check_expansion(base + count, "vertices")?;
                 for (k, c) in p.chunks_exact(3).enumerate() {
                     let q = if identity {
                         [c[0], c[1], c[2]]
@@ -715,6 +731,7 @@ fn add_mesh(doc: &Doc, mi: usize, m: &Mat, out: &mut Out) -> Result<()> {
                 out.mesh.materials.len() as u32 - 1
             }),
         };
+        doc.check_expansion(out.mesh.triangles.len() + tris.len(), "triangles")?;
         for t in tris {
             let t = t.map(|v| v + base);
             out.mesh
