@@ -123,8 +123,14 @@ impl Prepared {
             }
         }
         let mut attr_count = vec![0u32; nt];
+        let mut firsts = firsts;
         for (v, &t) in topo.iter().enumerate() {
             attr_count[t as usize] += used[v] as u32;
+            // A position's representative attribute vertex must be one the faces use: a
+            // collapse maps the removed vertex's corners from it.
+            if used[v] && !used[firsts[t as usize] as usize] {
+                firsts[t as usize] = v as u32;
+            }
         }
         // Faces in the order of their first vertex, so a vertex's faces sit close in memory.
         let mut order: Vec<(u32, u32)> = faces

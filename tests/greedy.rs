@@ -333,3 +333,27 @@ fn lone_triangle_and_small_components_survive() {
     assert_eq!(report.stop_reason, StopReason::NoValidCollapse);
     assert_eq!(out.triangles.len(), 4 + 1);
 }
+
+/// An unused vertex listed first at the same position as a used one, with other UVs: it is no
+/// seam, and the used vertex stays the one its corners map from (found by a randomized run
+/// that panicked in `apply`).
+#[test]
+fn unused_vertex_at_a_used_position_is_ignored() {
+    let g = mesh::grid(6);
+    let mut m = Mesh::new(
+        std::iter::once(g.positions[8])
+            .chain(g.positions.iter().copied())
+            .collect(),
+        g.triangles.iter().map(|t| t.map(|v| v + 1)).collect(),
+    );
+    let mut uvs = vec![[9.0, 9.0]];
+    uvs.extend(g.positions.iter().map(|p| [p[0], p[1]]));
+    m.uvs = Some(uvs);
+    for lock_border in [false, true] {
+        let mut opts = SimplifyOptions::with_faces(2);
+        opts.lock_border = lock_border;
+        let (out, report) = simplify(&m, &opts).unwrap();
+        check_invariants("grid with an unused twin vertex", &m, &out, &report);
+        assert_eq!(out.triangles.len(), 2, "{report:?}");
+    }
+}
