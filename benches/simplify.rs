@@ -1,4 +1,5 @@
-//! `meshslim cpu` (greedy QEM) against meshoptimizer's `simplify` on the same meshes.
+//! Every backend of `meshslim bench` (`meshslim::bench::BACKENDS`: meshslim's greedy `cpu`,
+//! meshoptimizer's `simplify` and `simplifySloppy`) on the same meshes, through the same calls.
 //!
 //! Inputs: horse.ply and igea.ply from the models folder when present (see
 //! `meshslim::bench::models_dir`), and the million-triangle scan
@@ -41,12 +42,11 @@ fn simplify(c: &mut Criterion) {
                 .sampling_mode(SamplingMode::Flat)
                 .warm_up_time(Duration::from_millis(500))
                 .measurement_time(Duration::from_secs(if faces > 500_000 { 40 } else { 5 }));
-            group.bench_function(BenchmarkId::from_parameter("meshslim-cpu"), |b| {
-                b.iter(|| meshslim::simplify(mesh, &opts).expect("simplify"))
-            });
-            group.bench_function(BenchmarkId::from_parameter("meshopt"), |b| {
-                b.iter(|| bench::meshopt_simplify(mesh, opts.target_faces))
-            });
+            for backend in bench::BACKENDS {
+                group.bench_function(BenchmarkId::from_parameter(backend.name), |b| {
+                    b.iter(|| (backend.simplify)(mesh, opts.target_faces).expect("simplify"))
+                });
+            }
             group.finish();
         }
     }

@@ -30,6 +30,7 @@ Examples:
   meshslim info scan.ply
   meshslim info builtin:torus --json
   meshslim compare scan.ply scan-5k.obj
+  meshslim bench --json bench.json --plot bench.svg
 
 Run 'meshslim <COMMAND> --help' for every option of a command.";
 
@@ -73,6 +74,23 @@ Examples:
   meshslim compare scan.ply scan-5k.obj --samples 1000000 --seed 7
   meshslim compare builtin:sphere builtin:sphere:500 --json";
 
+const BENCH_AFTER_HELP: &str = "\
+Each mesh is simplified to each ratio by each backend, --repeat times; the table reports the
+median wall time of the simplify call, input triangles per second, the peak heap held during
+the call (counted by the binary's allocator, output included), and the two-sided Metro
+distance to the input (as 'meshslim compare'), mean and max, relative to its bounding-box
+diagonal. Without MESH it runs the deterministic 1M-triangle scan: ../shared/models/igea.ply
+subdivided once when present ($MESHSLIM_MODELS names another folder), else a procedural
+displaced sphere.
+
+Examples:
+  # the benchmark: the 1M scan, every backend, ratios 0.5, 0.1 and 0.01
+  meshslim bench
+  meshslim bench --ratios 0.1,0.01 --json bench.json --plot bench.svg
+  meshslim bench scan.ply builtin:bumpy-sphere --backends cpu,meshopt --repeat 5
+  # JSON on stdout instead of the table
+  meshslim bench builtin:sphere --json -";
+
 /// Triangle-mesh simplification by quadric error metrics.
 #[derive(Debug, Parser)]
 #[command(name = "meshslim", version, after_help = TOP_AFTER_HELP)]
@@ -93,6 +111,9 @@ pub enum Command {
     /// change in area, volume, triangle quality and topology
     #[command(after_help = COMPARE_AFTER_HELP)]
     Compare(CompareArgs),
+    /// Time every backend on the same meshes and measure their error: a table, JSON and a plot
+    #[command(after_help = BENCH_AFTER_HELP)]
+    Bench(BenchArgs),
 }
 
 /// A mesh to read: a file, or a generated mesh `builtin:NAME[:FACES]`.
@@ -234,6 +255,66 @@ pub struct CompareArgs {
     /// Print one JSON object with every figure on stdout
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Meshes to benchmark: files or builtin:NAME[:FACES] [default: the deterministic
+    /// 1M-triangle scan]
+    #[arg(value_name = "MESH", value_parser = parse_input_arg)]
+    pub meshes: Vec<Input>,
+
+    /// Fractions of the faces to keep, comma-separated, each in (0, 1]
+    #[arg(long, value_name = "R,...", value_delimiter = ',', value_parser = parse_bench_ratio,
+          default_values_t = crate::bench::DEFAULT_RATIOS)]
+    pub ratios: Vec<f64>,
+
+    /// Backends to run, comma-separated: cpu (meshslim's greedy), meshopt (meshoptimizer's
+    /// simplify), meshopt-sloppy (its clustering simplifySloppy) [default: all of them]
+    #[arg(long, value_name = "B,...", value_delimiter = ',', value_parser = parse_bench_backend)]
+    pub backends: Vec<&'static crate::bench::BenchBackend>,
+
+    /// Timed runs of each simplify call; the table reports their median
+    #[arg(long, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..))]
+    pub repeat: u64,
+
+    /// Also write the report as one JSON object to FILE ('-': to stdout, instead of the table)
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+
+    /// Draw the mean error against the time (log-log, one panel per ratio) to FILE.svg
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
+
+    /// Points sampled on the faces in each direction for the error [default: as 'meshslim
+    /// compare']
+    #[arg(short = 'n', long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub samples: Option<u64>,
+
+    /// Seed of the error's sample positions
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    pub seed: u64,
+}
+
+fn parse_bench_ratio(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v > 0.0 && v <= 1.0 {
+        Ok(v)
+    } else {
+        Err(format!("each ratio must be in (0, 1], got {v}"))
+    }
+}
+
+fn parse_bench_backend(
+    s: &str,
+) -> std::result::Result<&'static crate::bench::BenchBackend, String> {
+    crate::bench::backend(s.trim()).ok_or_else(|| {
+        let names: Vec<&str> = crate::bench::BACKENDS.iter().map(|b| b.name).collect();
+        format!(
+            "unknown backend {s:?}; the backends are {}",
+            names.join(", ")
+        )
+    })
 }
 
 /// Declares [`BackendArg`] and its mapping to [`Backend`]: a new backend is one line here (with
@@ -495,6 +576,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Some(Command::Simplify(args)) => run_simplify(args),
         Some(Command::Info(args)) => run_info(args),
         Some(Command::Compare(args)) => run_compare(args),
+        Some(Command::Bench(args)) => run_bench(args),
     }
 }
 
@@ -867,6 +949,88 @@ fn run_compare(args: CompareArgs) -> Result<ExitCode> {
         writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
     } else {
         write_comparison(&mut out, &args.a, &args.b, &c, load_s, compare_s)?;
+    }
+    out.flush()?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_bench(args: BenchArgs) -> Result<ExitCode> {
+    let json_stdout = args.json.as_deref() == Some(Path::new("-"));
+    // Wrong output paths fail before the minutes of work.
+    if let Some(plot) = &args.plot {
+        if !plot
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("svg"))
+        {
+            return Err(UsageError(format!(
+                "{}: the plot is written as SVG; name it FILE.svg",
+                plot.display()
+            ))
+            .into());
+        }
+    }
+    for file in args.json.iter().filter(|_| !json_stdout).chain(&args.plot) {
+        if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
+            if !dir.is_dir() {
+                anyhow::bail!(
+                    "{}: the output directory {} does not exist",
+                    file.display(),
+                    dir.display()
+                );
+            }
+        }
+    }
+    let progress = Progress::new(std::io::stderr().is_terminal());
+    let mut inputs = Vec::new();
+    for input in &args.meshes {
+        inputs.push((input.display(), load(input, &progress)?));
+    }
+    if inputs.is_empty() {
+        inputs.push(
+            progress
+                .spinner("building the 1M-triangle scan".to_string(), || {
+                    crate::bench::million_triangle_scan()
+                })
+                .map_err(lib)
+                .context("cannot build the 1M-triangle scan")?,
+        );
+    }
+    let opts = crate::bench::BenchOptions {
+        ratios: args.ratios,
+        backends: if args.backends.is_empty() {
+            crate::bench::BACKENDS.iter().collect()
+        } else {
+            args.backends
+        },
+        repeat: args.repeat as usize,
+        compare: crate::metrics::CompareOptions {
+            samples: args.samples.map(|n| n as usize),
+            seed: args.seed,
+            ..Default::default()
+        },
+    };
+    let report = progress
+        .bar("benchmarking", |set| {
+            crate::bench::run(&inputs, &opts, &mut |f| set(f))
+        })
+        .map_err(lib)?;
+    drop(inputs);
+
+    let json = serde_json::to_string_pretty(&report)?;
+    let out = std::io::stdout();
+    let mut out = out.lock();
+    if json_stdout {
+        writeln!(out, "{json}")?;
+    } else {
+        crate::bench::write_table(&mut out, &report)?;
+        if let Some(file) = &args.json {
+            std::fs::write(file, json + "\n")
+                .with_context(|| format!("cannot write {}", file.display()))?;
+        }
+    }
+    if let Some(file) = &args.plot {
+        std::fs::write(file, crate::bench::plot_svg(&report))
+            .with_context(|| format!("cannot write {}", file.display()))?;
     }
     out.flush()?;
     Ok(ExitCode::SUCCESS)

@@ -6,6 +6,10 @@ use std::process::ExitCode;
 use clap::Parser;
 use meshslim::cli::{self, Cli};
 
+/// Counts heap bytes so that `meshslim bench` can report each simplify call's peak memory.
+#[global_allocator]
+static ALLOC: meshslim::bench::alloc::CountingAlloc = meshslim::bench::alloc::CountingAlloc;
+
 fn main() -> ExitCode {
     // clap prints its own usage errors and exits with 2.
     let args = Cli::parse();

@@ -1,0 +1,161 @@
+//! `meshslim bench` end to end on small built-in meshes: every requested backend × ratio has a
+//! row with every field, the plot has one series per backend, bad usage exits 2.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn meshslim(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_meshslim"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run meshslim")
+}
+
+/// Asserts the exit code, showing both streams when it differs.
+fn expect_code(o: &Output, code: i32) {
+    assert_eq!(
+        o.status.code(),
+        Some(code),
+        "stdout:\n{}\nstderr:\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+/// 1280 faces, one repeat, few samples: the whole run takes a fraction of a second.
+const SMALL: [&str; 6] = [
+    "bench",
+    "builtin:sphere:1000",
+    "--repeat",
+    "1",
+    "--samples",
+    "500",
+];
+
+const ROW_FIELDS: [&str; 17] = [
+    "mesh",
+    "input_faces",
+    "ratio",
+    "target_faces",
+    "backend",
+    "device",
+    "output_faces",
+    "median_s",
+    "times_s",
+    "mtri_per_s",
+    "peak_bytes",
+    "peak_mib",
+    "diagonal",
+    "mean_err",
+    "max_err",
+    "mean_err_rel",
+    "max_err_rel",
+];
+
+#[test]
+fn json_and_plot_have_every_backend_at_every_ratio() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut args = SMALL.to_vec();
+    args.extend([
+        "--ratios",
+        "0.5,0.1",
+        "--json",
+        "bench.json",
+        "--plot",
+        "bench.svg",
+    ]);
+    let o = meshslim(&args, dir.path());
+    expect_code(&o, 0);
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert!(table.contains("Mtri/s"), "the table is printed:\n{table}");
+
+    let text = std::fs::read_to_string(dir.path().join("bench.json")).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let cpu = json["machine"]["cpu"].as_str().unwrap();
+    assert!(!cpu.is_empty());
+    assert!(json["machine"]["cores"].as_u64().unwrap() >= 1);
+    let rows = json["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2 * 3, "{text}");
+    for backend in ["cpu", "meshopt", "meshopt-sloppy"] {
+        for ratio in [0.5, 0.1] {
+            let row = rows
+                .iter()
+                .find(|r| r["backend"] == backend && r["ratio"].as_f64() == Some(ratio))
+                .unwrap_or_else(|| panic!("no row for {backend} at {ratio}:\n{text}"));
+            for field in ROW_FIELDS {
+                assert!(
+                    row.get(field).is_some_and(|v| !v.is_null()),
+                    "{backend} at {ratio}: {field} missing or null:\n{row:#}"
+                );
+            }
+            assert_eq!(row["device"], cpu);
+            assert_eq!(row["mesh"], "builtin:sphere:1000");
+            assert_eq!(row["input_faces"], 1280);
+            let out = row["output_faces"].as_u64().unwrap();
+            assert!(out > 0 && out <= 1280, "{row:#}");
+            assert!(row["median_s"].as_f64().unwrap() > 0.0);
+            assert!(row["peak_bytes"].as_u64().unwrap() > 0, "{row:#}");
+            let (mean, max) = (
+                row["mean_err_rel"].as_f64().unwrap(),
+                row["max_err_rel"].as_f64().unwrap(),
+            );
+            assert!(0.0 < mean && mean <= max && max < 0.1, "{row:#}");
+        }
+    }
+
+    let svg = std::fs::read_to_string(dir.path().join("bench.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    for backend in ["cpu", "meshopt", "meshopt-sloppy"] {
+        let series = format!(r#"<g class="series" data-backend="{backend}">"#);
+        assert_eq!(svg.matches(&series).count(), 1, "one series for {backend}");
+    }
+    assert_eq!(svg.matches(r#"class="series""#).count(), 3);
+    for label in ["ratio 0.5", "ratio 0.1", "median simplify time (s)"] {
+        assert!(svg.contains(label), "{label} missing from the plot");
+    }
+}
+
+#[test]
+fn json_to_stdout_replaces_the_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut args = SMALL.to_vec();
+    args.extend(["--ratios", "0.5", "--backends", "meshopt", "--json", "-"]);
+    let o = meshslim(&args, dir.path());
+    expect_code(&o, 0);
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).expect("stdout is JSON");
+    let rows = json["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 1);
+    assert_eq!(rows[0]["backend"], "meshopt");
+}
+
+#[test]
+fn bad_usage_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    for extra in [
+        &["--backends", "cpu,nope"][..],
+        &["--ratios", "0.5,0"],
+        &["--ratios", "1.5"],
+        &["--repeat", "0"],
+        &["--plot", "bench.pdf"],
+    ] {
+        let mut args = SMALL.to_vec();
+        args.extend(extra);
+        let o = meshslim(&args, dir.path());
+        expect_code(&o, 2);
+    }
+    let o = meshslim(&["bench", "--backends", "nope"], dir.path());
+    expect_code(&o, 2);
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("cpu, meshopt, meshopt-sloppy"),
+        "the error lists the backends"
+    );
+}
+
+#[test]
+fn missing_mesh_exits_1_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(&["bench", "no-such-mesh.ply", "--repeat", "1"], dir.path());
+    expect_code(&o, 1);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no-such-mesh.ply"));
+}
