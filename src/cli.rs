@@ -65,7 +65,7 @@ Examples:
 
 const COMPARE_AFTER_HELP: &str = "\
 Distances are Metro's (as MeshLab's Hausdorff Distance filter): points sampled uniformly by
-area on the faces of each mesh, plus every vertex and edge midpoint for the maximum, each
+area on the faces of each mesh, plus every vertex and points along every edge for the maximum, each
 measured to the closest point of the other mesh. Relative figures are fractions of A's
 bounding-box diagonal; the two-sided mean is the average of the two directions' means.
 

@@ -28,9 +28,13 @@ fn a_mesh_against_itself_is_zero() {
         assert!(s.max_rel < 1e-12, "{s:?}");
         assert!(s.mean_rel < 1e-12, "{s:?}");
         assert!(s.rms_rel < 1e-12, "{s:?}");
-        assert_eq!(s.face_samples, 10 * m.face_count());
+        assert_eq!(
+            s.face_samples,
+            (10 * m.face_count()).max(meshslim::metrics::MIN_FACE_SAMPLES)
+        );
         assert_eq!(s.vertex_samples, m.vertex_count());
-        assert_eq!(s.edge_samples, 3 * m.face_count() / 2);
+        // At least the midpoint of each of the 3F/2 edges.
+        assert!(s.edge_samples >= 3 * m.face_count() / 2, "{s:?}");
     }
     assert!(d.two_sided.max_rel < 1e-12);
     assert_eq!(c.area.relative, Some(0.0));
@@ -106,6 +110,62 @@ fn a_small_patch_is_close_to_a_big_grid_but_not_the_other_way() {
     assert!(c.distance.b_to_a.mean < 1e-12, "{:?}", c.distance.b_to_a);
     assert_eq!(c.distance.two_sided.max, c.distance.a_to_b.max);
     assert!(close(c.area.relative.unwrap(), 0.0625 - 1.0, 1e-9));
+}
+
+/// Two triangles (a square) spanning `[-5, 5]²` in the plane `axis = at`.
+fn wall(axis: usize, at: f32, m: &mut Mesh) {
+    let base = m.positions.len() as u32;
+    for (u, v) in [(-5.0, -5.0), (5.0, -5.0), (5.0, 5.0), (-5.0, 5.0)] {
+        let mut p = [0.0f32; 3];
+        p[axis] = at;
+        p[(axis + 1) % 3] = u;
+        p[(axis + 2) % 3] = v;
+        m.positions.push(p);
+    }
+    m.triangles.push([base, base + 1, base + 2]);
+    m.triangles.push([base, base + 2, base + 3]);
+}
+
+#[test]
+fn a_maximum_inside_an_edge_is_found() {
+    // B: one triangle (0,0,0), (1,0,0), (0.5,-1,0). A: the walls x = -0.1, x = 1.33 and
+    // y = -0.715. The distance from (x, y, 0) in B to A is min(x + 0.1, |1.33 - x|, |y + 0.715|),
+    // largest (0.715) at (0.615, 0, 0) only: inside the edge y = 0, 61.5% along it, neither at a
+    // vertex (0.1 and 0.33 there) nor at its midpoint (0.6), nor at one of the evenly spaced
+    // points the face-sample spacing asks for (t = 0.2, 0.4, ...; 0.7 at t = 0.6).
+    let b = Mesh::new(
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, -1.0, 0.0]],
+        vec![[0, 1, 2]],
+    );
+    let mut a = Mesh::default();
+    wall(0, -0.1, &mut a);
+    wall(0, 1.33, &mut a);
+    wall(1, -0.715, &mut a);
+    let want = 0.715f64;
+    for seed in [1, 2, 3] {
+        // Ten face samples: 0.22 apart, so the edge gets evenly spaced points at t = 0.2, 0.4,
+        // ... (0.7 at t = 0.6), and the refinement has to find the rest.
+        let opts = CompareOptions {
+            samples: Some(10),
+            seed,
+            ..Default::default()
+        };
+        let c = compare(&a, &b, &opts).unwrap();
+        let ba = &c.distance.b_to_a;
+        assert!(ba.max <= want + 1e-6, "above the true maximum: {ba:?}");
+        assert!(
+            ba.max >= want * (1.0 - 2e-3),
+            "{} vs {want}: {ba:?}",
+            ba.max
+        );
+        // Without the edges the maximum is missed by far.
+        let faces_only = CompareOptions {
+            vertices_and_edges: false,
+            ..opts
+        };
+        let f = compare(&a, &b, &faces_only).unwrap();
+        assert!(f.distance.b_to_a.max < 0.71, "{:?}", f.distance.b_to_a);
+    }
 }
 
 fn noisy_pair() -> (Mesh, Mesh) {

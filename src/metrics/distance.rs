@@ -13,8 +13,8 @@ const CHUNK: usize = 8192;
 /// Distances from the samples of one mesh to the other mesh's surface.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DirectionStats {
-    /// Largest distance over every sample (faces, vertices, edge midpoints): the one-sided
-    /// Hausdorff distance.
+    /// Largest distance over every sample (faces, vertices, edges): the one-sided Hausdorff
+    /// distance.
     pub max: f64,
     /// Mean over the area-uniform face samples: an estimate of the mean distance over the surface.
     pub mean: f64,
@@ -28,7 +28,8 @@ pub struct DirectionStats {
     pub face_samples: usize,
     /// Vertices used by a face, each measured once.
     pub vertex_samples: usize,
-    /// Midpoints of the unique edges.
+    /// Points measured on the unique edges: evenly spaced ones (at least the midpoint of
+    /// each edge) and those the refinement near the maximum added.
     pub edge_samples: usize,
     /// Sum of the vertex samples' distances, relative to A's diagonal: how far the sampled
     /// mesh's vertices sit off the other surface, in total.
@@ -81,6 +82,155 @@ fn measure(n: usize, bvh: &TriangleBvh, point: impl Fn(usize) -> [f64; 3] + Sync
     parts.into_iter().fold(Acc::default(), Acc::merge)
 }
 
+/// Edges per parallel task of the edge sampling (fixed, as [`CHUNK`]).
+const EDGE_CHUNK: usize = 2048;
+/// At most this many evenly spaced segments per edge.
+const EDGE_MAX_SEGMENTS: usize = 256;
+/// Edges whose evenly spaced samples come within this fraction of the largest distance found
+/// are refined.
+const EDGE_CANDIDATE: f64 = 0.75;
+/// At most this many more points per refined edge.
+const EDGE_REFINE_BUDGET: usize = 32;
+/// The refinement of an edge stops once its maximum is known within this relative tolerance.
+const EDGE_REL_TOL: f64 = 1e-3;
+
+/// A point of an edge: its parameter t in [0, 1] and its distance.
+type EdgePoint = (f64, f64);
+
+fn lerp(a: [f64; 3], b: [f64; 3], t: f64) -> [f64; 3] {
+    [0, 1, 2].map(|k| a[k] + t * (b[k] - a[k]))
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (0..3).map(|k| (b[k] - a[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// Evenly spaced segments of an edge of length `len` for samples `spacing` apart: at least two
+/// (the midpoint), at most [`EDGE_MAX_SEGMENTS`].
+fn edge_segments(len: f64, spacing: f64) -> usize {
+    let k = len / spacing;
+    if k.is_finite() {
+        (k.ceil() as usize).clamp(2, EDGE_MAX_SEGMENTS)
+    } else {
+        2
+    }
+}
+
+/// Samples every unique edge of `x`, measuring each point's distance to `y`, in two passes.
+///
+/// 1. Metro's edge sampling: each edge of length L is cut into k = ⌈L / `spacing`⌉ equal
+///    segments (2 ≤ k ≤ 256, so the midpoint at least) and its k − 1 inner points are measured;
+///    `spacing` is the face samples' mean spacing, so a long edge of a coarse mesh gets several
+///    points and a short edge of a dense one its midpoint. The endpoints are the vertex samples.
+/// 2. Refinement of the edges that may hold the maximum: those whose samples reach
+///    [`EDGE_CANDIDATE`] of the largest distance found so far (`lower`, the faces' and
+///    vertices', and the edges' of pass 1). The distance to a surface is 1-Lipschitz, so on a
+///    segment of length s with distances d0 and d1 at its ends it is at most (d0 + d1 + s) / 2;
+///    the segment with the largest such bound is halved, best first, until every bound is within
+///    [`EDGE_REL_TOL`] of the largest distance known, or [`EDGE_REFINE_BUDGET`] points were added.
+///    A maximum inside an edge, between two evenly spaced points, is so found to 0.1%.
+///
+/// Deterministic: both passes run over fixed chunks of edges in a fixed order, and the
+/// refinement of an edge depends on that edge and on `lower` alone.
+fn sample_edges(x: &Mesh, y: &TriangleBvh, spacing: f64, lower: f64) -> Acc {
+    let keys = unique_edges(x);
+    let ends = |e: usize| {
+        (
+            p64(x.positions[(keys[e] >> 32) as usize]),
+            p64(x.positions[keys[e] as u32 as usize]),
+        )
+    };
+    let closest = |p: [f64; 3], hint: &mut Option<u32>| {
+        let hit = y
+            .closest(p, *hint)
+            .expect("the index has faces (checked by the caller)");
+        *hint = Some(hit.face);
+        hit.dist2.sqrt()
+    };
+    // Pass 1: evenly spaced points; keep the edges that come near `lower`.
+    let parts: Vec<(Acc, Vec<(usize, f64)>)> = (0..keys.len().div_ceil(EDGE_CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            let mut acc = Acc::default();
+            let mut near = Vec::new();
+            let mut hint = None;
+            for e in c * EDGE_CHUNK..((c + 1) * EDGE_CHUNK).min(keys.len()) {
+                let (a, b) = ends(e);
+                let k = edge_segments(dist(a, b), spacing);
+                let mut emax = 0.0f64;
+                for j in 1..k {
+                    let d = closest(lerp(a, b, j as f64 / k as f64), &mut hint);
+                    acc.add(d);
+                    emax = emax.max(d);
+                }
+                if emax >= EDGE_CANDIDATE * lower {
+                    near.push((e, emax));
+                }
+            }
+            (acc, near)
+        })
+        .collect();
+    let mut acc = Acc::default();
+    let mut near = Vec::new();
+    for (a, n) in parts {
+        acc = acc.merge(a);
+        near.extend(n);
+    }
+    let lower = lower.max(acc.max);
+    near.retain(|&(_, emax)| emax >= EDGE_CANDIDATE * lower);
+
+    // Pass 2: refine the candidates.
+    let refined: Vec<Acc> = near
+        .par_chunks(64)
+        .map(|chunk| {
+            let mut acc = Acc::default();
+            let mut hint = None;
+            for &(e, _) in chunk {
+                let (a, b) = ends(e);
+                let len = dist(a, b);
+                let k = edge_segments(len, spacing);
+                // (t, distance) at the evenly spaced points and the ends, measured again.
+                let pts: Vec<EdgePoint> = (0..=k)
+                    .map(|j| {
+                        let t = j as f64 / k as f64;
+                        (t, closest(lerp(a, b, t), &mut hint))
+                    })
+                    .collect();
+                let mut best = pts.iter().fold(0.0f64, |m, p| m.max(p.1));
+                let bound =
+                    |(t0, d0): (f64, f64), (t1, d1): (f64, f64)| 0.5 * (d0 + d1 + (t1 - t0) * len);
+                // Segments as (upper bound, start, end).
+                let mut segs: Vec<(f64, EdgePoint, EdgePoint)> = pts
+                    .windows(2)
+                    .map(|w| (bound(w[0], w[1]), w[0], w[1]))
+                    .collect();
+                for _ in 0..EDGE_REFINE_BUDGET {
+                    let threshold = best.max(lower) * (1.0 + EDGE_REL_TOL);
+                    let Some((i, &(ub, p0, p1))) = segs
+                        .iter()
+                        .enumerate()
+                        .max_by(|u, v| u.1.0.total_cmp(&v.1.0))
+                    else {
+                        break;
+                    };
+                    if ub <= threshold {
+                        break;
+                    }
+                    segs.swap_remove(i);
+                    let t = 0.5 * (p0.0 + p1.0);
+                    let d = closest(lerp(a, b, t), &mut hint);
+                    acc.add(d);
+                    best = best.max(d);
+                    segs.push((bound(p0, (t, d)), p0, (t, d)));
+                    segs.push((bound((t, d), p1), (t, d), p1));
+                }
+            }
+            acc
+        })
+        .collect();
+    refined.into_iter().fold(acc, Acc::merge)
+}
+
 /// A random generator for sample `i` of a stream, independent of every other sample's.
 fn sample_rng(seed: u64, i: usize) -> SplitMix64 {
     let mut h = SplitMix64(seed ^ (i as u64).wrapping_mul(0xD1B5_4A32_D192_ED03));
@@ -114,7 +264,8 @@ fn unique_edges(mesh: &Mesh) -> Vec<u64> {
 /// i-th sample falls at area (i + u)·total/n for one seeded offset u, so each face gets its
 /// expected count rounded up or down), each placed uniformly at random in its face with a
 /// generator seeded by (seed, i). Then, when `vertices_and_edges`, every vertex used by a face
-/// and every edge midpoint, so that the maximum is not missed between random samples.
+/// and points along every edge ([`sample_edges`]), so that the maximum is not missed between
+/// random samples.
 pub(crate) fn one_direction(
     x: &Mesh,
     y: &TriangleBvh,
@@ -155,14 +306,13 @@ pub(crate) fn one_direction(
             .filter(|&v| used[v as usize])
             .collect();
         let verts = measure(used.len(), y, |i| p64(x.positions[used[i] as usize]));
-        let keys = unique_edges(x);
-        let edges = measure(keys.len(), y, |i| {
-            let (a, b) = (
-                p64(x.positions[(keys[i] >> 32) as usize]),
-                p64(x.positions[keys[i] as u32 as usize]),
-            );
-            [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]))
-        });
+        // Edge spacing: the mean distance between neighbouring face samples.
+        let spacing = if n_faces > 0 {
+            (total / n_faces as f64).sqrt()
+        } else {
+            f64::INFINITY
+        };
+        let edges = sample_edges(x, y, spacing, faces.max.max(verts.max));
         (verts, edges)
     } else {
         (Acc::default(), Acc::default())
