@@ -93,31 +93,16 @@ pub fn inputs() -> Result<Vec<(String, Mesh)>> {
 /// works on positions only; attributes are carried along for the vertices it keeps, per-face
 /// materials and groups are dropped. The output is compacted to the vertices it uses.
 pub fn meshopt_simplify(mesh: &Mesh, target_faces: usize) -> Mesh {
-    let indices: &[u32] = bytemuck::cast_slice(&mesh.triangles);
-    let vertices = meshopt::VertexDataAdapter::new(
-        bytemuck::cast_slice(&mesh.positions),
-        std::mem::size_of::<[f32; 3]>(),
-        0,
-    )
-    .expect("a [f32; 3] slice is a valid vertex buffer");
-    let out = meshopt::simplify(
-        indices,
-        &vertices,
-        target_faces * 3,
-        1.0,
-        meshopt::SimplifyOptions::None,
-        None,
-    );
-    let mut m = Mesh {
-        positions: mesh.positions.clone(),
-        triangles: bytemuck::cast_slice(&out).to_vec(),
-        normals: mesh.normals.clone(),
-        uvs: mesh.uvs.clone(),
-        colors: mesh.colors.clone(),
-        ..Default::default()
-    };
-    m.remove_unused_vertices();
-    m
+    with_meshopt(mesh, |indices, vertices| {
+        meshopt::simplify(
+            indices,
+            vertices,
+            target_faces * 3,
+            1.0,
+            meshopt::SimplifyOptions::None,
+            None,
+        )
+    })
 }
 
 /// Simplifies with meshoptimizer's `meshopt_simplifySloppy` (vertex clustering on a grid, no
@@ -125,6 +110,17 @@ pub fn meshopt_simplify(mesh: &Mesh, target_faces: usize) -> Mesh {
 /// is 1.0 so that the face count alone stops it. Positions only, as [`meshopt_simplify`]; the
 /// output is compacted to the vertices it uses.
 pub fn meshopt_simplify_sloppy(mesh: &Mesh, target_faces: usize) -> Mesh {
+    with_meshopt(mesh, |indices, vertices| {
+        meshopt::simplify_sloppy(indices, vertices, target_faces * 3, 1.0, None)
+    })
+}
+
+/// Runs a meshoptimizer index-buffer simplifier on `mesh`'s positions and turns its output
+/// back into a mesh, attributes carried along, compacted to the vertices it uses.
+fn with_meshopt(
+    mesh: &Mesh,
+    simplify: impl FnOnce(&[u32], &meshopt::VertexDataAdapter) -> Vec<u32>,
+) -> Mesh {
     let indices: &[u32] = bytemuck::cast_slice(&mesh.triangles);
     let vertices = meshopt::VertexDataAdapter::new(
         bytemuck::cast_slice(&mesh.positions),
@@ -132,7 +128,7 @@ pub fn meshopt_simplify_sloppy(mesh: &Mesh, target_faces: usize) -> Mesh {
         0,
     )
     .expect("a [f32; 3] slice is a valid vertex buffer");
-    let out = meshopt::simplify_sloppy(indices, &vertices, target_faces * 3, 1.0, None);
+    let out = simplify(indices, &vertices);
     let mut m = Mesh {
         positions: mesh.positions.clone(),
         triangles: bytemuck::cast_slice(&out).to_vec(),
