@@ -282,8 +282,9 @@ pub struct BenchArgs {
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
 
-    /// Draw the mean error against the time (log-log, one panel per ratio) to FILE.svg
-    #[arg(long, value_name = "FILE.svg")]
+    /// Draw the mean error against the time (log-log, one panel per ratio) to FILE.svg or
+    /// FILE.png
+    #[arg(long, value_name = "FILE.svg|FILE.png")]
     pub plot: Option<PathBuf>,
 
     /// Points sampled on the faces in each direction for the error [default: as 'meshslim
@@ -960,10 +961,10 @@ fn run_bench(args: BenchArgs) -> Result<ExitCode> {
     if let Some(plot) = &args.plot {
         if !plot
             .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("svg"))
+            .is_some_and(|e| e.eq_ignore_ascii_case("svg") || e.eq_ignore_ascii_case("png"))
         {
             return Err(UsageError(format!(
-                "{}: the plot is written as SVG; name it FILE.svg",
+                "{}: the plot is written as SVG or PNG; name it FILE.svg or FILE.png",
                 plot.display()
             ))
             .into());
@@ -1029,8 +1030,17 @@ fn run_bench(args: BenchArgs) -> Result<ExitCode> {
         }
     }
     if let Some(file) = &args.plot {
-        std::fs::write(file, crate::bench::plot_svg(&report))
-            .with_context(|| format!("cannot write {}", file.display()))?;
+        let svg = crate::bench::plot_svg(&report);
+        let bytes = if file
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+        {
+            crate::bench::svg_to_png(&svg)
+                .map_err(|e| anyhow::anyhow!("cannot render the plot as PNG: {e}"))?
+        } else {
+            svg.into_bytes()
+        };
+        std::fs::write(file, bytes).with_context(|| format!("cannot write {}", file.display()))?;
     }
     out.flush()?;
     Ok(ExitCode::SUCCESS)

@@ -159,3 +159,22 @@ fn missing_mesh_exits_1_naming_the_file() {
     expect_code(&o, 1);
     assert!(String::from_utf8_lossy(&o.stderr).contains("no-such-mesh.ply"));
 }
+
+/// `--plot FILE.png` renders the same plot to a PNG image.
+#[test]
+fn the_plot_can_be_a_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut args = SMALL.to_vec();
+    args.extend(["--ratios", "0.1", "--plot", "bench.png"]);
+    let o = meshslim(&args, dir.path());
+    expect_code(&o, 0);
+    let png = std::fs::read(dir.path().join("bench.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "not a PNG");
+    // The width and height in the IHDR chunk: the plot's own size, not an empty image.
+    let (w, h) = (
+        u32::from_be_bytes(png[16..20].try_into().unwrap()),
+        u32::from_be_bytes(png[20..24].try_into().unwrap()),
+    );
+    assert!(w >= 400 && h >= 200, "{w}x{h}");
+    assert!(png.len() > 5_000, "{} bytes: nothing drawn?", png.len());
+}
