@@ -1,27 +1,8 @@
 //! `meshslim bench` end to end on small built-in meshes: every requested backend × ratio has a
 //! row with every field, the plot has one series per backend, bad usage exits 2.
 
-use std::path::Path;
-use std::process::{Command, Output};
-
-fn meshslim(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_meshslim"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run meshslim")
-}
-
-/// Asserts the exit code, showing both streams when it differs.
-fn expect_code(o: &Output, code: i32) {
-    assert_eq!(
-        o.status.code(),
-        Some(code),
-        "stdout:\n{}\nstderr:\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
+mod common;
+use common::{expect_code, meshslim};
 
 /// 1280 faces, one repeat, few samples: the whole run takes a fraction of a second.
 const SMALL: [&str; 6] = [

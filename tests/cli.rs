@@ -1,15 +1,9 @@
 //! The `meshslim` binary end to end: arguments, exit codes, messages, files written.
 
+mod common;
+use common::{expect_code, meshslim};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn meshslim(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_meshslim"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run meshslim")
-}
+use std::process::Output;
 
 fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
@@ -17,17 +11,6 @@ fn stdout(o: &Output) -> String {
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Asserts the exit code, showing both streams when it differs.
-fn expect_code(o: &Output, code: i32) {
-    assert_eq!(
-        o.status.code(),
-        Some(code),
-        "stdout:\n{}\nstderr:\n{}",
-        stdout(o),
-        stderr(o)
-    );
 }
 
 fn json(o: &Output) -> serde_json::Value {

@@ -3,7 +3,8 @@
 
 use meshslim::mesh::{self, topology};
 use meshslim::{Mesh, SimplifyReport, StopReason};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 /// The generated meshes every backend is checked on, by name.
 pub fn generated_meshes() -> Vec<(&'static str, Mesh)> {
@@ -247,4 +248,24 @@ impl Grid {
         }
         best.1
     }
+}
+
+/// Runs the `meshslim` binary with `args` in `dir`.
+pub fn meshslim(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_meshslim"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run meshslim")
+}
+
+/// Asserts the exit code, showing both streams when it differs.
+pub fn expect_code(o: &Output, code: i32) {
+    assert_eq!(
+        o.status.code(),
+        Some(code),
+        "stdout:\n{}\nstderr:\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
 }
