@@ -87,6 +87,15 @@ TIME_KEYS = {
 }
 
 
+
+def print_aligned(head, lines):
+    """Prints rows of strings as a column-aligned table with a rule under the header."""
+    widths = [max(len(x) for x in col) for col in zip(head, *lines)]
+    for i, line in enumerate([head, *lines]):
+        print(" | ".join(x.ljust(w) for x, w in zip(line, widths)))
+        if i == 0:
+            print("-+-".join("-" * w for w in widths))
+
 def models_dir() -> Path | None:
     """Same search order as meshslim::bench::models_dir."""
     candidates = []
@@ -337,11 +346,7 @@ def print_agreement(rows: list[dict]) -> bool:
                 "yes" if ok else "NO",
             )
         )
-    widths = [max(len(x) for x in col) for col in zip(head, *lines)]
-    for i, line in enumerate([head, *lines]):
-        print(" | ".join(x.ljust(w) for x, w in zip(line, widths)))
-        if i == 0:
-            print("-+-".join("-" * w for w in widths))
+    print_aligned(head, lines)
     print(
         "absolute distances; (x) = ours / MeshLab; MeshLab max = largest of "
         f"{MAX_REPEATS} vertex+edge+face runs, mean = face-only run"
@@ -382,11 +387,7 @@ def print_table(rows: list[dict]) -> None:
             mx = f"- / {lab['max']:.2e}"
             tm = f"- / {r['meshlab_seconds']:.3f}"
         lines.append((r["mesh"], ratio_name(r["ratio"]), faces, mean, mx, tm))
-    widths = [max(len(x) for x in col) for col in zip(head, *lines)]
-    for i, line in enumerate([head, *lines]):
-        print(" | ".join(x.ljust(w) for x, w in zip(line, widths)))
-        if i == 0:
-            print("-+-".join("-" * w for w in widths))
+    print_aligned(head, lines)
     print(
         "distances relative to the original's bbox diagonal; mean = average of both directions, "
         "max = larger direction; (x) = ours / MeshLab; * = wall clock of the whole CLI run"
