@@ -50,6 +50,23 @@ pub enum Error {
     InvalidOption(String),
     #[error("refusing to overwrite the input file {0}; choose another output path")]
     WouldOverwriteInput(PathBuf),
+    /// No GPU adapter, a lost device, a shader or pipeline the driver refused.
+    #[error("GPU: {0}")]
+    Gpu(String),
+    /// A buffer larger than the device allows.
+    #[error(
+        "GPU: buffer {label} needs {size} bytes but the device allows at most {limit} ({which}); \
+         the mesh is too big for this device, use --backend cpu-parallel"
+    )]
+    BufferTooLarge {
+        label: String,
+        size: u64,
+        limit: u64,
+        which: &'static str,
+    },
+    /// A broken invariant inside the library: a bug, reported instead of a panic.
+    #[error("internal error (please report): {0}")]
+    Internal(String),
 }
 
 impl Error {

@@ -402,7 +402,11 @@ fn edge_constraint(pa: [f64; 3], pb: [f64; 3], surface: [f64; 3], weight: f64) -
 /// Renumbers position classes along a Morton (Z-order) curve. The queue visits the mesh in cost
 /// order, effectively at random; with neighbours close in memory, the dozen vertices and faces
 /// one collapse touches share cache lines and pages instead of each being a miss.
-fn spatial_order(positions: &[[f32; 3]], topo: Vec<u32>, firsts: Vec<u32>) -> (Vec<u32>, Vec<u32>) {
+pub(crate) fn spatial_order(
+    positions: &[[f32; 3]],
+    topo: Vec<u32>,
+    firsts: Vec<u32>,
+) -> (Vec<u32>, Vec<u32>) {
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for &v in &firsts {
         let p = positions[v as usize];
@@ -1127,6 +1131,7 @@ pub fn simplify_greedy(
         stop_reason,
         dropped_degenerate_faces: s.p.dropped_degenerate,
         pinned_vertices,
+        rounds: None,
     };
     Ok((out, report))
 }

@@ -15,11 +15,14 @@
 
 pub mod bench;
 pub mod cli;
+pub mod cpu;
 pub mod error;
+pub mod gpu;
 pub mod greedy;
 pub mod io;
 pub mod mesh;
 pub mod metrics;
+pub mod parallel;
 pub mod quadric;
 pub mod simplify;
 

@@ -11,12 +11,18 @@ use serde::Serialize;
 pub enum Backend {
     /// Greedy quadric edge collapse with a priority queue, in f64: the quality reference.
     Cpu,
+    /// The GPU's rounds of independent-set parallel collapses, run on the CPU with rayon.
+    CpuParallel,
+    /// Rounds of parallel collapses as WGSL compute passes through wgpu.
+    Gpu,
 }
 
 impl Backend {
     pub fn name(self) -> &'static str {
         match self {
             Backend::Cpu => "cpu",
+            Backend::CpuParallel => "cpu-parallel",
+            Backend::Gpu => "gpu",
         }
     }
 }
@@ -149,8 +155,12 @@ pub struct SimplifyReport {
     /// Faces with a repeated vertex dropped from the input before simplifying.
     pub dropped_degenerate_faces: usize,
     /// Vertices kept in place: where the surface is not manifold, and (with `lock_border`)
-    /// attribute seams that reach the border. Seam vertices elsewhere slide along their seam.
+    /// attribute seams that reach the border. Seam vertices elsewhere slide along their seam
+    /// (`cpu`); the round-based backends keep seams whole.
     pub pinned_vertices: usize,
+    /// Rounds, per-round removals and stage times of the round-based backends.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rounds: Option<crate::parallel::RoundsReport>,
 }
 
 /// Simplifies `mesh` with the backend and targets in `opts`.
@@ -168,5 +178,18 @@ pub fn simplify_with_progress(
     mesh.validate()?;
     match opts.backend {
         Backend::Cpu => crate::greedy::simplify_greedy(mesh, opts, progress),
+        Backend::CpuParallel => {
+            let up = crate::parallel::Upload::new(mesh);
+            let mut runner = crate::cpu::CpuRounds::new(&up, crate::parallel::SELECTION_PASSES);
+            crate::parallel::simplify_rounds(
+                &mut runner,
+                &up,
+                mesh,
+                opts,
+                progress,
+                Default::default(),
+            )
+        }
+        Backend::Gpu => crate::gpu::simplify_gpu(mesh, opts, progress),
     }
 }

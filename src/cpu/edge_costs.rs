@@ -1,0 +1,274 @@
+//! Twin of shaders/edge_costs.wgsl: per edge, the collapse position and cost, with the same
+//! validity rules as the greedy reference — link condition, no border pinch, no lone triangle,
+//! no tetrahedral fold, no flipped or needle face, pinned and frozen vertices — and the cost
+//! histogram the ceiling is picked from. Invalid edges get `INVALID_COST`.
+
+use super::common::*;
+use super::vertex_flags::count_containing;
+use super::{face_of, faces_of};
+use crate::gpu::types::{
+    Counters, EdgeCandidate, HIST_SHIFT, INVALID_COST, Params, Quadric, flag, state,
+};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+
+/// What `edge_costs` decided for one edge, before it is written out.
+pub enum Verdict {
+    Invalid,
+    /// Valid, but its error exceeds the maximum.
+    OverMaxError,
+    Candidate(EdgeCandidate),
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate(
+    params: &Params,
+    positions: &[[f32; 4]],
+    quadrics: &[Quadric],
+    flags: &[u32],
+    indices: &[u32],
+    offsets: &[u32],
+    vertex_faces: &[u32],
+    face_normals: &[[f32; 4]],
+    a: u32,
+    b: u32,
+) -> Verdict {
+    let (fla, flb) = (flags[a as usize], flags[b as usize]);
+    if (fla | flb) & flag::FROZEN != 0 {
+        return Verdict::Invalid;
+    }
+    let (pin_a, pin_b) = (fla & flag::PINNED != 0, flb & flag::PINNED != 0);
+    if pin_a && pin_b {
+        return Verdict::Invalid;
+    }
+    let la = faces_of(offsets, vertex_faces, a);
+    let lb = faces_of(offsets, vertex_faces, b);
+
+    // Faces on the edge and their opposite vertices.
+    let mut edge_faces = 0u32;
+    let mut opp = [u32::MAX; 2];
+    for &f in la {
+        let t = face_of(indices, f);
+        if t.contains(&b) {
+            if edge_faces == 2 {
+                return Verdict::Invalid;
+            }
+            opp[edge_faces as usize] = t.into_iter().find(|&u| u != a && u != b).unwrap_or(a);
+            edge_faces += 1;
+        }
+    }
+    if edge_faces == 0 {
+        return Verdict::Invalid;
+    }
+    // Link condition: the common neighbours are exactly the opposite vertices.
+    let mut common = 0u32;
+    for (i, &f) in la.iter().enumerate() {
+        for u in face_of(indices, f) {
+            if u != a
+                && u != b
+                && !la[..i].iter().any(|&g| face_of(indices, g).contains(&u))
+                && lb.iter().any(|&g| face_of(indices, g).contains(&u))
+            {
+                common += 1;
+            }
+        }
+    }
+    if common != edge_faces {
+        return Verdict::Invalid;
+    }
+    let (bord_a, bord_b) = (fla & flag::BORDER != 0, flb & flag::BORDER != 0);
+    if edge_faces == 2 && bord_a && bord_b {
+        return Verdict::Invalid; // joining two border vertices through the interior pinches
+    }
+    if edge_faces == 1 {
+        let c = opp[0];
+        if count_containing(indices, la, c) == 1 && count_containing(indices, lb, c) == 1 {
+            return Verdict::Invalid; // a lone triangle: the whole component would go
+        }
+    }
+
+    // Placement, relative to a.
+    let pa = xyz(positions[a as usize]);
+    let pb = xyz(positions[b as usize]);
+    let dab = sub(pb, pa);
+    // b's quadric moved to a's origin: x - pb = (x - pa) + (pa - pb).
+    let q = quadric_add(
+        &quadrics[a as usize],
+        &quadric_shift(&quadrics[b as usize], sub(pa, pb)),
+    );
+    let (keep, remove, y) = if pin_a {
+        (a, b, [0.0; 3])
+    } else if pin_b {
+        (b, a, dab)
+    } else {
+        let y = match quadric_optimum(&q) {
+            Some(y) => y,
+            None => {
+                let mut best = [0.0f32; 3];
+                let mut best_e = quadric_eval(&q, best);
+                for c in [dab, scale(dab, 0.5)] {
+                    let e = quadric_eval(&q, c);
+                    if e < best_e {
+                        best = c;
+                        best_e = e;
+                    }
+                }
+                best
+            }
+        };
+        // The survivor is the endpoint nearer the new position.
+        if dot(y, y) <= dot(sub(y, dab), sub(y, dab)) {
+            (a, b, y)
+        } else {
+            (b, a, y)
+        }
+    };
+    let error = quadric_eval(&q, y);
+    let pos = add(pa, y);
+
+    // Faces that move: normals may not turn past the limit (against the current and the input
+    // normal), no needle may appear; the worst new quality scales the priority.
+    let mut min_q = f32::INFINITY;
+    let mut on_cd = [false; 2];
+    for (side, (moved, other)) in [(keep, remove), (remove, keep)].into_iter().enumerate() {
+        let list = if moved == a { la } else { lb };
+        for &f in list {
+            let t = face_of(indices, f);
+            if t.contains(&other) {
+                continue;
+            }
+            if edge_faces == 2 && t.contains(&opp[0]) && t.contains(&opp[1]) {
+                on_cd[side] = true;
+            }
+            let old = t.map(|u| xyz(positions[u as usize]));
+            let new = t.map(|u| {
+                if u == moved {
+                    pos
+                } else {
+                    xyz(positions[u as usize])
+                }
+            });
+            let n_old = cross(sub(old[1], old[0]), sub(old[2], old[0]));
+            let n_new = cross(sub(new[1], new[0]), sub(new[2], new[0]));
+            let (l_old, l_new) = (length(n_old), length(n_new));
+            if !(l_new > 0.0) {
+                return Verdict::Invalid;
+            }
+            if l_old > 0.0 && dot(n_old, n_new) < params.cos_max_angle * l_old * l_new {
+                return Verdict::Invalid;
+            }
+            let n_ref = xyz(face_normals[f as usize]);
+            if face_normals[f as usize][3] > 0.0 && dot(n_ref, n_new) < params.cos_max_angle * l_new
+            {
+                return Verdict::Invalid;
+            }
+            let q_new = triangle_quality(new[0], new[1], new[2]);
+            if q_new < params.min_quality && q_new < triangle_quality(old[0], old[1], old[2]) {
+                return Verdict::Invalid;
+            }
+            min_q = min_q.min(q_new);
+        }
+    }
+    if on_cd[0] && on_cd[1] {
+        return Verdict::Invalid; // faces (keep, c, d) and (remove, c, d) would coincide
+    }
+    let qt = params.quality_threshold;
+    let priority = if qt > 0.0 && min_q < qt {
+        error * (qt / min_q.max(1e-12))
+    } else {
+        error
+    };
+    let weight = q.q[2][2];
+    let err2 = if weight > 0.0 { error / weight } else { 0.0 };
+    if !(priority.is_finite() && err2.is_finite() && pos.iter().all(|x| x.is_finite())) {
+        return Verdict::Invalid;
+    }
+    if err2 > params.max_error2 {
+        return Verdict::OverMaxError;
+    }
+    Verdict::Candidate(EdgeCandidate {
+        pos: [pos[0], pos[1], pos[2], err2],
+        keep,
+        remove,
+        cost_bits: priority.to_bits(),
+        faces: edge_faces,
+    })
+}
+
+/// Per edge (`edge_capacity` invocations; those past the edge count stop at once).
+#[allow(clippy::too_many_arguments)]
+pub fn edge_costs(
+    params: &Params,
+    positions: &[[f32; 4]],           // per vertex
+    quadrics: &[Quadric],             // per vertex
+    flags: &[u32],                    // per vertex
+    indices: &[u32],                  // per face × 3
+    offsets: &[u32],                  // per vertex + 1
+    vertex_faces: &[u32],             // per corner
+    face_normals: &[[f32; 4]],        // per face
+    edges: &[[u32; 2]],               // per edge
+    edge_offsets: &[u32],             // per vertex + 1: the edge count at [vertex_count]
+    candidates: &mut [EdgeCandidate], // per edge
+    edge_state: &mut [u32],           // per edge
+    histogram: &[AtomicU32],          // HIST_BINS, cleared
+    counters: &[AtomicU32],           // Counters, cleared
+) {
+    let ne = edge_offsets[params.vertex_count as usize] as usize;
+    candidates[..ne]
+        .par_iter_mut()
+        .zip(&mut edge_state[..ne])
+        .enumerate()
+        .with_min_len(256)
+        .for_each(|(e, (out, st))| {
+            let [a, b] = edges[e];
+            let verdict = evaluate(
+                params,
+                positions,
+                quadrics,
+                flags,
+                indices,
+                offsets,
+                vertex_faces,
+                face_normals,
+                a,
+                b,
+            );
+            *st = state::OUT;
+            *out = EdgeCandidate {
+                cost_bits: INVALID_COST,
+                ..Default::default()
+            };
+            match verdict {
+                Verdict::Invalid => {}
+                Verdict::OverMaxError => {
+                    counter(counters, CounterField::OverMaxError).fetch_add(1, Relaxed);
+                }
+                Verdict::Candidate(c) => {
+                    histogram[(c.cost_bits >> HIST_SHIFT) as usize].fetch_add(1, Relaxed);
+                    counter(counters, CounterField::Candidates).fetch_add(1, Relaxed);
+                    *out = c;
+                    *st = state::CANDIDATE;
+                }
+            }
+        });
+}
+
+/// Fields of [`Counters`] by position, for the atomic view of the buffer.
+#[derive(Clone, Copy)]
+pub enum CounterField {
+    Candidates = 0,
+    OverMaxError = 1,
+    Ceiling = 2,
+    Winners = 3,
+    Removed = 4,
+    MaxErr2Bits = 5,
+    TrimBin = 6,
+    TrimBudget = 7,
+    VerticesOut = 8,
+    FacesOut = 9,
+}
+
+pub fn counter(counters: &[AtomicU32], f: CounterField) -> &AtomicU32 {
+    const _: () = assert!(std::mem::size_of::<Counters>() == 16 * 4);
+    &counters[f as usize]
+}

@@ -1,0 +1,125 @@
+//! Twins of shaders/select_cost.wgsl, select_id.wgsl and select_win.wgsl: one pass of the
+//! independent-set selection. An edge wins when its key (cost bits, then edge id) is the
+//! smallest over every candidate touching any face around either endpoint: 32-bit atomicMax of
+//! inverted keys per face, first on the cost, then on the id among equal costs (64-bit atomics
+//! are not portable). Two winners then share no face, so the checks each passed in
+//! `edge_costs` stay true when both collapse. Winners lock their faces; a candidate touching a
+//! locked face drops out at the next pass, and the others compete again (Luby-style).
+
+use super::edge_costs::{CounterField, counter};
+use super::{faces_of, par_for};
+use crate::gpu::types::{EdgeCandidate, Params, state};
+use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+
+/// Faces around either endpoint of edge `e` (those on the edge come twice, harmlessly).
+fn around<'a>(
+    offsets: &[u32],
+    vertex_faces: &'a [u32],
+    e: [u32; 2],
+) -> impl Iterator<Item = u32> + 'a {
+    let la = faces_of(offsets, vertex_faces, e[0]);
+    let lb = faces_of(offsets, vertex_faces, e[1]);
+    la.iter().chain(lb).copied()
+}
+
+/// Invocations of the per-edge passes: the edge count, from the edge prefix sum.
+fn edge_count(params: &Params, edge_offsets: &[u32]) -> u32 {
+    edge_offsets[params.vertex_count as usize]
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn select_cost(
+    params: &Params,
+    offsets: &[u32],
+    vertex_faces: &[u32],
+    edges: &[[u32; 2]],
+    edge_offsets: &[u32],
+    candidates: &[EdgeCandidate],
+    face_lock: &[AtomicU32], // per face
+    counters: &[AtomicU32],
+    edge_state: &[AtomicU32], // per edge
+    face_best: &[AtomicU32],  // per face, cleared
+) {
+    let ceiling = counter(counters, CounterField::Ceiling).load(Relaxed);
+    par_for(edge_count(params, edge_offsets), |e| {
+        let e = e as usize;
+        if edge_state[e].load(Relaxed) != state::CANDIDATE {
+            return;
+        }
+        let c = &candidates[e];
+        if c.cost_bits >= ceiling
+            || around(offsets, vertex_faces, edges[e])
+                .any(|f| face_lock[f as usize].load(Relaxed) != 0)
+        {
+            edge_state[e].store(state::OUT, Relaxed);
+            return;
+        }
+        let inv = !c.cost_bits;
+        for f in around(offsets, vertex_faces, edges[e]) {
+            face_best[f as usize].fetch_max(inv, Relaxed);
+        }
+    });
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn select_id(
+    params: &Params,
+    offsets: &[u32],
+    vertex_faces: &[u32],
+    edges: &[[u32; 2]],
+    edge_offsets: &[u32],
+    candidates: &[EdgeCandidate],
+    face_best: &[AtomicU32],
+    edge_state: &[AtomicU32],
+    face_id: &[AtomicU32], // per face, cleared
+) {
+    par_for(edge_count(params, edge_offsets), |e| {
+        let eu = e as usize;
+        if edge_state[eu].load(Relaxed) != state::CANDIDATE {
+            return;
+        }
+        let inv = !candidates[eu].cost_bits;
+        for f in around(offsets, vertex_faces, edges[eu]) {
+            if face_best[f as usize].load(Relaxed) == inv {
+                face_id[f as usize].fetch_max(!e, Relaxed);
+            }
+        }
+    });
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn select_win(
+    params: &Params,
+    offsets: &[u32],
+    vertex_faces: &[u32],
+    edges: &[[u32; 2]],
+    edge_offsets: &[u32],
+    candidates: &[EdgeCandidate],
+    face_best: &[AtomicU32],
+    face_id: &[AtomicU32],
+    edge_state: &[AtomicU32],
+    face_lock: &[AtomicU32],
+    counters: &[AtomicU32],
+) {
+    par_for(edge_count(params, edge_offsets), |e| {
+        let eu = e as usize;
+        if edge_state[eu].load(Relaxed) != state::CANDIDATE {
+            return;
+        }
+        let c = &candidates[eu];
+        let inv = !c.cost_bits;
+        let wins = around(offsets, vertex_faces, edges[eu]).all(|f| {
+            face_best[f as usize].load(Relaxed) == inv && face_id[f as usize].load(Relaxed) == !e
+        });
+        if !wins {
+            return;
+        }
+        edge_state[eu].store(state::WON, Relaxed);
+        for f in around(offsets, vertex_faces, edges[eu]) {
+            face_lock[f as usize].store(1, Relaxed);
+        }
+        counter(counters, CounterField::Winners).fetch_add(1, Relaxed);
+        counter(counters, CounterField::Removed).fetch_add(c.faces, Relaxed);
+        counter(counters, CounterField::MaxErr2Bits).fetch_max(c.pos[3].to_bits(), Relaxed);
+    });
+}

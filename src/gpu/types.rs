@@ -1,0 +1,153 @@
+//! Structs shared by the WGSL stages and their CPU twins. Keep in sync with
+//! shaders/common.wgsl: every struct here has a WGSL twin of the same name and layout, and
+//! `tests` in `src/gpu/shaders.rs` compare naga's sizes with `size_of`.
+//! No `vec3` members: storage structs are packed into `vec4`s so the layouts need no padding
+//! rules beyond 16-byte alignment.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Threads per workgroup of every 1-D stage. Keep in sync with `WG` in shaders/common.wgsl.
+pub const WG: u32 = 256;
+/// Elements one workgroup of the prefix sum scans (4 per thread). Keep in sync with
+/// `SCAN_BLOCK` in shaders/common.wgsl.
+pub const SCAN_BLOCK: u32 = WG * 4;
+/// Bins of the cost histogram: the top 12 bits of a non-negative f32 (sign, 8 exponent bits,
+/// 3 mantissa bits), the resolution meshoptimizer ranks with. Keep in sync with `HIST_BINS`.
+pub const HIST_BINS: u32 = 4096;
+/// Shift that turns cost bits into a histogram bin.
+pub const HIST_SHIFT: u32 = 20;
+/// Cost bits of an edge that may not collapse (a NaN pattern: above every real cost).
+pub const INVALID_COST: u32 = 0xffff_ffff;
+
+/// Vertex flag bits (`flags` buffers). Keep in sync with shaders/common.wgsl.
+pub mod flag {
+    /// The vertex lies on an open border.
+    pub const BORDER: u32 = 1;
+    /// Keeps its position and is never removed (non-manifold spot, locked border); a free
+    /// neighbour may still collapse onto it.
+    pub const PINNED: u32 = 2;
+    /// On an attribute seam (UV, normal or colour discontinuity): no edge touching it collapses,
+    /// so the corners around it keep their attributes exactly.
+    pub const FROZEN: u32 = 4;
+    /// Moved by a collapse: the output takes its new position (unmoved vertices keep their
+    /// input coordinates bit for bit).
+    pub const MOVED: u32 = 8;
+}
+
+/// Per-edge selection state (`edge_state` buffer). Keep in sync with shaders/common.wgsl.
+pub mod state {
+    /// Invalid or already out of this round.
+    pub const OUT: u32 = 0;
+    /// Competes in the next selection pass.
+    pub const CANDIDATE: u32 = 1;
+    /// Collapses this round.
+    pub const WON: u32 = 2;
+}
+
+/// Per-round constants, a uniform. Keep in sync with `Params` in shaders/common.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct Params {
+    pub vertex_count: u32,
+    pub face_count: u32,
+    /// Upper bound on the edge count (3 × faces): per-edge stages are dispatched for this many
+    /// invocations and stop at the real count, read from the edge prefix sum.
+    pub edge_capacity: u32,
+    pub target_faces: u32,
+    /// Faces still to remove this run: `face_count - target_faces`.
+    pub needed_faces: u32,
+    /// How many candidates the cost ceiling lets compete.
+    pub ceiling_wanted: u32,
+    /// 1 under `lock_border`: border vertices are pinned.
+    pub lock_border: u32,
+    /// 1 when this round trims its winners so the face count lands on the target.
+    pub trim: u32,
+    pub cos_max_angle: f32,
+    pub min_quality: f32,
+    pub quality_threshold: f32,
+    pub border_weight: f32,
+    /// Largest allowed squared collapse error (relative to the diagonal); f32::MAX if none.
+    pub max_error2: f32,
+    pub _pad: [u32; 3],
+}
+
+/// Prefix-sum size, a uniform (one buffer per scan site). Keep in sync with shaders/common.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct ScanParams {
+    /// Elements scanned; the buffer holds `n + 1`, the total lands at index `n`.
+    pub n: u32,
+    pub _pad: [u32; 3],
+}
+
+/// Round counters, atomics on the GPU. Keep in sync with `Counters` in shaders/common.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct Counters {
+    /// Valid edges after `edge_costs`.
+    pub candidates: u32,
+    /// Edges refused only because their error exceeds the maximum.
+    pub over_max_error: u32,
+    /// Cost bits below which candidates compete (from `cost_ceiling`).
+    pub ceiling: u32,
+    /// Winners of `select_win`, summed over the passes.
+    pub winners: u32,
+    /// Faces the winners remove (before trimming).
+    pub removed: u32,
+    /// Largest squared error of a winner, as f32 bits (non-negative floats order as integers).
+    pub max_err2_bits: u32,
+    /// Trimming: winners above this bin lose; within it, by edge id up to `trim_budget`.
+    pub trim_bin: u32,
+    pub trim_budget: u32,
+    /// Vertex and face counts after compaction (copied from the prefix sums' totals).
+    pub vertices_out: u32,
+    pub faces_out: u32,
+    pub _pad: [u32; 6],
+}
+
+/// A vertex's quadric in f32, relative to the vertex's own position: `E(y) = yᵀAy + 2bᵀy + c`
+/// with `y = x - position`. Keeping the origin at the vertex keeps `c` and `b` small, so f32
+/// does not lose the tiny errors of a million-triangle scan to cancellation.
+/// Layout `[a00 a01 a02 a11] [a12 a22 b0 b1] [b2 c weight 0]`.
+/// Keep in sync with `Quadric` in shaders/common.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct Quadric {
+    pub q: [[f32; 4]; 3],
+}
+
+/// The best collapse of one edge. Keep in sync with `EdgeCandidate` in shaders/common.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct EdgeCandidate {
+    /// New position (xyz) and squared error relative to the diagonal (w).
+    pub pos: [f32; 4],
+    pub keep: u32,
+    pub remove: u32,
+    /// f32 bits of the priority (error scaled by triangle quality); INVALID_COST if invalid.
+    pub cost_bits: u32,
+    /// Faces on the edge: 1 (border) or 2; what the collapse removes.
+    pub faces: u32,
+}
+
+/// Per-face data carried through compaction alongside the indices: the attribute vertex of
+/// each corner (for seam corners) and the face's index in the input (materials, groups).
+/// Keep in sync with `FaceExtra` in shaders/common.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct FaceExtra {
+    pub attr: [u32; 3],
+    pub origin: u32,
+}
+
+/// Indexed indirect draw arguments, as wgpu's `DrawIndexedIndirectArgs`, written by
+/// `draw_args` so a renderer draws the current mesh without reading its size back.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct DrawArgs {
+    pub index_count: u32,
+    pub instance_count: u32,
+    pub first_index: u32,
+    pub base_vertex: i32,
+    pub first_instance: u32,
+}

@@ -1,0 +1,378 @@
+//! The round driver shared by the `gpu` and `cpu-parallel` backends: what is uploaded, how many
+//! collapses each round aims for, when it trims to land on the target, why it stops, and how
+//! the result becomes a [`Mesh`] again. The backends only run the stages ([`RoundRunner`]).
+
+use crate::error::Result;
+use crate::gpu::types::{Counters, FaceExtra, Params, flag};
+use crate::mesh::{Mesh, weld, weld::position_classes};
+use crate::simplify::{SimplifyOptions, SimplifyReport, StopReason};
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// Selection passes per round. One pass removes ~5% of the faces per round, three ~15%
+/// (ARCHITECTURE.md's prototype); more passes add little once most candidates are blocked.
+pub const SELECTION_PASSES: u32 = 4;
+/// The cost ceiling lets this many times the collapses still needed compete: fewer keeps the
+/// order closer to greedy, more needs fewer rounds.
+pub const CEILING_FACTOR: u32 = 2;
+/// A round trims its winners once the faces still to remove fall below this share of the
+/// faces: a round never removes more than about a third of them.
+pub const TRIM_SHARE: f64 = 0.4;
+/// Safety net: a run that has not converged after this many rounds stops.
+pub const MAX_ROUNDS: usize = 400;
+
+/// One backend's stage runner: the same rounds on GPU buffers or CPU slices.
+pub trait RoundRunner {
+    /// Runs one round with `params` (the first also computes face planes, flags and quadrics)
+    /// and returns its counters.
+    fn round(&mut self, params: &Params, first: bool) -> Result<Counters>;
+    /// The current mesh, read back.
+    fn download(&mut self) -> Result<Download>;
+    fn stage_times(&self) -> &StageTimes;
+}
+
+/// Seconds per stage name, in first-seen order, summed over rounds.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct StageTimes(pub Vec<(String, f64)>);
+
+impl StageTimes {
+    pub fn add(&mut self, stage: &str, seconds: f64) {
+        match self.0.iter_mut().find(|(s, _)| s == stage) {
+            Some(e) => e.1 += seconds,
+            None => self.0.push((stage.to_string(), seconds)),
+        }
+    }
+    pub fn total(&self) -> f64 {
+        self.0.iter().map(|e| e.1).sum()
+    }
+    /// The stage that took longest.
+    pub fn slowest(&self) -> Option<(&str, f64)> {
+        self.0
+            .iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(s, t)| (s.as_str(), *t))
+    }
+}
+
+/// What the rounds did, reported by `--stats` and `--json`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct RoundsReport {
+    /// GPU adapter name (gpu backend only).
+    pub adapter: Option<String>,
+    pub rounds: usize,
+    /// Faces removed by each round.
+    pub faces_removed_per_round: Vec<usize>,
+    /// Time per stage: GPU time from timestamp queries when the device has them (else the
+    /// wall time of each submission), CPU time for cpu-parallel.
+    pub stage_seconds: StageTimes,
+    /// Whether `stage_seconds` comes from GPU timestamp queries.
+    pub gpu_timestamps: bool,
+    /// Shader compilation and pipeline creation (gpu backend), reported apart from simplifying.
+    pub pipeline_seconds: f64,
+    /// Upload and download between host and device (gpu backend).
+    pub transfer_seconds: f64,
+}
+
+/// The surface as the rounds see it: position classes (a seam's vertices share one), Morton
+/// ordered, normalized into the unit-diagonal box centred on the origin.
+pub struct Upload {
+    /// The input after exact welding: its vertices are the attribute vertices written out.
+    pub welded: Mesh,
+    /// Per class: position (w = 1).
+    pub positions: Vec<[f32; 4]>,
+    /// Per face × 3: class ids.
+    pub indices: Vec<u32>,
+    /// Per class: FROZEN for seams (more than one attribute vertex used).
+    pub flags: Vec<u32>,
+    /// Per class: one attribute vertex the faces use.
+    pub vertex_attr: Vec<u32>,
+    pub face_extra: Vec<FaceExtra>,
+    pub center: [f64; 3],
+    pub scale: f64,
+    pub dropped_degenerate: usize,
+    pub frozen: usize,
+}
+
+/// The rounds' buffers read back at the end.
+#[derive(Debug, Clone, Default)]
+pub struct Download {
+    pub positions: Vec<[f32; 4]>,
+    pub flags: Vec<u32>,
+    pub vertex_attr: Vec<u32>,
+    pub indices: Vec<u32>,
+    pub face_extra: Vec<FaceExtra>,
+}
+
+impl Upload {
+    pub fn new(input: &Mesh) -> Upload {
+        let welded = weld(input).mesh;
+        let (topo, firsts) = position_classes(&welded.positions);
+        let (topo, _) = crate::greedy::spatial_order(&welded.positions, topo, firsts);
+        let nclass = topo.iter().map(|&t| t as usize + 1).max().unwrap_or(0);
+        // Faces with three distinct classes; the rest would be degenerate.
+        let mut faces: Vec<(u32, [u32; 3], FaceExtra)> = welded
+            .triangles
+            .iter()
+            .enumerate()
+            .filter_map(|(f, t)| {
+                let c = t.map(|v| topo[v as usize]);
+                (c[0] != c[1] && c[1] != c[2] && c[0] != c[2]).then(|| {
+                    let lo = c[0].min(c[1]).min(c[2]);
+                    (
+                        lo,
+                        c,
+                        FaceExtra {
+                            attr: *t,
+                            origin: f as u32,
+                        },
+                    )
+                })
+            })
+            .collect();
+        let dropped_degenerate = welded.triangles.len() - faces.len();
+        // Faces in the order of their lowest vertex: a vertex's faces sit close in memory.
+        faces.par_sort_unstable_by_key(|e| (e.0, e.2.origin));
+        // Classes the faces use, renumbered densely in Morton order; their attribute vertices.
+        let mut class_attr = vec![u32::MAX; nclass];
+        let mut attr_count = vec![0u32; nclass];
+        let mut seen_attr = vec![false; welded.positions.len()];
+        for (_, c, x) in &faces {
+            for k in 0..3 {
+                let (cl, a) = (c[k] as usize, x.attr[k]);
+                if !seen_attr[a as usize] {
+                    seen_attr[a as usize] = true;
+                    attr_count[cl] += 1;
+                }
+                if class_attr[cl] == u32::MAX {
+                    class_attr[cl] = a;
+                }
+            }
+        }
+        let mut dense = vec![u32::MAX; nclass];
+        let mut n = 0u32;
+        for (c, &a) in class_attr.iter().enumerate() {
+            if a != u32::MAX {
+                dense[c] = n;
+                n += 1;
+            }
+        }
+        let (center, scale) = match welded.bounds() {
+            Some(b) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
+            Some(b) => (b.center(), 1.0),
+            None => ([0.0; 3], 1.0),
+        };
+        let mut positions = vec![[0.0f32; 4]; n as usize];
+        let mut flags = vec![0u32; n as usize];
+        let mut vertex_attr = vec![0u32; n as usize];
+        for c in 0..nclass {
+            if dense[c] != u32::MAX {
+                let d = dense[c] as usize;
+                let p = welded.positions[class_attr[c] as usize];
+                let q = [0, 1, 2].map(|i| ((p[i] as f64 - center[i]) * scale) as f32);
+                positions[d] = [q[0], q[1], q[2], 1.0];
+                vertex_attr[d] = class_attr[c];
+                if attr_count[c] > 1 {
+                    flags[d] = flag::FROZEN;
+                }
+            }
+        }
+        let indices = faces
+            .iter()
+            .flat_map(|(_, c, _)| c.map(|x| dense[x as usize]))
+            .collect();
+        let frozen = flags.iter().filter(|&&f| f != 0).count();
+        Upload {
+            positions,
+            indices,
+            flags,
+            vertex_attr,
+            face_extra: faces.into_iter().map(|e| e.2).collect(),
+            welded,
+            center,
+            scale,
+            dropped_degenerate,
+            frozen,
+        }
+    }
+
+    pub fn face_count(&self) -> usize {
+        self.face_extra.len()
+    }
+
+    /// The round parameters common to every round.
+    pub fn base_params(&self, opts: &SimplifyOptions) -> Params {
+        Params {
+            vertex_count: self.positions.len() as u32,
+            face_count: self.face_count() as u32,
+            edge_capacity: 3 * self.face_count() as u32,
+            target_faces: opts.target_faces as u32,
+            lock_border: opts.lock_border as u32,
+            cos_max_angle: opts.max_normal_angle_deg.to_radians().cos() as f32,
+            min_quality: opts.min_quality as f32,
+            quality_threshold: opts.quality_threshold as f32,
+            border_weight: opts.border_weight as f32,
+            max_error2: opts.max_error.map_or(f32::MAX, |e| (e * e) as f32),
+            ..Default::default()
+        }
+    }
+
+    /// The output mesh: the rounds' faces as attribute vertices of the welded input (a seam
+    /// corner keeps its own, any other corner takes its class's), moved vertices taken out of
+    /// the normalized frame, materials and groups per face, unused vertices dropped.
+    pub fn build_output(&self, d: &Download, normals: bool) -> Mesh {
+        let mut out = self.welded.clone_without_geometry();
+        out.positions = self.welded.positions.clone();
+        out.uvs = self.welded.uvs.clone();
+        out.colors = self.welded.colors.clone();
+        for (v, p) in d.positions.iter().enumerate() {
+            if d.flags[v] & flag::MOVED != 0 {
+                let q = [0, 1, 2].map(|i| (p[i] as f64 / self.scale + self.center[i]) as f32);
+                out.positions[d.vertex_attr[v] as usize] = q;
+            }
+        }
+        let nf = d.face_extra.len();
+        out.triangles = (0..nf)
+            .map(|f| {
+                let x = &d.face_extra[f];
+                [0, 1, 2].map(|k| {
+                    let v = d.indices[3 * f + k] as usize;
+                    if d.flags[v] & flag::FROZEN != 0 {
+                        x.attr[k]
+                    } else {
+                        d.vertex_attr[v]
+                    }
+                })
+            })
+            .collect();
+        let origin = |f: usize| d.face_extra[f].origin as usize;
+        out.face_materials = self
+            .welded
+            .face_materials
+            .as_ref()
+            .map(|m| (0..nf).map(|f| m[origin(f)]).collect());
+        out.face_groups = self
+            .welded
+            .face_groups
+            .as_ref()
+            .map(|g| (0..nf).map(|f| g[origin(f)]).collect());
+        out.remove_unused_vertices();
+        if normals {
+            out.recompute_normals();
+        }
+        out
+    }
+}
+
+/// What [`drive`] did.
+pub struct Driven {
+    pub stop_reason: StopReason,
+    /// Largest error of an applied collapse (relative RMS distance).
+    pub max_error: f64,
+    /// Faces removed per round.
+    pub removed: Vec<usize>,
+    pub collapses: usize,
+}
+
+/// Runs rounds until the target, the error bound, or no valid collapse.
+pub fn drive(
+    runner: &mut dyn RoundRunner,
+    up: &Upload,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<Driven> {
+    let base = up.base_params(opts);
+    let (mut nv, mut nf) = (base.vertex_count, base.face_count);
+    let target = base.target_faces;
+    let start = nf.saturating_sub(target).max(1) as f32;
+    let mut removed = Vec::new();
+    let mut max_err2 = 0f32;
+    let mut collapses = 0usize;
+    let mut first = true;
+    let reason = loop {
+        // An interior collapse removes two faces: one above the target is as close as it gets
+        // when only interior collapses remain.
+        if nf <= target.saturating_add(1) && (nf <= target || !first) {
+            break StopReason::TargetReached;
+        }
+        if removed.len() >= MAX_ROUNDS {
+            break StopReason::NoValidCollapse;
+        }
+        let needed = nf - target;
+        let params = Params {
+            vertex_count: nv,
+            face_count: nf,
+            edge_capacity: 3 * nf,
+            needed_faces: needed,
+            ceiling_wanted: needed.div_ceil(2).saturating_mul(CEILING_FACTOR).max(1),
+            trim: ((needed as f64) < TRIM_SHARE * nf as f64) as u32,
+            ..base
+        };
+        let c = runner.round(&params, first)?;
+        first = false;
+        if c.faces_out > nf || c.vertices_out > nv {
+            return Err(crate::error::Error::Internal(format!(
+                "round {} grew the mesh: {nf} -> {} faces",
+                removed.len() + 1,
+                c.faces_out
+            )));
+        }
+        if c.faces_out == nf {
+            break if c.over_max_error > 0 && c.candidates == 0 {
+                StopReason::MaxError
+            } else {
+                StopReason::NoValidCollapse
+            };
+        }
+        if c.winners > 0 {
+            max_err2 = max_err2.max(f32::from_bits(c.max_err2_bits));
+        }
+        removed.push((nf - c.faces_out) as usize);
+        collapses += (nv - c.vertices_out) as usize;
+        nv = c.vertices_out;
+        nf = c.faces_out;
+        progress((base.face_count - nf) as f32 / start);
+    };
+    Ok(Driven {
+        stop_reason: reason,
+        max_error: (max_err2 as f64).sqrt(),
+        removed,
+        collapses,
+    })
+}
+
+/// Runs the rounds on `runner` over `up` and assembles the report.
+pub fn simplify_rounds(
+    runner: &mut dyn RoundRunner,
+    up: &Upload,
+    input: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+    mut rounds_report: RoundsReport,
+) -> Result<(Mesh, SimplifyReport)> {
+    let driven = drive(runner, up, opts, progress)?;
+    let down = runner.download()?;
+    let out = up.build_output(&down, input.normals.is_some());
+    rounds_report.rounds = driven.removed.len();
+    rounds_report.stage_seconds = runner.stage_times().clone();
+    rounds_report.faces_removed_per_round = driven.removed;
+    let pinned = down
+        .flags
+        .iter()
+        .filter(|&&f| f & (flag::PINNED | flag::FROZEN) != 0)
+        .count();
+    let report = SimplifyReport {
+        backend: opts.backend,
+        input_faces: input.triangles.len(),
+        target_faces: opts.target_faces,
+        output_faces: out.triangles.len(),
+        input_vertices: input.positions.len(),
+        output_vertices: out.positions.len(),
+        collapses: driven.collapses,
+        max_collapse_error: driven.max_error,
+        stop_reason: driven.stop_reason,
+        dropped_degenerate_faces: up.dropped_degenerate,
+        pinned_vertices: pinned,
+        rounds: Some(rounds_report),
+    };
+    Ok((out, report))
+}
