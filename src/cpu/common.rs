@@ -39,6 +39,19 @@ pub fn xyz(p: [f32; 4]) -> V3 {
     [p[0], p[1], p[2]]
 }
 
+/// Tie-break rank of edge `e` among candidates of equal cost: a bijective integer hash (Chris
+/// Wellons' lowbias32), so ranks never tie, yet neighbours get unrelated ranks. Ranking by the id
+/// itself let only a few local minima of a monotone id wave win per pass on flat regions, where
+/// every cost is zero (a 40 × 40 grid took 127 rounds to 1%).
+pub fn tie_rank(e: u32) -> u32 {
+    let mut x = e;
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^ (x >> 16)
+}
+
 /// `weight · (n·y + d)²` for the plane `n·y + d = 0` (unit `n`), in the frame of the vertex.
 pub fn quadric_from_plane(n: V3, d: f32, w: f32) -> Quadric {
     Quadric {

@@ -16,10 +16,10 @@ pub mod edge_costs;
 pub mod edges;
 pub mod face_planes;
 pub mod prefix_sum;
-pub mod quadrics;
 pub mod select;
 pub mod trim;
 pub mod vertex_flags;
+pub mod vertex_quadrics;
 
 use crate::error::Result;
 use crate::gpu::types::*;
@@ -221,8 +221,8 @@ impl CpuRounds {
         self.time("vertex_flags", |s| {
             vertex_flags::vertex_flags(p, &s.indices, &s.offsets, &s.vertex_faces, &mut s.flags)
         });
-        self.time("quadrics", |s| {
-            quadrics::quadrics(
+        self.time("vertex_quadrics", |s| {
+            vertex_quadrics::vertex_quadrics(
                 p,
                 &s.positions,
                 &s.indices,

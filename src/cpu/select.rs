@@ -1,11 +1,12 @@
 //! Twins of shaders/select_cost.wgsl, select_id.wgsl and select_win.wgsl: one pass of the
 //! independent-set selection. An edge wins when its key (cost bits, then edge id) is the
 //! smallest over every candidate touching any face around either endpoint: 32-bit atomicMax of
-//! inverted keys per face, first on the cost, then on the id among equal costs (64-bit atomics
+//! inverted keys per face, first on the cost, then on a hash of the id among equal costs (64-bit atomics
 //! are not portable). Two winners then share no face, so the checks each passed in
 //! `edge_costs` stay true when both collapse. Winners lock their faces; a candidate touching a
 //! locked face drops out at the next pass, and the others compete again (Luby-style).
 
+use super::common::tie_rank;
 use super::edge_costs::{CounterField, counter};
 use super::{faces_of, par_for};
 use crate::gpu::types::{EdgeCandidate, Params, state};
@@ -81,7 +82,7 @@ pub fn select_id(
         let inv = !candidates[eu].cost_bits;
         for f in around(offsets, vertex_faces, edges[eu]) {
             if face_best[f as usize].load(Relaxed) == inv {
-                face_id[f as usize].fetch_max(!e, Relaxed);
+                face_id[f as usize].fetch_max(!tie_rank(e), Relaxed);
             }
         }
     });
@@ -109,7 +110,8 @@ pub fn select_win(
         let c = &candidates[eu];
         let inv = !c.cost_bits;
         let wins = around(offsets, vertex_faces, edges[eu]).all(|f| {
-            face_best[f as usize].load(Relaxed) == inv && face_id[f as usize].load(Relaxed) == !e
+            face_best[f as usize].load(Relaxed) == inv
+                && face_id[f as usize].load(Relaxed) == !tie_rank(e)
         });
         if !wins {
             return;

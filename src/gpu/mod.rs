@@ -1,15 +1,38 @@
-//! Backend `gpu`: the rounds as WGSL compute passes run by wgpu.
+//! Backend `gpu`: the rounds as WGSL compute passes run by wgpu (shaders/ holds one file per
+//! stage; src/cpu/ holds their twins).
 
+pub mod context;
+pub mod shaders;
+pub mod simplifier;
 pub mod types;
 
-use crate::error::{Error, Result};
+pub use context::GpuContext;
+pub use simplifier::{GpuMesh, GpuRounds, GpuSimplifier};
+
+use crate::error::Result;
 use crate::mesh::Mesh;
+use crate::parallel::{RoundsReport, SELECTION_PASSES, Upload, simplify_rounds};
 use crate::simplify::{SimplifyOptions, SimplifyReport};
 
+/// Simplifies on the first GPU adapter found.
 pub fn simplify_gpu(
-    _mesh: &Mesh,
-    _opts: &SimplifyOptions,
-    _progress: &mut dyn FnMut(f32),
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
-    Err(Error::Gpu("not yet built".into()))
+    let ctx = GpuContext::new()?;
+    let sim = GpuSimplifier::new(&ctx.device, &ctx.queue)?;
+    let up = Upload::new(mesh);
+    let mut rounds = GpuRounds::new(&sim, &up, SELECTION_PASSES)?;
+    let report = RoundsReport {
+        adapter: Some(ctx.adapter_name.clone()),
+        gpu_timestamps: sim.has_timestamps(),
+        pipeline_seconds: sim.pipeline_seconds,
+        ..Default::default()
+    };
+    let (out, mut rep) = simplify_rounds(&mut rounds, &up, mesh, opts, progress, report)?;
+    if let Some(r) = rep.rounds.as_mut() {
+        r.transfer_seconds = rounds.transfer_seconds;
+    }
+    Ok((out, rep))
 }

@@ -1,4 +1,4 @@
-//! Twin of shaders/quadrics.wgsl (first round): each vertex gathers the area-weighted plane
+//! Twin of shaders/vertex_quadrics.wgsl (first round): each vertex gathers the area-weighted plane
 //! quadrics of its faces and, for each border edge at it, Hoppe's constraint plane through the
 //! edge perpendicular to its face, weighted by the squared edge length. A gather in the sorted
 //! face order, so the sums do not depend on thread timing. Quadrics are relative to the vertex.
@@ -8,7 +8,7 @@ use super::vertex_flags::count_containing;
 use super::{face_of, faces_of, par_for_mut};
 use crate::gpu::types::{Params, Quadric};
 
-pub fn quadrics(
+pub fn vertex_quadrics(
     params: &Params,
     positions: &[[f32; 4]],    // per vertex
     indices: &[u32],           // per face × 3

@@ -1,0 +1,32 @@
+// Each winner moves its survivor to the new position with both quadrics re-centred there and
+// summed, carries the border bit, and points the removed vertex at the survivor. Winners share
+// no face, hence no vertex, so these writes never meet.
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> candidates: array<EdgeCandidate>; // per edge
+@group(0) @binding(2) var<storage, read> edge_state: array<u32>;          // per edge
+@group(0) @binding(3) var<storage, read> edge_offsets: array<u32>;        // per vertex + 1
+@group(0) @binding(4) var<storage, read_write> positions: array<vec4<f32>>; // per vertex
+@group(0) @binding(5) var<storage, read_write> quadrics: array<Quadric>;   // per vertex
+@group(0) @binding(6) var<storage, read_write> flags: array<u32>;          // per vertex
+@group(0) @binding(7) var<storage, read_write> remap: array<u32>;          // per vertex
+
+@compute @workgroup_size(256)
+fn collapse(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let e = gid.x + gid.y * nwg.x * WG;
+    if (e >= edge_offsets[params.vertex_count] || edge_state[e] != STATE_WON) {
+        return;
+    }
+    let c = candidates[e];
+    let k = c.keep;
+    let r = c.remove;
+    let pk = positions[k].xyz;
+    let pr = positions[r].xyz;
+    let p = c.pos.xyz;
+    quadrics[k] = quadric_add(quadric_shift(quadrics[k], p - pk), quadric_shift(quadrics[r], p - pr));
+    var moved = 0u;
+    if (any(p != pk)) { moved = FLAG_MOVED; }
+    flags[k] = flags[k] | (flags[r] & FLAG_BORDER) | moved;
+    positions[k] = vec4<f32>(p, 1.0);
+    remap[r] = k;
+}

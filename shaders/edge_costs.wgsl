@@ -1,0 +1,212 @@
+// Per edge: the collapse position and cost, with the greedy reference's validity rules (link
+// condition, no border pinch, no lone triangle, no tetrahedral fold, no flipped or needle face,
+// pinned and frozen vertices), and the cost histogram. Relies on the current CSR face lists.
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;        // per vertex
+@group(0) @binding(2) var<storage, read> quadrics: array<Quadric>;           // per vertex
+@group(0) @binding(3) var<storage, read> flags: array<u32>;                  // per vertex
+@group(0) @binding(4) var<storage, read> indices: array<u32>;                // per face × 3
+@group(0) @binding(5) var<storage, read> offsets: array<u32>;                // per vertex + 1
+@group(0) @binding(6) var<storage, read> vertex_faces: array<u32>;           // per corner
+@group(0) @binding(7) var<storage, read> face_normals: array<vec4<f32>>;     // per face
+@group(0) @binding(8) var<storage, read> edges: array<vec2<u32>>;            // per edge
+@group(0) @binding(9) var<storage, read> edge_offsets: array<u32>;           // per vertex + 1
+@group(0) @binding(10) var<storage, read_write> candidates: array<EdgeCandidate>; // per edge
+@group(0) @binding(11) var<storage, read_write> edge_state: array<u32>;      // per edge
+@group(0) @binding(12) var<storage, read_write> histogram: array<atomic<u32>>; // HIST_BINS
+@group(0) @binding(13) var<storage, read_write> counters: array<atomic<u32>, 16>;
+
+fn face_of(f: u32) -> vec3<u32> {
+    return vec3<u32>(indices[3u * f], indices[3u * f + 1u], indices[3u * f + 2u]);
+}
+
+fn has(t: vec3<u32>, u: u32) -> bool {
+    return t.x == u || t.y == u || t.z == u;
+}
+
+fn list_has(lo: u32, hi: u32, u: u32) -> bool {
+    for (var i = lo; i < hi; i = i + 1u) {
+        if (has(face_of(vertex_faces[i]), u)) { return true; }
+    }
+    return false;
+}
+
+fn count_containing(lo: u32, hi: u32, u: u32) -> u32 {
+    var n = 0u;
+    for (var i = lo; i < hi; i = i + 1u) {
+        if (has(face_of(vertex_faces[i]), u)) { n = n + 1u; }
+    }
+    return n;
+}
+
+const VERDICT_INVALID: u32 = 0u;
+const VERDICT_OVER: u32 = 1u;
+const VERDICT_OK: u32 = 2u;
+
+struct Verdict {
+    kind: u32,
+    c: EdgeCandidate,
+}
+
+fn invalid() -> Verdict {
+    return Verdict(VERDICT_INVALID, EdgeCandidate(vec4<f32>(0.0), 0u, 0u, INVALID_COST, 0u));
+}
+
+fn evaluate(a: u32, b: u32) -> Verdict {
+    let fla = flags[a];
+    let flb = flags[b];
+    if (((fla | flb) & FLAG_FROZEN) != 0u) { return invalid(); }
+    let pin_a = (fla & FLAG_PINNED) != 0u;
+    let pin_b = (flb & FLAG_PINNED) != 0u;
+    if (pin_a && pin_b) { return invalid(); }
+    let alo = offsets[a];
+    let ahi = offsets[a + 1u];
+    let blo = offsets[b];
+    let bhi = offsets[b + 1u];
+
+    var edge_faces = 0u;
+    var opp = vec2<u32>(0xffffffffu, 0xffffffffu);
+    for (var i = alo; i < ahi; i = i + 1u) {
+        let t = face_of(vertex_faces[i]);
+        if (has(t, b)) {
+            if (edge_faces == 2u) { return invalid(); }
+            var o = a;
+            for (var k = 0u; k < 3u; k = k + 1u) {
+                if (t[k] != a && t[k] != b) { o = t[k]; break; }
+            }
+            opp[edge_faces] = o;
+            edge_faces = edge_faces + 1u;
+        }
+    }
+    if (edge_faces == 0u) { return invalid(); }
+    var shared_nbrs = 0u;
+    for (var i = alo; i < ahi; i = i + 1u) {
+        let t = face_of(vertex_faces[i]);
+        for (var k = 0u; k < 3u; k = k + 1u) {
+            let u = t[k];
+            if (u != a && u != b && !list_has(alo, i, u) && list_has(blo, bhi, u)) {
+                shared_nbrs = shared_nbrs + 1u;
+            }
+        }
+    }
+    if (shared_nbrs != edge_faces) { return invalid(); }
+    let bord_a = (fla & FLAG_BORDER) != 0u;
+    let bord_b = (flb & FLAG_BORDER) != 0u;
+    if (edge_faces == 2u && bord_a && bord_b) { return invalid(); }
+    if (edge_faces == 1u) {
+        let c = opp[0];
+        if (count_containing(alo, ahi, c) == 1u && count_containing(blo, bhi, c) == 1u) {
+            return invalid();
+        }
+    }
+
+    let pa = positions[a].xyz;
+    let pb = positions[b].xyz;
+    let dab = pb - pa;
+    let q = quadric_add(quadrics[a], quadric_shift(quadrics[b], pa - pb));
+    var keep = a;
+    var remove = b;
+    var y = vec3<f32>(0.0);
+    if (pin_a) {
+        y = vec3<f32>(0.0);
+    } else if (pin_b) {
+        keep = b;
+        remove = a;
+        y = dab;
+    } else {
+        let opt = quadric_optimum(q);
+        if (opt.ok) {
+            y = opt.y;
+        } else {
+            var best = vec3<f32>(0.0);
+            var best_e = quadric_eval(q, best);
+            let e1 = quadric_eval(q, dab);
+            if (e1 < best_e) { best = dab; best_e = e1; }
+            let mid = dab * 0.5;
+            let e2 = quadric_eval(q, mid);
+            if (e2 < best_e) { best = mid; best_e = e2; }
+            y = best;
+        }
+        let dy = y - dab;
+        if (!(dot(y, y) <= dot(dy, dy))) {
+            keep = b;
+            remove = a;
+        }
+    }
+    let error = quadric_eval(q, y);
+    let pos = pa + y;
+
+    var min_q = 3.0e38;
+    var on_cd = vec2<bool>(false, false);
+    for (var side = 0u; side < 2u; side = side + 1u) {
+        var moved = keep;
+        var other = remove;
+        if (side == 1u) { moved = remove; other = keep; }
+        var lo = alo;
+        var hi = ahi;
+        if (moved != a) { lo = blo; hi = bhi; }
+        for (var i = lo; i < hi; i = i + 1u) {
+            let f = vertex_faces[i];
+            let t = face_of(f);
+            if (has(t, other)) { continue; }
+            if (edge_faces == 2u && has(t, opp[0]) && has(t, opp[1])) { on_cd[side] = true; }
+            let o0 = positions[t.x].xyz;
+            let o1 = positions[t.y].xyz;
+            let o2 = positions[t.z].xyz;
+            var n0 = o0; var n1 = o1; var n2 = o2;
+            if (t.x == moved) { n0 = pos; }
+            if (t.y == moved) { n1 = pos; }
+            if (t.z == moved) { n2 = pos; }
+            let n_old = cross(o1 - o0, o2 - o0);
+            let n_new = cross(n1 - n0, n2 - n0);
+            let l_old = length(n_old);
+            let l_new = length(n_new);
+            if (!(l_new > 0.0)) { return invalid(); }
+            if (l_old > 0.0 && dot(n_old, n_new) < params.cos_max_angle * l_old * l_new) { return invalid(); }
+            let fr = face_normals[f];
+            if (fr.w > 0.0 && dot(fr.xyz, n_new) < params.cos_max_angle * l_new) { return invalid(); }
+            let q_new = triangle_quality(n0, n1, n2);
+            if (q_new < params.min_quality && q_new < triangle_quality(o0, o1, o2)) { return invalid(); }
+            min_q = min(min_q, q_new);
+        }
+    }
+    if (on_cd[0] && on_cd[1]) { return invalid(); }
+    let qt = params.quality_threshold;
+    var priority = error;
+    if (qt > 0.0 && min_q < qt) {
+        priority = error * (qt / max(min_q, 1e-12));
+    }
+    let weight = q.q2.z;
+    var err2 = 0.0;
+    if (weight > 0.0) { err2 = error / weight; }
+    if (!(is_finite(priority) && is_finite(err2) && is_finite(pos.x) && is_finite(pos.y) && is_finite(pos.z))) {
+        return invalid();
+    }
+    if (err2 > params.max_error2) {
+        return Verdict(VERDICT_OVER, EdgeCandidate(vec4<f32>(0.0), 0u, 0u, INVALID_COST, 0u));
+    }
+    return Verdict(VERDICT_OK, EdgeCandidate(vec4<f32>(pos, err2), keep, remove, bitcast<u32>(priority), edge_faces));
+}
+
+@compute @workgroup_size(256)
+fn edge_costs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let e = gid.x + gid.y * nwg.x * WG;
+    if (e >= edge_offsets[params.vertex_count]) {
+        return;
+    }
+    let ab = edges[e];
+    let v = evaluate(ab.x, ab.y);
+    edge_state[e] = STATE_OUT;
+    if (v.kind == VERDICT_OK) {
+        candidates[e] = v.c;
+        edge_state[e] = STATE_CANDIDATE;
+        atomicAdd(&histogram[v.c.cost_bits >> HIST_SHIFT], 1u);
+        atomicAdd(&counters[C_CANDIDATES], 1u);
+    } else {
+        candidates[e] = EdgeCandidate(vec4<f32>(0.0), 0u, 0u, INVALID_COST, 0u);
+        if (v.kind == VERDICT_OVER) {
+            atomicAdd(&counters[C_OVER_MAX_ERROR], 1u);
+        }
+    }
+}

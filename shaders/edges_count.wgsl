@@ -1,0 +1,41 @@
+// Counts each vertex's edges to higher-id neighbours (first occurrence in its sorted face list)
+// and resets its collapse remap to itself. Relies on sorted face lists for stable edge ids.
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> indices: array<u32>;          // per face × 3
+@group(0) @binding(2) var<storage, read> offsets: array<u32>;          // per vertex + 1
+@group(0) @binding(3) var<storage, read> vertex_faces: array<u32>;     // per corner
+@group(0) @binding(4) var<storage, read_write> edge_counts: array<u32>; // per vertex + 1
+@group(0) @binding(5) var<storage, read_write> remap: array<u32>;       // per vertex
+
+fn face_of(f: u32) -> vec3<u32> {
+    return vec3<u32>(indices[3u * f], indices[3u * f + 1u], indices[3u * f + 2u]);
+}
+
+// u occurs in a face of the list before position i.
+fn seen_before(lo: u32, i: u32, u: u32) -> bool {
+    for (var j = lo; j < i; j = j + 1u) {
+        let t = face_of(vertex_faces[j]);
+        if (t.x == u || t.y == u || t.z == u) { return true; }
+    }
+    return false;
+}
+
+@compute @workgroup_size(256)
+fn edges_count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let v = gid.x + gid.y * nwg.x * WG;
+    if (v >= params.vertex_count) {
+        return;
+    }
+    let lo = offsets[v];
+    let hi = offsets[v + 1u];
+    var n = 0u;
+    for (var i = lo; i < hi; i = i + 1u) {
+        let t = face_of(vertex_faces[i]);
+        for (var k = 0u; k < 3u; k = k + 1u) {
+            if (t[k] > v && !seen_before(lo, i, t[k])) { n = n + 1u; }
+        }
+    }
+    edge_counts[v] = n;
+    remap[v] = v;
+}

@@ -1,0 +1,31 @@
+// Selection pass, step 2: among the candidates whose cost is the best at a face, the lowest tie rank
+// (a hash of the edge id) wins the face (atomicMax of the inverted rank). Relies on face_id being cleared.
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> offsets: array<u32>;             // per vertex + 1
+@group(0) @binding(2) var<storage, read> vertex_faces: array<u32>;        // per corner
+@group(0) @binding(3) var<storage, read> edges: array<vec2<u32>>;         // per edge
+@group(0) @binding(4) var<storage, read> edge_offsets: array<u32>;        // per vertex + 1
+@group(0) @binding(5) var<storage, read> candidates: array<EdgeCandidate>; // per edge
+@group(0) @binding(6) var<storage, read> face_best: array<u32>;           // per face
+@group(0) @binding(7) var<storage, read> edge_state: array<u32>;          // per edge
+@group(0) @binding(8) var<storage, read_write> face_id: array<atomic<u32>>; // per face
+
+@compute @workgroup_size(256)
+fn select_id(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let e = gid.x + gid.y * nwg.x * WG;
+    if (e >= edge_offsets[params.vertex_count] || edge_state[e] != STATE_CANDIDATE) {
+        return;
+    }
+    let inv = ~candidates[e].cost_bits;
+    let ab = edges[e];
+    for (var s = 0u; s < 2u; s = s + 1u) {
+        let v = ab[s];
+        for (var i = offsets[v]; i < offsets[v + 1u]; i = i + 1u) {
+            let f = vertex_faces[i];
+            if (face_best[f] == inv) {
+                atomicMax(&face_id[f], ~tie_rank(e));
+            }
+        }
+    }
+}

@@ -1,0 +1,43 @@
+// Selection pass, step 3: an edge whose (cost, tie rank) key is the best at every face around both
+// endpoints wins and locks those faces. Two winners therefore share no face, so the checks each
+// passed in edge_costs stay true when both collapse.
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> offsets: array<u32>;             // per vertex + 1
+@group(0) @binding(2) var<storage, read> vertex_faces: array<u32>;        // per corner
+@group(0) @binding(3) var<storage, read> edges: array<vec2<u32>>;         // per edge
+@group(0) @binding(4) var<storage, read> edge_offsets: array<u32>;        // per vertex + 1
+@group(0) @binding(5) var<storage, read> candidates: array<EdgeCandidate>; // per edge
+@group(0) @binding(6) var<storage, read> face_best: array<u32>;           // per face
+@group(0) @binding(7) var<storage, read> face_id: array<u32>;             // per face
+@group(0) @binding(8) var<storage, read_write> edge_state: array<u32>;    // per edge
+@group(0) @binding(9) var<storage, read_write> face_lock: array<u32>;     // per face
+@group(0) @binding(10) var<storage, read_write> counters: array<atomic<u32>, 16>;
+
+@compute @workgroup_size(256)
+fn select_win(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let e = gid.x + gid.y * nwg.x * WG;
+    if (e >= edge_offsets[params.vertex_count] || edge_state[e] != STATE_CANDIDATE) {
+        return;
+    }
+    let c = candidates[e];
+    let inv = ~c.cost_bits;
+    let ab = edges[e];
+    for (var s = 0u; s < 2u; s = s + 1u) {
+        let v = ab[s];
+        for (var i = offsets[v]; i < offsets[v + 1u]; i = i + 1u) {
+            let f = vertex_faces[i];
+            if (face_best[f] != inv || face_id[f] != ~tie_rank(e)) { return; }
+        }
+    }
+    edge_state[e] = STATE_WON;
+    for (var s = 0u; s < 2u; s = s + 1u) {
+        let v = ab[s];
+        for (var i = offsets[v]; i < offsets[v + 1u]; i = i + 1u) {
+            face_lock[vertex_faces[i]] = 1u;
+        }
+    }
+    atomicAdd(&counters[C_WINNERS], 1u);
+    atomicAdd(&counters[C_REMOVED], c.faces);
+    atomicMax(&counters[C_MAX_ERR2_BITS], bitcast<u32>(c.pos.w));
+}

@@ -1,0 +1,27 @@
+// Trimming, step 2 (one invocation): the bin where the winners' removals pass the budget and what
+// is left of the budget in it; HIST_BINS when every winner fits.
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> histogram: array<u32>;               // HIST_BINS
+@group(0) @binding(2) var<storage, read_write> counters: array<atomic<u32>, 16>;
+
+@compute @workgroup_size(1)
+fn trim_ceiling() {
+    let budget = params.needed_faces;
+    var bin_out = HIST_BINS;
+    var left = 0u;
+    if (atomicLoad(&counters[C_REMOVED]) > budget) {
+        var cum = 0u;
+        for (var bin = 0u; bin < HIST_BINS; bin = bin + 1u) {
+            let h = histogram[bin];
+            if (cum + h > budget) {
+                bin_out = bin;
+                left = budget - cum;
+                break;
+            }
+            cum = cum + h;
+        }
+    }
+    atomicStore(&counters[C_TRIM_BIN], bin_out);
+    atomicStore(&counters[C_TRIM_BUDGET], left);
+}

@@ -1,0 +1,110 @@
+//! The device: adapter and device through pollster, with the adapter's own limits so that
+//! million-triangle meshes fit, and every buffer checked against them before it is allocated.
+
+use crate::error::{Error, Result};
+use std::sync::{Arc, Mutex};
+
+/// A device and queue the simplifier (and a viewer) use.
+pub struct GpuContext {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub adapter_name: String,
+}
+
+impl GpuContext {
+    /// The first hardware or software adapter wgpu finds (lavapipe counts), with its limits and,
+    /// when it has them, timestamp queries.
+    pub fn new() -> Result<GpuContext> {
+        // Vulkan, Metal, DX12 (WGPU_BACKEND overrides): GL's compute is limited, and probing it
+        // without a display only prints EGL noise.
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = wgpu::Backends::PRIMARY;
+        let instance = wgpu::Instance::new(desc.with_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            ..Default::default()
+        }))
+        .map_err(|e| {
+            Error::Gpu(format!(
+                "no GPU adapter found ({e}); install a Vulkan driver (on Debian without a GPU: \
+                 apt-get install mesa-vulkan-drivers libvulkan1) or use --backend cpu-parallel"
+            ))
+        })?;
+        let info = adapter.get_info();
+        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("meshslim"),
+            required_features: features,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| Error::Gpu(format!("adapter {} refused a device: {e}", info.name)))?;
+        Ok(GpuContext {
+            device,
+            queue,
+            adapter_name: info.name,
+        })
+    }
+}
+
+/// Errors the device reports asynchronously (validation, out of memory, device lost), kept until
+/// the host checks after a submission, instead of wgpu's default panic.
+#[derive(Clone, Default)]
+pub struct ErrorSink(Arc<Mutex<Option<String>>>);
+
+impl ErrorSink {
+    pub fn install(device: &wgpu::Device) -> ErrorSink {
+        let sink = ErrorSink::default();
+        let s = sink.0.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            let mut slot = s.lock().unwrap_or_else(|p| p.into_inner());
+            slot.get_or_insert_with(|| e.to_string());
+        }));
+        sink
+    }
+
+    pub fn check(&self, doing: &str) -> Result<()> {
+        let slot = self.0.lock().unwrap_or_else(|p| p.into_inner()).take();
+        match slot {
+            Some(e) => Err(Error::Gpu(format!("{doing}: {e}"))),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Checks a storage buffer of `size` bytes against the device limits.
+pub fn check_buffer(limits: &wgpu::Limits, label: &str, size: u64) -> Result<()> {
+    let too_big = |limit: u64, which| Error::BufferTooLarge {
+        label: label.to_string(),
+        size,
+        limit,
+        which,
+    };
+    if size > limits.max_buffer_size {
+        return Err(too_big(limits.max_buffer_size, "max_buffer_size"));
+    }
+    if size > limits.max_storage_buffer_binding_size as u64 {
+        return Err(too_big(
+            limits.max_storage_buffer_binding_size as u64,
+            "max_storage_buffer_binding_size",
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn oversized_buffer_names_itself_and_the_limit() {
+        let limits = wgpu::Limits::default();
+        let err = check_buffer(&limits, "meshslim.candidates", 1 << 40).unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            msg.contains("meshslim.candidates") && msg.contains("max_buffer_size"),
+            "{msg}"
+        );
+        assert!(check_buffer(&limits, "meshslim.small", 1024).is_ok());
+    }
+}

@@ -1,0 +1,197 @@
+//! The WGSL stages: each file in shaders/ is one stage (prefix_sum has its three steps), compiled
+//! as shaders/common.wgsl followed by the stage's own source. Tests parse and validate every
+//! stage with naga — no GPU needed — and compare the WGSL structs with their Rust twins.
+
+/// (file stem, entry points, source) of every stage.
+pub const STAGES: &[(&str, &[&str], &str)] = &[
+    (
+        "prefix_sum",
+        &["prefix_sum_reduce", "prefix_sum_spine", "prefix_sum_apply"],
+        include_str!("../../shaders/prefix_sum.wgsl"),
+    ),
+    (
+        "adjacency_count",
+        &["adjacency_count"],
+        include_str!("../../shaders/adjacency_count.wgsl"),
+    ),
+    (
+        "adjacency_fill",
+        &["adjacency_fill"],
+        include_str!("../../shaders/adjacency_fill.wgsl"),
+    ),
+    (
+        "adjacency_sort",
+        &["adjacency_sort"],
+        include_str!("../../shaders/adjacency_sort.wgsl"),
+    ),
+    (
+        "face_planes",
+        &["face_planes"],
+        include_str!("../../shaders/face_planes.wgsl"),
+    ),
+    (
+        "vertex_flags",
+        &["vertex_flags"],
+        include_str!("../../shaders/vertex_flags.wgsl"),
+    ),
+    (
+        "vertex_quadrics",
+        &["vertex_quadrics"],
+        include_str!("../../shaders/vertex_quadrics.wgsl"),
+    ),
+    (
+        "edges_count",
+        &["edges_count"],
+        include_str!("../../shaders/edges_count.wgsl"),
+    ),
+    (
+        "edges_fill",
+        &["edges_fill"],
+        include_str!("../../shaders/edges_fill.wgsl"),
+    ),
+    (
+        "edge_costs",
+        &["edge_costs"],
+        include_str!("../../shaders/edge_costs.wgsl"),
+    ),
+    (
+        "cost_ceiling",
+        &["cost_ceiling"],
+        include_str!("../../shaders/cost_ceiling.wgsl"),
+    ),
+    (
+        "select_cost",
+        &["select_cost"],
+        include_str!("../../shaders/select_cost.wgsl"),
+    ),
+    (
+        "select_id",
+        &["select_id"],
+        include_str!("../../shaders/select_id.wgsl"),
+    ),
+    (
+        "select_win",
+        &["select_win"],
+        include_str!("../../shaders/select_win.wgsl"),
+    ),
+    (
+        "trim_histogram",
+        &["trim_histogram"],
+        include_str!("../../shaders/trim_histogram.wgsl"),
+    ),
+    (
+        "trim_ceiling",
+        &["trim_ceiling"],
+        include_str!("../../shaders/trim_ceiling.wgsl"),
+    ),
+    (
+        "trim_mark",
+        &["trim_mark"],
+        include_str!("../../shaders/trim_mark.wgsl"),
+    ),
+    (
+        "trim_apply",
+        &["trim_apply"],
+        include_str!("../../shaders/trim_apply.wgsl"),
+    ),
+    (
+        "collapse",
+        &["collapse"],
+        include_str!("../../shaders/collapse.wgsl"),
+    ),
+    (
+        "compact_mark",
+        &["compact_mark"],
+        include_str!("../../shaders/compact_mark.wgsl"),
+    ),
+    (
+        "compact_vertices",
+        &["compact_vertices"],
+        include_str!("../../shaders/compact_vertices.wgsl"),
+    ),
+    (
+        "compact_faces",
+        &["compact_faces"],
+        include_str!("../../shaders/compact_faces.wgsl"),
+    ),
+    (
+        "draw_args",
+        &["draw_args"],
+        include_str!("../../shaders/draw_args.wgsl"),
+    ),
+];
+
+pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
+
+/// The full source of a stage: the common definitions, then the stage.
+pub fn source(stage_source: &str) -> String {
+    format!("{COMMON}\n{stage_source}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::types::*;
+
+    fn parse(stem: &str, src: &str) -> naga::Module {
+        let module = naga::front::wgsl::parse_str(&source(src))
+            .unwrap_or_else(|e| panic!("shaders/{stem}.wgsl: {}", e.emit_to_string(&source(src))));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::empty(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("shaders/{stem}.wgsl does not validate: {e:?}"));
+        module
+    }
+
+    #[test]
+    fn every_stage_parses_and_validates() {
+        for (stem, entries, src) in STAGES {
+            let module = parse(stem, src);
+            for e in *entries {
+                assert!(
+                    module.entry_points.iter().any(|ep| ep.name == *e),
+                    "shaders/{stem}.wgsl has no entry point {e}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn every_shader_file_is_a_stage() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let name = entry.unwrap().file_name().into_string().unwrap();
+            let stem = name.trim_end_matches(".wgsl");
+            assert!(
+                stem == "common" || STAGES.iter().any(|s| s.0 == stem),
+                "shaders/{name} is not listed in STAGES"
+            );
+        }
+    }
+
+    #[test]
+    fn wgsl_structs_match_their_rust_twins() {
+        let module = parse(
+            "draw_args",
+            STAGES.iter().find(|s| s.0 == "draw_args").unwrap().2,
+        );
+        let size = |name: &str| {
+            let (_, ty) = module
+                .types
+                .iter()
+                .find(|(_, t)| t.name.as_deref() == Some(name))
+                .unwrap_or_else(|| panic!("no struct {name} in common.wgsl"));
+            ty.inner.size(module.to_ctx()) as usize
+        };
+        use std::mem::size_of;
+        assert_eq!(size("Params"), size_of::<Params>());
+        assert_eq!(size("ScanParams"), size_of::<ScanParams>());
+        assert_eq!(size("Counters"), size_of::<Counters>());
+        assert_eq!(size("Quadric"), size_of::<Quadric>());
+        assert_eq!(size("EdgeCandidate"), size_of::<EdgeCandidate>());
+        assert_eq!(size("FaceExtra"), size_of::<FaceExtra>());
+        assert_eq!(size("DrawArgs"), size_of::<DrawArgs>());
+    }
+}

@@ -1,0 +1,696 @@
+//! The rounds on the GPU: pipelines made once per device ([`GpuSimplifier`]), buffers made once
+//! per mesh ([`GpuMesh`] plus the working buffers), and one command buffer per round whose only
+//! read-back is the 64-byte counters block (and the stage timestamps when the device has them).
+
+use super::context::{ErrorSink, check_buffer};
+use super::shaders::{STAGES, source};
+use super::types::*;
+use crate::error::{Error, Result};
+use crate::parallel::{Download, RoundRunner, StageTimes, Upload};
+use std::collections::HashMap;
+use std::time::Instant;
+use wgpu::util::DeviceExt;
+
+const SU: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
+    .union(wgpu::BufferUsages::COPY_DST)
+    .union(wgpu::BufferUsages::COPY_SRC);
+
+/// Timestamp slots per round: two per compute pass.
+const QUERY_CAP: u32 = 512;
+
+/// Compute pipelines of every stage, made once for a device and reused for every mesh.
+pub struct GpuSimplifier {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    pipelines: HashMap<&'static str, wgpu::ComputePipeline>,
+    /// Seconds spent compiling shaders and creating pipelines.
+    pub pipeline_seconds: f64,
+    timestamps: bool,
+    errors: ErrorSink,
+}
+
+impl GpuSimplifier {
+    /// Compiles every stage on `device`. Borrows the device: a viewer can share it.
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<GpuSimplifier> {
+        let t = Instant::now();
+        let errors = ErrorSink::install(device);
+        let limits = device.limits();
+        if limits.max_storage_buffers_per_shader_stage < 10 {
+            return Err(Error::Gpu(format!(
+                "the device binds at most {} storage buffers per stage; the simplifier needs 10",
+                limits.max_storage_buffers_per_shader_stage
+            )));
+        }
+        let mut pipelines = HashMap::new();
+        for (stem, entries, src) in STAGES {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(stem),
+                source: wgpu::ShaderSource::Wgsl(source(src).into()),
+            });
+            for &entry in *entries {
+                let label = format!("meshslim.{entry}");
+                let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(&label),
+                    layout: None,
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    cache: None,
+                });
+                pipelines.insert(entry, p);
+            }
+        }
+        errors.check("creating the compute pipelines")?;
+        Ok(GpuSimplifier {
+            device: device.clone(),
+            queue: queue.clone(),
+            pipelines,
+            pipeline_seconds: t.elapsed().as_secs_f64(),
+            timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
+            errors,
+        })
+    }
+
+    pub fn has_timestamps(&self) -> bool {
+        self.timestamps
+    }
+}
+
+/// The mesh on the GPU as a renderer draws it: positions (vec4, normalized frame) and u32
+/// indices, usable as STORAGE, VERTEX and INDEX buffers, and indexed indirect draw arguments the
+/// rounds keep current. Positions are in the unit-diagonal frame: world = p / scale + center.
+pub struct GpuMesh {
+    pub positions: wgpu::Buffer,
+    pub indices: wgpu::Buffer,
+    pub draw_args: wgpu::Buffer,
+    pub center: [f64; 3],
+    pub scale: f64,
+}
+
+/// One ping-pong half of the per-vertex and per-face buffers.
+struct Half {
+    positions: wgpu::Buffer,
+    quadrics: wgpu::Buffer,
+    flags: wgpu::Buffer,
+    vertex_attr: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    face_normals: wgpu::Buffer,
+    face_extra: wgpu::Buffer,
+}
+
+/// The working state of one simplification on the GPU.
+pub struct GpuRounds<'a> {
+    sim: &'a GpuSimplifier,
+    half: [Half; 2],
+    cur: usize,
+    draw_args: wgpu::Buffer,
+    params: wgpu::Buffer,
+    scan_v: wgpu::Buffer,
+    scan_f: wgpu::Buffer,
+    scan_e: wgpu::Buffer,
+    offsets: wgpu::Buffer,
+    cursor: wgpu::Buffer,
+    vertex_faces: wgpu::Buffer,
+    edge_offsets: wgpu::Buffer,
+    edges: wgpu::Buffer,
+    candidates: wgpu::Buffer,
+    edge_state: wgpu::Buffer,
+    histogram: wgpu::Buffer,
+    face_best: wgpu::Buffer,
+    face_id: wgpu::Buffer,
+    face_lock: wgpu::Buffer,
+    remap: wgpu::Buffer,
+    vertex_keep: wgpu::Buffer,
+    face_keep: wgpu::Buffer,
+    marks: wgpu::Buffer,
+    block_sums: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
+    /// Stage of each timestamp pair recorded this round.
+    query_stages: Vec<&'static str>,
+    times: StageTimes,
+    selection_passes: u32,
+    /// Upload and download seconds.
+    pub transfer_seconds: f64,
+}
+
+fn wg(n: u32) -> u32 {
+    n.div_ceil(WG).max(1)
+}
+
+impl<'a> GpuRounds<'a> {
+    /// Uploads `up` and allocates every working buffer for its size (they only shrink).
+    pub fn new(
+        sim: &'a GpuSimplifier,
+        up: &Upload,
+        selection_passes: u32,
+    ) -> Result<GpuRounds<'a>> {
+        let t = Instant::now();
+        let dev = &sim.device;
+        let limits = dev.limits();
+        let nv = up.positions.len().max(1) as u64;
+        let nf = up.face_count().max(1) as u64;
+        let cap = 3 * nf;
+        let mk = |label: &str, size: u64, usage: wgpu::BufferUsages| -> Result<wgpu::Buffer> {
+            let label = format!("meshslim.{label}");
+            check_buffer(&limits, &label, size)?;
+            Ok(dev.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(&label),
+                size: size.max(16).next_multiple_of(4),
+                usage,
+                mapped_at_creation: false,
+            }))
+        };
+        let init = |label: &str, data: &[u8], usage: wgpu::BufferUsages| -> Result<wgpu::Buffer> {
+            let label = format!("meshslim.{label}");
+            check_buffer(&limits, &label, data.len() as u64)?;
+            let mut bytes = data.to_vec();
+            bytes.resize(bytes.len().max(16), 0);
+            Ok(dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(&label),
+                contents: &bytes,
+                usage,
+            }))
+        };
+        let mesh_usage = SU | wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::INDEX;
+        let qsize = std::mem::size_of::<Quadric>() as u64;
+        let half0 = Half {
+            positions: init("positions", bytemuck::cast_slice(&up.positions), mesh_usage)?,
+            quadrics: mk("quadrics", nv * qsize, SU)?,
+            flags: init("flags", bytemuck::cast_slice(&up.flags), SU)?,
+            vertex_attr: init("vertex_attr", bytemuck::cast_slice(&up.vertex_attr), SU)?,
+            indices: init("indices", bytemuck::cast_slice(&up.indices), mesh_usage)?,
+            face_normals: mk("face_normals", nf * 16, SU)?,
+            face_extra: init("face_extra", bytemuck::cast_slice(&up.face_extra), SU)?,
+        };
+        let half1 = Half {
+            positions: mk("positions_out", nv * 16, mesh_usage)?,
+            quadrics: mk("quadrics_out", nv * qsize, SU)?,
+            flags: mk("flags_out", nv * 4, SU)?,
+            vertex_attr: mk("vertex_attr_out", nv * 4, SU)?,
+            indices: mk("indices_out", nf * 12, mesh_usage)?,
+            face_normals: mk("face_normals_out", nf * 16, SU)?,
+            face_extra: mk("face_extra_out", nf * 16, SU)?,
+        };
+        let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+        let queries = sim.timestamps.then(|| {
+            let set = dev.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("meshslim.timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: QUERY_CAP,
+            });
+            let resolve = dev.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("meshslim.timestamps_resolve"),
+                size: QUERY_CAP as u64 * 8,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            (set, resolve)
+        });
+        let blocks = (cap + 1)
+            .div_ceil(SCAN_BLOCK as u64)
+            .max(nv.div_ceil(SCAN_BLOCK as u64))
+            + 1;
+        let r = GpuRounds {
+            sim,
+            half: [half0, half1],
+            cur: 0,
+            draw_args: mk(
+                "draw_args",
+                std::mem::size_of::<DrawArgs>() as u64,
+                SU | wgpu::BufferUsages::INDIRECT,
+            )?,
+            params: mk("params", std::mem::size_of::<Params>() as u64, uniform)?,
+            scan_v: mk("scan_v", 16, uniform)?,
+            scan_f: mk("scan_f", 16, uniform)?,
+            scan_e: mk("scan_e", 16, uniform)?,
+            offsets: mk("offsets", (nv + 1) * 4, SU)?,
+            cursor: mk("cursor", nv * 4, SU)?,
+            vertex_faces: mk("vertex_faces", nf * 12, SU)?,
+            edge_offsets: mk("edge_offsets", (nv + 1) * 4, SU)?,
+            edges: mk("edges", cap * 8, SU)?,
+            candidates: mk(
+                "candidates",
+                cap * std::mem::size_of::<EdgeCandidate>() as u64,
+                SU,
+            )?,
+            edge_state: mk("edge_state", cap * 4, SU)?,
+            histogram: mk("histogram", HIST_BINS as u64 * 4, SU)?,
+            face_best: mk("face_best", nf * 4, SU)?,
+            face_id: mk("face_id", nf * 4, SU)?,
+            face_lock: mk("face_lock", nf * 4, SU)?,
+            remap: mk("remap", nv * 4, SU)?,
+            vertex_keep: mk("vertex_keep", (nv + 1) * 4, SU)?,
+            face_keep: mk("face_keep", (nf + 1) * 4, SU)?,
+            marks: mk("marks", (cap + 1) * 4, SU)?,
+            block_sums: mk("block_sums", blocks * 4, SU)?,
+            counters: mk("counters", 64, SU)?,
+            readback: mk(
+                "readback",
+                64 + QUERY_CAP as u64 * 8,
+                wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            )?,
+            queries,
+            query_stages: Vec::new(),
+            times: StageTimes::default(),
+            selection_passes,
+            transfer_seconds: 0.0,
+        };
+        sim.errors.check("uploading the mesh")?;
+        let mut r = r;
+        r.transfer_seconds += t.elapsed().as_secs_f64();
+        Ok(r)
+    }
+
+    /// One compute pass: `entry` with `bindings` in the shader's binding order, over
+    /// `workgroups` workgroups (split over y beyond the per-dimension limit).
+    fn pass(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        entry: &'static str,
+        bindings: &[&wgpu::Buffer],
+        workgroups: u32,
+    ) {
+        let pipeline = &self.sim.pipelines[entry];
+        let layout = pipeline.get_bind_group_layout(0);
+        let entries: Vec<wgpu::BindGroupEntry> = bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        let bg = self
+            .sim
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(entry),
+                layout: &layout,
+                entries: &entries,
+            });
+        let max_x = self
+            .sim
+            .device
+            .limits()
+            .max_compute_workgroups_per_dimension;
+        let (x, y) = if workgroups <= max_x {
+            (workgroups, 1)
+        } else {
+            (max_x, workgroups.div_ceil(max_x))
+        };
+        let qi = self.query_stages.len() as u32 * 2;
+        let timestamp_writes = match &self.queries {
+            Some((set, _)) if qi + 2 <= QUERY_CAP => {
+                self.query_stages.push(entry);
+                Some(wgpu::ComputePassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(qi),
+                    end_of_pass_write_index: Some(qi + 1),
+                })
+            }
+            _ => None,
+        };
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(entry),
+            timestamp_writes,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+
+    /// Exclusive prefix sum of `data` (n + 1 values; `scan` holds n) in three passes.
+    fn prefix_sum(&mut self, enc: &mut wgpu::CommandEncoder, scan: &str, data: &str, n: u32) {
+        let (s, d, b) = (self.buf(scan), self.buf(data), self.block_sums.clone());
+        let blocks = n.div_ceil(SCAN_BLOCK).max(1);
+        self.pass(enc, "prefix_sum_reduce", &[&s, &d, &b], blocks);
+        self.pass(enc, "prefix_sum_spine", &[&s, &d, &b], 1);
+        self.pass(enc, "prefix_sum_apply", &[&s, &d, &b], blocks);
+    }
+
+    fn buf(&self, name: &str) -> wgpu::Buffer {
+        match name {
+            "scan_v" => self.scan_v.clone(),
+            "scan_f" => self.scan_f.clone(),
+            "scan_e" => self.scan_e.clone(),
+            "offsets" => self.offsets.clone(),
+            "edge_offsets" => self.edge_offsets.clone(),
+            "vertex_keep" => self.vertex_keep.clone(),
+            "face_keep" => self.face_keep.clone(),
+            "marks" => self.marks.clone(),
+            _ => unreachable!("no scan buffer {name}"),
+        }
+    }
+
+    /// The mesh as it stands (after the last round), for a renderer.
+    pub fn into_mesh(self, up: &Upload) -> Result<GpuMesh> {
+        let h = &self.half[self.cur];
+        let (positions, indices) = if self.cur == 0 {
+            (h.positions.clone(), h.indices.clone())
+        } else {
+            // The result lives in the second half: copy it into the first, the GpuMesh's own.
+            let mut enc = self.sim.device.create_command_encoder(&Default::default());
+            let h0 = &self.half[0];
+            enc.copy_buffer_to_buffer(
+                &h.positions,
+                0,
+                &h0.positions,
+                0,
+                h.positions.size().min(h0.positions.size()),
+            );
+            enc.copy_buffer_to_buffer(
+                &h.indices,
+                0,
+                &h0.indices,
+                0,
+                h.indices.size().min(h0.indices.size()),
+            );
+            self.sim.queue.submit([enc.finish()]);
+            (h0.positions.clone(), h0.indices.clone())
+        };
+        Ok(GpuMesh {
+            positions,
+            indices,
+            draw_args: self.draw_args.clone(),
+            center: up.center,
+            scale: up.scale,
+        })
+    }
+
+    fn read(&self, src: &wgpu::Buffer, bytes: u64) -> Result<Vec<u8>> {
+        let dev = &self.sim.device;
+        let size = bytes.max(4).next_multiple_of(4);
+        let staging = dev.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("meshslim.download"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = dev.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+        self.sim.queue.submit([enc.finish()]);
+        map_wait(dev, &staging)?;
+        let data = staging
+            .get_mapped_range(..)
+            .map_err(|e| Error::Gpu(format!("reading back: {e}")))?[..bytes as usize]
+            .to_vec();
+        staging.unmap();
+        Ok(data)
+    }
+}
+
+/// Maps `buf` for reading and waits for it.
+fn map_wait(dev: &wgpu::Device, buf: &wgpu::Buffer) -> Result<()> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    buf.map_async(wgpu::MapMode::Read, .., move |r| {
+        let _ = tx.send(r);
+    });
+    dev.poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| Error::Gpu(format!("waiting for the device: {e}")))?;
+    rx.recv()
+        .map_err(|_| Error::Gpu("the device dropped a read-back".into()))?
+        .map_err(|e| Error::Gpu(format!("mapping a read-back buffer: {e}")))
+}
+
+impl RoundRunner for GpuRounds<'_> {
+    fn round(&mut self, p: &Params, first: bool) -> Result<Counters> {
+        let sim = self.sim;
+        let (q, dev) = (&sim.queue, &sim.device);
+        q.write_buffer(&self.params, 0, bytemuck::bytes_of(p));
+        let sp = |n: u32| ScanParams { n, _pad: [0; 3] };
+        q.write_buffer(&self.scan_v, 0, bytemuck::bytes_of(&sp(p.vertex_count)));
+        q.write_buffer(&self.scan_f, 0, bytemuck::bytes_of(&sp(p.face_count)));
+        q.write_buffer(&self.scan_e, 0, bytemuck::bytes_of(&sp(p.edge_capacity)));
+        self.query_stages.clear();
+        let mut enc = dev.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("meshslim.round"),
+        });
+        let (nv, nf, cap) = (p.vertex_count, p.face_count, p.edge_capacity);
+        let (h, o) = (self.cur, 1 - self.cur);
+        let hp = |s: &Self| {
+            let x = &s.half[h];
+            (
+                x.positions.clone(),
+                x.quadrics.clone(),
+                x.flags.clone(),
+                x.vertex_attr.clone(),
+                x.indices.clone(),
+                x.face_normals.clone(),
+                x.face_extra.clone(),
+            )
+        };
+        let (pos, quad, flags, vattr, idx, fnorm, fextra) = hp(self);
+        let out = &self.half[o];
+        let (pos_o, quad_o, flags_o, vattr_o, idx_o, fnorm_o, fextra_o) = (
+            out.positions.clone(),
+            out.quadrics.clone(),
+            out.flags.clone(),
+            out.vertex_attr.clone(),
+            out.indices.clone(),
+            out.face_normals.clone(),
+            out.face_extra.clone(),
+        );
+        let c = |b: &wgpu::Buffer| b.clone();
+        let (params, counters, offsets, cursor, vf) = (
+            c(&self.params),
+            c(&self.counters),
+            c(&self.offsets),
+            c(&self.cursor),
+            c(&self.vertex_faces),
+        );
+        let (eoff, edges, cand, est, hist) = (
+            c(&self.edge_offsets),
+            c(&self.edges),
+            c(&self.candidates),
+            c(&self.edge_state),
+            c(&self.histogram),
+        );
+        let (fbest, fid, flock, remap, vkeep, fkeep, marks) = (
+            c(&self.face_best),
+            c(&self.face_id),
+            c(&self.face_lock),
+            c(&self.remap),
+            c(&self.vertex_keep),
+            c(&self.face_keep),
+            c(&self.marks),
+        );
+        let draw = c(&self.draw_args);
+
+        enc.clear_buffer(&counters, 0, None);
+        enc.clear_buffer(&offsets, 0, None);
+        enc.clear_buffer(&cursor, 0, None);
+        self.pass(
+            &mut enc,
+            "adjacency_count",
+            &[&params, &idx, &offsets],
+            wg(nf),
+        );
+        self.prefix_sum(&mut enc, "scan_v", "offsets", nv);
+        self.pass(
+            &mut enc,
+            "adjacency_fill",
+            &[&params, &idx, &offsets, &cursor, &vf],
+            wg(nf),
+        );
+        self.pass(
+            &mut enc,
+            "adjacency_sort",
+            &[&params, &offsets, &vf],
+            wg(nv),
+        );
+        if first {
+            self.pass(
+                &mut enc,
+                "face_planes",
+                &[&params, &pos, &idx, &fnorm],
+                wg(nf),
+            );
+            self.pass(
+                &mut enc,
+                "vertex_flags",
+                &[&params, &idx, &offsets, &vf, &flags],
+                wg(nv),
+            );
+            self.pass(
+                &mut enc,
+                "vertex_quadrics",
+                &[&params, &pos, &idx, &offsets, &vf, &fnorm, &quad],
+                wg(nv),
+            );
+        }
+        self.pass(
+            &mut enc,
+            "edges_count",
+            &[&params, &idx, &offsets, &vf, &eoff, &remap],
+            wg(nv),
+        );
+        self.prefix_sum(&mut enc, "scan_v", "edge_offsets", nv);
+        self.pass(
+            &mut enc,
+            "edges_fill",
+            &[&params, &idx, &offsets, &vf, &eoff, &edges],
+            wg(nv),
+        );
+        enc.clear_buffer(&hist, 0, None);
+        self.pass(
+            &mut enc,
+            "edge_costs",
+            &[
+                &params, &pos, &quad, &flags, &idx, &offsets, &vf, &fnorm, &edges, &eoff, &cand,
+                &est, &hist, &counters,
+            ],
+            wg(cap),
+        );
+        self.pass(&mut enc, "cost_ceiling", &[&params, &hist, &counters], 1);
+        enc.clear_buffer(&flock, 0, None);
+        for _ in 0..self.selection_passes {
+            enc.clear_buffer(&fbest, 0, None);
+            enc.clear_buffer(&fid, 0, None);
+            self.pass(
+                &mut enc,
+                "select_cost",
+                &[
+                    &params, &offsets, &vf, &edges, &eoff, &cand, &flock, &counters, &est, &fbest,
+                ],
+                wg(cap),
+            );
+            self.pass(
+                &mut enc,
+                "select_id",
+                &[
+                    &params, &offsets, &vf, &edges, &eoff, &cand, &fbest, &est, &fid,
+                ],
+                wg(cap),
+            );
+            self.pass(
+                &mut enc,
+                "select_win",
+                &[
+                    &params, &offsets, &vf, &edges, &eoff, &cand, &fbest, &fid, &est, &flock,
+                    &counters,
+                ],
+                wg(cap),
+            );
+        }
+        if p.trim != 0 {
+            enc.clear_buffer(&hist, 0, None);
+            self.pass(
+                &mut enc,
+                "trim_histogram",
+                &[&params, &cand, &est, &eoff, &hist],
+                wg(cap),
+            );
+            self.pass(&mut enc, "trim_ceiling", &[&params, &hist, &counters], 1);
+            self.pass(
+                &mut enc,
+                "trim_mark",
+                &[&params, &cand, &est, &eoff, &counters, &marks],
+                wg(cap),
+            );
+            self.prefix_sum(&mut enc, "scan_e", "marks", cap);
+            self.pass(
+                &mut enc,
+                "trim_apply",
+                &[&params, &cand, &marks, &counters, &eoff, &est],
+                wg(cap),
+            );
+        }
+        self.pass(
+            &mut enc,
+            "collapse",
+            &[&params, &cand, &est, &eoff, &pos, &quad, &flags, &remap],
+            wg(cap),
+        );
+        self.pass(
+            &mut enc,
+            "compact_mark",
+            &[&params, &idx, &remap, &vkeep, &fkeep],
+            wg(nv.max(nf)),
+        );
+        self.prefix_sum(&mut enc, "scan_v", "vertex_keep", nv);
+        self.prefix_sum(&mut enc, "scan_f", "face_keep", nf);
+        self.pass(
+            &mut enc,
+            "compact_vertices",
+            &[
+                &params, &vkeep, &pos, &quad, &flags, &vattr, &pos_o, &quad_o, &flags_o, &vattr_o,
+            ],
+            wg(nv),
+        );
+        self.pass(
+            &mut enc,
+            "compact_faces",
+            &[
+                &params, &idx, &fnorm, &fextra, &remap, &vkeep, &fkeep, &idx_o, &fnorm_o, &fextra_o,
+            ],
+            wg(nf),
+        );
+        self.pass(
+            &mut enc,
+            "draw_args",
+            &[&params, &vkeep, &fkeep, &counters, &draw],
+            1,
+        );
+
+        enc.copy_buffer_to_buffer(&counters, 0, &self.readback, 0, 64);
+        let used = self.query_stages.len() as u32 * 2;
+        if let Some((set, resolve)) = &self.queries {
+            if used > 0 {
+                enc.resolve_query_set(set, 0..used, resolve, 0);
+                enc.copy_buffer_to_buffer(resolve, 0, &self.readback, 64, used as u64 * 8);
+            }
+        }
+        let t = Instant::now();
+        q.submit([enc.finish()]);
+        map_wait(dev, &self.readback)?;
+        let wall = t.elapsed().as_secs_f64();
+        let (counters_out, stamps) = {
+            let view = self
+                .readback
+                .get_mapped_range(..)
+                .map_err(|e| Error::Gpu(format!("reading the round counters: {e}")))?;
+            let c: Counters = *bytemuck::from_bytes(&view[..64]);
+            let stamps: Vec<u64> =
+                bytemuck::cast_slice::<u8, u64>(&view[64..64 + used as usize * 8]).to_vec();
+            (c, stamps)
+        };
+        self.readback.unmap();
+        sim.errors.check("running a round")?;
+        if self.queries.is_some() && !stamps.is_empty() {
+            let period = q.get_timestamp_period() as f64 * 1e-9;
+            for (i, stage) in self.query_stages.iter().enumerate() {
+                let d = stamps[2 * i + 1].saturating_sub(stamps[2 * i]);
+                self.times.add(stage, d as f64 * period);
+            }
+        } else {
+            self.times.add("round (wall, no timestamps)", wall);
+        }
+        self.cur = o;
+        Ok(counters_out)
+    }
+
+    fn download(&mut self) -> Result<Download> {
+        let t = Instant::now();
+        // Counts from the last round's draw arguments (the buffers are sized for the input).
+        let args: DrawArgs = *bytemuck::from_bytes(&self.read(&self.draw_args, 20)?);
+        let nf = (args.index_count / 3) as u64;
+        let vk = self.read(&self.counters, 64)?;
+        let nv = bytemuck::from_bytes::<Counters>(&vk).vertices_out as u64;
+        let h = &self.half[self.cur];
+        let d = Download {
+            positions: bytemuck::pod_collect_to_vec(&self.read(&h.positions, nv * 16)?),
+            flags: bytemuck::pod_collect_to_vec(&self.read(&h.flags, nv * 4)?),
+            vertex_attr: bytemuck::pod_collect_to_vec(&self.read(&h.vertex_attr, nv * 4)?),
+            indices: bytemuck::pod_collect_to_vec(&self.read(&h.indices, nf * 12)?),
+            face_extra: bytemuck::pod_collect_to_vec(&self.read(&h.face_extra, nf * 16)?),
+        };
+        self.transfer_seconds += t.elapsed().as_secs_f64();
+        Ok(d)
+    }
+
+    fn stage_times(&self) -> &StageTimes {
+        &self.times
+    }
+}
