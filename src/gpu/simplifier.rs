@@ -379,6 +379,37 @@ impl<'a> GpuRounds<'a> {
         })
     }
 
+    /// The first `bytes` of a working buffer, by its WGSL variable name (the buffers of the
+    /// current half for per-vertex and per-face data): what tests diff against the CPU twin.
+    pub fn read_buffer(&self, name: &str, bytes: u64) -> Result<Vec<u8>> {
+        let h = &self.half[self.cur];
+        let other = &self.half[1 - self.cur];
+        let b = match name {
+            "positions" => &h.positions,
+            "quadrics" => &h.quadrics,
+            "flags" => &h.flags,
+            "indices" => &h.indices,
+            "face_normals" => &h.face_normals,
+            // The buffers the last round compacted from.
+            "positions_before" => &other.positions,
+            "quadrics_before" => &other.quadrics,
+            "flags_before" => &other.flags,
+            "face_normals_before" => &other.face_normals,
+            "offsets" => &self.offsets,
+            "vertex_faces" => &self.vertex_faces,
+            "edge_offsets" => &self.edge_offsets,
+            "edges" => &self.edges,
+            "candidates" => &self.candidates,
+            "edge_state" => &self.edge_state,
+            "remap" => &self.remap,
+            "vertex_keep" => &self.vertex_keep,
+            "face_keep" => &self.face_keep,
+            "draw_args" => &self.draw_args,
+            _ => return Err(Error::Internal(format!("no GPU buffer named {name}"))),
+        };
+        self.read(b, bytes)
+    }
+
     fn read(&self, src: &wgpu::Buffer, bytes: u64) -> Result<Vec<u8>> {
         let dev = &self.sim.device;
         let size = bytes.max(4).next_multiple_of(4);
