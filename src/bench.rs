@@ -168,6 +168,20 @@ pub static BACKENDS: &[BenchBackend] = &[
         device: cpu_name,
     },
     BenchBackend {
+        name: "cpu-parallel",
+        about: "meshslim's GPU rounds run on the CPU's cores (rayon)",
+        simplify: |m, faces| {
+            Ok(crate::simplify(m, &with_backend(faces, crate::Backend::CpuParallel))?.0)
+        },
+        device: cpu_name,
+    },
+    BenchBackend {
+        name: "gpu",
+        about: "meshslim's rounds as WGSL compute passes (wgpu)",
+        simplify: |m, faces| Ok(crate::simplify(m, &with_backend(faces, crate::Backend::Gpu))?.0),
+        device: gpu_name,
+    },
+    BenchBackend {
         name: "meshopt",
         about: "meshoptimizer's simplify (quadric edge collapse)",
         simplify: |m, faces| Ok(meshopt_simplify(m, faces)),
@@ -180,6 +194,22 @@ pub static BACKENDS: &[BenchBackend] = &[
         device: cpu_name,
     },
 ];
+
+fn with_backend(faces: usize, backend: crate::Backend) -> SimplifyOptions {
+    let mut o = SimplifyOptions::with_faces(faces);
+    o.backend = backend;
+    o
+}
+
+/// The GPU adapter's name, or why there is none.
+pub fn gpu_name() -> String {
+    static NAME: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    NAME.get_or_init(|| match crate::gpu::shared() {
+        Ok((c, _)) => c.adapter_name.clone(),
+        Err(e) => format!("no GPU ({e})"),
+    })
+    .clone()
+}
 
 /// The backend called `name` in [`BACKENDS`].
 pub fn backend(name: &str) -> Option<&'static BenchBackend> {

@@ -318,29 +318,30 @@ fn parse_bench_backend(
     })
 }
 
-/// Declares [`BackendArg`] and its mapping to [`Backend`]: a new backend is one line here (with
-/// its doc comment, which becomes its `--help` text), named as the library's variant.
-macro_rules! backend_args {
-    ($($(#[doc = $doc:literal])* $variant:ident),* $(,)?) => {
-        /// The `--backend` choices.
-        #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-        pub enum BackendArg {
-            $($(#[doc = $doc])* $variant,)*
-        }
-
-        impl From<BackendArg> for Backend {
-            fn from(b: BackendArg) -> Backend {
-                match b {
-                    $(BackendArg::$variant => Backend::$variant,)*
-                }
-            }
-        }
-    };
-}
-
-backend_args! {
+/// The `--backend` choices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BackendArg {
     /// Greedy quadric edge collapse with a priority queue, in f64: the quality reference
     Cpu,
+    /// The GPU's rounds of parallel collapses, on the CPU's cores (rayon)
+    CpuParallel,
+    /// Rounds of parallel collapses as WGSL compute passes (wgpu: Vulkan, Metal, DX12)
+    Gpu,
+    /// gpu when an adapter is found, else cpu-parallel (says which on stderr); falls back to
+    /// cpu-parallel when the GPU fails (a lost device, a mesh too big for it)
+    Auto,
+}
+
+impl BackendArg {
+    /// The library backend, `None` for `auto` (decided when the mesh is there).
+    fn fixed(self) -> Option<Backend> {
+        match self {
+            BackendArg::Cpu => Some(Backend::Cpu),
+            BackendArg::CpuParallel => Some(Backend::CpuParallel),
+            BackendArg::Gpu => Some(Backend::Gpu),
+            BackendArg::Auto => None,
+        }
+    }
 }
 
 fn parse_input_arg(s: &str) -> std::result::Result<Input, String> {
@@ -675,14 +676,47 @@ fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     opts.border_weight = args.border_weight;
     opts.max_normal_angle_deg = args.max_normal_angle;
     opts.quality_threshold = args.quality_threshold;
-    opts.backend = args.backend.into();
+    let say = |msg: String| {
+        if !args.quiet {
+            eprintln!("{msg}");
+        }
+    };
+    opts.backend = match args.backend.fixed() {
+        Some(b) => b,
+        None => match crate::gpu::GpuContext::new() {
+            Ok(ctx) => {
+                say(format!("backend auto: gpu on {}", ctx.adapter_name));
+                Backend::Gpu
+            }
+            Err(e) => {
+                say(format!("backend auto: cpu-parallel ({e})"));
+                Backend::CpuParallel
+            }
+        },
+    };
 
     let t = Instant::now();
-    let (simplified, report) = progress
-        .bar("simplifying", |set| {
+    let mut result = progress.bar("simplifying", |set| {
+        crate::simplify_with_progress(&mesh, &opts, &mut |f| set(f))
+    });
+    if args.backend == BackendArg::Auto
+        && opts.backend == Backend::Gpu
+        && matches!(
+            result,
+            Err(crate::Error::Gpu(_) | crate::Error::BufferTooLarge { .. })
+        )
+    {
+        if let Err(e) = &result {
+            say(format!(
+                "backend auto: the GPU failed ({e}); falling back to cpu-parallel"
+            ));
+        }
+        opts.backend = Backend::CpuParallel;
+        result = progress.bar("simplifying", |set| {
             crate::simplify_with_progress(&mesh, &opts, &mut |f| set(f))
-        })
-        .map_err(lib)?;
+        });
+    }
+    let (simplified, report) = result.map_err(lib)?;
     let simplify_s = t.elapsed().as_secs_f64();
     drop(mesh);
 
@@ -735,6 +769,7 @@ fn simplify_json(input: &Input, output: &Path, r: &SimplifyReport, t: &Times) ->
         "pinned_vertices": r.pinned_vertices,
         "dropped_degenerate_faces": r.dropped_degenerate_faces,
         "seconds": { "load": t.load, "simplify": t.simplify, "save": t.save },
+        "rounds": r.rounds,
     })
 }
 
@@ -803,6 +838,45 @@ fn write_summary(
             "max collapse error  {:.3e} of the bounding-box diagonal",
             r.max_collapse_error
         )?;
+        if let Some(rr) = &r.rounds {
+            write_rounds(out, rr)?;
+        }
+    }
+    Ok(())
+}
+
+/// The round-based backends' statistics: adapter, rounds, removals, time per stage.
+fn write_rounds(out: &mut impl Write, rr: &crate::parallel::RoundsReport) -> std::io::Result<()> {
+    if let Some(a) = &rr.adapter {
+        writeln!(out, "adapter             {a}")?;
+        writeln!(
+            out,
+            "pipelines           {:.3} s to compile shaders and create pipelines (not in the \
+             stage times); upload + download {:.3} s",
+            rr.pipeline_seconds, rr.transfer_seconds
+        )?;
+    }
+    let removed = &rr.faces_removed_per_round;
+    writeln!(out, "rounds              {}", rr.rounds)?;
+    let list: Vec<String> = removed.iter().map(|n| n.to_string()).collect();
+    writeln!(out, "faces removed/round {}", list.join(" "))?;
+    let kind = if rr.adapter.is_none() {
+        "CPU time"
+    } else if rr.gpu_timestamps {
+        "GPU time (timestamp queries)"
+    } else {
+        "wall time per round (the device has no timestamp queries)"
+    };
+    let total = rr.stage_seconds.total();
+    writeln!(out, "stage times         {kind}, {total:.3} s in all")?;
+    let mut stages = rr.stage_seconds.0.clone();
+    stages.sort_by(|a, b| b.1.total_cmp(&a.1));
+    for (s, t) in &stages {
+        let share = if total > 0.0 { 100.0 * t / total } else { 0.0 };
+        writeln!(out, "  {s:<20} {t:>9.4} s {share:>5.1}%")?;
+    }
+    if let Some((s, _)) = rr.stage_seconds.slowest() {
+        writeln!(out, "slowest stage       {s}")?;
     }
     Ok(())
 }
@@ -999,7 +1073,16 @@ fn run_bench(args: BenchArgs) -> Result<ExitCode> {
     let opts = crate::bench::BenchOptions {
         ratios: args.ratios,
         backends: if args.backends.is_empty() {
-            crate::bench::BACKENDS.iter().collect()
+            // Every backend; gpu only where there is an adapter (named with --backends gpu, a
+            // missing adapter is an error instead).
+            let gpu = crate::gpu::shared().is_ok();
+            if !gpu {
+                eprintln!("note: no GPU adapter; the gpu backend is left out");
+            }
+            crate::bench::BACKENDS
+                .iter()
+                .filter(|b| gpu || b.name != "gpu")
+                .collect()
         } else {
             args.backends
         },

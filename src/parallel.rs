@@ -137,8 +137,8 @@ impl Upload {
         let mut attr_count = vec![0u32; nclass];
         let mut seen_attr = vec![false; welded.positions.len()];
         for (_, c, x) in &faces {
-            for k in 0..3 {
-                let (cl, a) = (c[k] as usize, x.attr[k]);
+            for (&cl, &a) in c.iter().zip(&x.attr) {
+                let cl = cl as usize;
                 if !seen_attr[a as usize] {
                     seen_attr[a as usize] = true;
                     attr_count[cl] += 1;

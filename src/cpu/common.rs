@@ -128,7 +128,9 @@ pub fn quadric_optimum(q: &Quadric) -> Option<V3> {
     let c02 = a01 * a12 - a02 * a11;
     let det = a00 * c00 + a01 * c01 + a02 * c02;
     let tr = a00 + a11 + a22;
-    if !(tr > 0.0) || !(det.abs() > 1e-6 * tr * tr * tr) {
+    // Written so that NaN fails too.
+    let conditioned = tr > 0.0 && det.abs() > 1e-6 * tr * tr * tr;
+    if !conditioned {
         return None;
     }
     let c11 = a00 * a22 - a02 * a02;

@@ -151,7 +151,7 @@ pub fn evaluate(
             let n_old = cross(sub(old[1], old[0]), sub(old[2], old[0]));
             let n_new = cross(sub(new[1], new[0]), sub(new[2], new[0]));
             let (l_old, l_new) = (length(n_old), length(n_new));
-            if !(l_new > 0.0) {
+            if l_new.is_nan() || l_new <= 0.0 {
                 return Verdict::Invalid;
             }
             if l_old > 0.0 && dot(n_old, n_new) < params.cos_max_angle * l_old * l_new {

@@ -110,6 +110,7 @@ impl<'a, T: Copy> Scatter<'a, T> {
     /// # Safety
     /// No other invocation touches `lo..hi` during the stage.
     #[inline]
+    #[allow(clippy::mut_from_ref)] // the point of a scatter: disjoint writes through a shared view
     pub unsafe fn range_mut(&self, lo: usize, hi: usize) -> &mut [T] {
         assert!(
             lo <= hi && hi <= self.len,

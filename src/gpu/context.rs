@@ -83,9 +83,9 @@ pub fn check_buffer(limits: &wgpu::Limits, label: &str, size: u64) -> Result<()>
     if size > limits.max_buffer_size {
         return Err(too_big(limits.max_buffer_size, "max_buffer_size"));
     }
-    if size > limits.max_storage_buffer_binding_size as u64 {
+    if size > limits.max_storage_buffer_binding_size {
         return Err(too_big(
-            limits.max_storage_buffer_binding_size as u64,
+            limits.max_storage_buffer_binding_size,
             "max_storage_buffer_binding_size",
         ));
     }

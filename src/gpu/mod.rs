@@ -14,16 +14,41 @@ use crate::mesh::Mesh;
 use crate::parallel::{RoundsReport, SELECTION_PASSES, Upload, simplify_rounds};
 use crate::simplify::{SimplifyOptions, SimplifyReport};
 
-/// Simplifies on the first GPU adapter found.
+/// Simplifies on the first GPU adapter found, made ready once per process ([`shared`]).
 pub fn simplify_gpu(
     mesh: &Mesh,
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
-    let ctx = GpuContext::new()?;
-    let sim = GpuSimplifier::new(&ctx.device, &ctx.queue)?;
+    let (ctx, sim) = shared()?;
+    simplify_with(ctx, sim, mesh, opts, progress)
+}
+
+/// The process's device and compiled pipelines, made on first use: later calls (the benchmark's
+/// repeats) do not pay for adapter discovery and shader compilation again.
+pub fn shared() -> Result<&'static (GpuContext, GpuSimplifier)> {
+    static SHARED: std::sync::OnceLock<std::result::Result<(GpuContext, GpuSimplifier), String>> =
+        std::sync::OnceLock::new();
+    SHARED
+        .get_or_init(|| {
+            let ctx = GpuContext::new().map_err(|e| e.to_string())?;
+            let sim = GpuSimplifier::new(&ctx.device, &ctx.queue).map_err(|e| e.to_string())?;
+            Ok((ctx, sim))
+        })
+        .as_ref()
+        .map_err(|e| crate::Error::Gpu(e.trim_start_matches("GPU: ").to_string()))
+}
+
+/// Simplifies with pipelines already made on `ctx`'s device.
+pub fn simplify_with(
+    ctx: &GpuContext,
+    sim: &GpuSimplifier,
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport)> {
     let up = Upload::new(mesh);
-    let mut rounds = GpuRounds::new(&sim, &up, SELECTION_PASSES)?;
+    let mut rounds = GpuRounds::new(sim, &up, SELECTION_PASSES)?;
     let report = RoundsReport {
         adapter: Some(ctx.adapter_name.clone()),
         gpu_timestamps: sim.has_timestamps(),
