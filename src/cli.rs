@@ -1075,14 +1075,11 @@ fn run_bench(args: BenchArgs) -> Result<ExitCode> {
         backends: if args.backends.is_empty() {
             // Every backend; gpu only where there is an adapter (named with --backends gpu, a
             // missing adapter is an error instead).
-            let gpu = crate::gpu::shared().is_ok();
-            if !gpu {
+            let all = crate::bench::available_backends();
+            if all.len() < crate::bench::BACKENDS.len() {
                 eprintln!("note: no GPU adapter; the gpu backend is left out");
             }
-            crate::bench::BACKENDS
-                .iter()
-                .filter(|b| gpu || b.name != "gpu")
-                .collect()
+            all
         } else {
             args.backends
         },
