@@ -448,3 +448,39 @@ fn compare_prints_a_table_and_names_a_missing_file() {
     );
     expect_code(&o, 2);
 }
+
+#[test]
+fn round_backends_report_rounds_and_stages() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = meshslim(
+        &[
+            "simplify",
+            SMALL_SPHERE,
+            "out.ply",
+            "--backend",
+            "cpu-parallel",
+            "--json",
+        ],
+        dir.path(),
+    );
+    expect_code(&o, 0);
+    let v = json(&o);
+    assert_eq!(v["backend"], "cpu-parallel");
+    assert!(v["rounds"]["rounds"].as_u64().unwrap() >= 1);
+    assert!(v["rounds"]["stage_seconds"].as_array().unwrap().len() > 5);
+    // auto says which backend it took, on stderr.
+    let o = meshslim(
+        &[
+            "simplify",
+            SMALL_SPHERE,
+            "out2.ply",
+            "--backend",
+            "auto",
+            "--stats",
+        ],
+        dir.path(),
+    );
+    expect_code(&o, 0);
+    assert!(stderr(&o).contains("backend auto:"), "{}", stderr(&o));
+    assert!(stdout(&o).contains("rounds"), "{}", stdout(&o));
+}

@@ -59,3 +59,82 @@ fn tetrahedron_is_stuck() {
     assert_eq!(report.stop_reason, StopReason::NoValidCollapse);
     assert_eq!(report.collapses, 0);
 }
+
+#[test]
+fn max_error_stops_before_the_target() {
+    let m = meshslim::mesh::noisy_sphere(4, 0.02, 1);
+    let mut o = SimplifyOptions::with_faces(20);
+    o.backend = Backend::CpuParallel;
+    o.max_error = Some(1e-3);
+    let (out, report) = simplify(&m, &o).unwrap();
+    assert_eq!(report.stop_reason, StopReason::MaxError, "{report:?}");
+    assert!(out.triangles.len() > 20);
+    assert!(
+        report.max_collapse_error <= 1e-3,
+        "{}",
+        report.max_collapse_error
+    );
+}
+
+/// A UV seam (the same position with two UVs) is kept whole: its vertices are frozen, the rest
+/// simplifies, and every output corner keeps a UV of the input.
+#[test]
+fn seams_are_kept_and_attributes_follow() {
+    let mut m = meshslim::mesh::grid(20);
+    // UV = (x, y), except vertices right of the middle column take u + 1: a seam at x = 0.5.
+    let n = m.positions.len();
+    let mut uvs: Vec<[f32; 2]> = m.positions.iter().map(|p| [p[0], p[1]]).collect();
+    for t in m.triangles.iter_mut() {
+        if t.iter().all(|&v| m.positions[v as usize][0] >= 0.5) {
+            for v in t.iter_mut() {
+                let p = m.positions[*v as usize];
+                m.positions.push(p);
+                uvs.push([p[0] + 1.0, p[1]]);
+                *v = (m.positions.len() - 1) as u32;
+            }
+        }
+    }
+    assert!(m.positions.len() > n);
+    m.uvs = Some(uvs);
+    let (out, report) = simplify(&m, &opts(m.triangles.len(), 0.2)).unwrap();
+    assert!(out.triangles.len() < m.triangles.len() / 2, "{report:?}");
+    let uvs = out.uvs.as_ref().expect("UVs kept");
+    // Faces right of the seam keep u >= 1.5 - so no face mixes the two sides' UVs.
+    for t in &out.triangles {
+        let right = t.iter().filter(|&&v| uvs[v as usize][0] >= 1.5).count();
+        let left = t
+            .iter()
+            .filter(|&&v| uvs[v as usize][0] < 0.5 + 1e-6)
+            .count();
+        assert!(right == 0 || left == 0, "a face straddles the seam: {t:?}");
+    }
+    assert!(report.pinned_vertices > 0);
+}
+
+#[test]
+fn shared_models_keep_their_invariants() {
+    let Some(dir) = shared_models() else {
+        println!("note: ../shared/models not found; skipping the real-scan checks");
+        return;
+    };
+    for name in [
+        "fandisk.obj",
+        "suzanne.obj",
+        "teapot.obj",
+        "spot/spot_triangulated.obj",
+        "stanford-bunny.obj",
+        "horse.ply",
+        "igea.ply",
+    ] {
+        let m = meshslim::io::read(&dir.join(name)).unwrap();
+        for ratio in [0.1, 0.01] {
+            let (out, report) = simplify(&m, &opts(m.triangles.len(), ratio)).unwrap();
+            check_invariants(
+                &format!("cpu-parallel {name} at {ratio}"),
+                &m,
+                &out,
+                &report,
+            );
+        }
+    }
+}
