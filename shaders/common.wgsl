@@ -15,6 +15,7 @@ const FLAG_MOVED: u32 = 8u;
 const STATE_OUT: u32 = 0u;
 const STATE_CANDIDATE: u32 = 1u;
 const STATE_WON: u32 = 2u;
+const STATE_TENTATIVE: u32 = 3u;
 
 struct Params {
     vertex_count: u32,

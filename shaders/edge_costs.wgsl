@@ -1,6 +1,6 @@
-// Per edge: the collapse position and cost, with the greedy reference's validity rules (link
-// condition, no border pinch, no lone triangle, no tetrahedral fold, no flipped or needle face,
-// pinned and frozen vertices), and the cost histogram. Relies on the current CSR face lists.
+// Per edge: the collapse position, quadric error, flip and needle checks of the faces that move,
+// the quality-scaled priority, and the cost histogram; the topological checks wait for validate.
+// Relies on the current CSR face lists.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;        // per vertex
@@ -25,20 +25,7 @@ fn has(t: vec3<u32>, u: u32) -> bool {
     return t.x == u || t.y == u || t.z == u;
 }
 
-fn list_has(lo: u32, hi: u32, u: u32) -> bool {
-    for (var i = lo; i < hi; i = i + 1u) {
-        if (has(face_of(vertex_faces[i]), u)) { return true; }
-    }
-    return false;
-}
 
-fn count_containing(lo: u32, hi: u32, u: u32) -> u32 {
-    var n = 0u;
-    for (var i = lo; i < hi; i = i + 1u) {
-        if (has(face_of(vertex_faces[i]), u)) { n = n + 1u; }
-    }
-    return n;
-}
 
 const VERDICT_INVALID: u32 = 0u;
 const VERDICT_OVER: u32 = 1u;
@@ -60,47 +47,6 @@ fn evaluate(a: u32, b: u32) -> Verdict {
     let pin_a = (fla & FLAG_PINNED) != 0u;
     let pin_b = (flb & FLAG_PINNED) != 0u;
     if (pin_a && pin_b) { return invalid(); }
-    let alo = offsets[a];
-    let ahi = offsets[a + 1u];
-    let blo = offsets[b];
-    let bhi = offsets[b + 1u];
-
-    var edge_faces = 0u;
-    var opp = vec2<u32>(0xffffffffu, 0xffffffffu);
-    for (var i = alo; i < ahi; i = i + 1u) {
-        let t = face_of(vertex_faces[i]);
-        if (has(t, b)) {
-            if (edge_faces == 2u) { return invalid(); }
-            var o = a;
-            for (var k = 0u; k < 3u; k = k + 1u) {
-                if (t[k] != a && t[k] != b) { o = t[k]; break; }
-            }
-            opp[edge_faces] = o;
-            edge_faces = edge_faces + 1u;
-        }
-    }
-    if (edge_faces == 0u) { return invalid(); }
-    var shared_nbrs = 0u;
-    for (var i = alo; i < ahi; i = i + 1u) {
-        let t = face_of(vertex_faces[i]);
-        for (var k = 0u; k < 3u; k = k + 1u) {
-            let u = t[k];
-            if (u != a && u != b && !list_has(alo, i, u) && list_has(blo, bhi, u)) {
-                shared_nbrs = shared_nbrs + 1u;
-            }
-        }
-    }
-    if (shared_nbrs != edge_faces) { return invalid(); }
-    let bord_a = (fla & FLAG_BORDER) != 0u;
-    let bord_b = (flb & FLAG_BORDER) != 0u;
-    if (edge_faces == 2u && bord_a && bord_b) { return invalid(); }
-    if (edge_faces == 1u) {
-        let c = opp[0];
-        if (count_containing(alo, ahi, c) == 1u && count_containing(blo, bhi, c) == 1u) {
-            return invalid();
-        }
-    }
-
     let pa = positions[a].xyz;
     let pb = positions[b].xyz;
     let dab = pb - pa;
@@ -138,19 +84,14 @@ fn evaluate(a: u32, b: u32) -> Verdict {
     let pos = pa + y;
 
     var min_q = 3.0e38;
-    var on_cd = vec2<bool>(false, false);
     for (var side = 0u; side < 2u; side = side + 1u) {
         var moved = keep;
         var other = remove;
         if (side == 1u) { moved = remove; other = keep; }
-        var lo = alo;
-        var hi = ahi;
-        if (moved != a) { lo = blo; hi = bhi; }
-        for (var i = lo; i < hi; i = i + 1u) {
+        for (var i = offsets[moved]; i < offsets[moved + 1u]; i = i + 1u) {
             let f = vertex_faces[i];
             let t = face_of(f);
             if (has(t, other)) { continue; }
-            if (edge_faces == 2u && has(t, opp[0]) && has(t, opp[1])) { on_cd[side] = true; }
             let o0 = positions[t.x].xyz;
             let o1 = positions[t.y].xyz;
             let o2 = positions[t.z].xyz;
@@ -171,7 +112,6 @@ fn evaluate(a: u32, b: u32) -> Verdict {
             min_q = min(min_q, q_new);
         }
     }
-    if (on_cd[0] && on_cd[1]) { return invalid(); }
     let qt = params.quality_threshold;
     var priority = error;
     if (qt > 0.0 && min_q < qt) {
@@ -186,7 +126,7 @@ fn evaluate(a: u32, b: u32) -> Verdict {
     if (err2 > params.max_error2) {
         return Verdict(VERDICT_OVER, EdgeCandidate(vec4<f32>(0.0), 0u, 0u, INVALID_COST, 0u));
     }
-    return Verdict(VERDICT_OK, EdgeCandidate(vec4<f32>(pos, err2), keep, remove, bitcast<u32>(priority), edge_faces));
+    return Verdict(VERDICT_OK, EdgeCandidate(vec4<f32>(pos, err2), keep, remove, bitcast<u32>(priority), 0u));
 }
 
 @compute @workgroup_size(256)

@@ -1,6 +1,6 @@
 // Selection pass, step 3: an edge whose (cost, tie rank) key is the best at every face around both
-// endpoints wins and locks those faces. Two winners therefore share no face, so the checks each
-// passed in edge_costs stay true when both collapse.
+// endpoints wins the pass, tentatively until validate checks its topology. Two winners therefore
+// share no face, so the checks each passed stay true when both collapse.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> offsets: array<u32>;             // per vertex + 1
@@ -11,8 +11,6 @@
 @group(0) @binding(6) var<storage, read> face_best: array<u32>;           // per face
 @group(0) @binding(7) var<storage, read> face_id: array<u32>;             // per face
 @group(0) @binding(8) var<storage, read_write> edge_state: array<u32>;    // per edge
-@group(0) @binding(9) var<storage, read_write> face_lock: array<u32>;     // per face
-@group(0) @binding(10) var<storage, read_write> counters: array<atomic<u32>, 16>;
 
 @compute @workgroup_size(256)
 fn select_win(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -30,14 +28,5 @@ fn select_win(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
             if (face_best[f] != inv || face_id[f] != ~tie_rank(e)) { return; }
         }
     }
-    edge_state[e] = STATE_WON;
-    for (var s = 0u; s < 2u; s = s + 1u) {
-        let v = ab[s];
-        for (var i = offsets[v]; i < offsets[v + 1u]; i = i + 1u) {
-            face_lock[vertex_faces[i]] = 1u;
-        }
-    }
-    atomicAdd(&counters[C_WINNERS], 1u);
-    atomicAdd(&counters[C_REMOVED], c.faces);
-    atomicMax(&counters[C_MAX_ERR2_BITS], bitcast<u32>(c.pos.w));
+    edge_state[e] = STATE_TENTATIVE;
 }

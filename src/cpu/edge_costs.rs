@@ -1,10 +1,11 @@
-//! Twin of shaders/edge_costs.wgsl: per edge, the collapse position and cost, with the same
-//! validity rules as the greedy reference — link condition, no border pinch, no lone triangle,
-//! no tetrahedral fold, no flipped or needle face, pinned and frozen vertices — and the cost
-//! histogram the ceiling is picked from. Invalid edges get `INVALID_COST`.
+//! Twin of shaders/edge_costs.wgsl: per edge, where the collapse would put the survivor, its
+//! quadric error, the faces that move (no flip past the angle limit, no needle) and the priority
+//! (error scaled up for poor triangle quality, MeshLab-style), and the cost histogram the ceiling
+//! is picked from. The topological checks (link condition, border pinch, lone triangle,
+//! tetrahedral fold) scan both endpoints' neighbourhoods and rarely fail on a manifold, so they
+//! run in `validate`, only for the edges that win a selection pass.
 
 use super::common::*;
-use super::vertex_flags::count_containing;
 use super::{face_of, faces_of};
 use crate::gpu::types::{
     Counters, EdgeCandidate, HIST_SHIFT, INVALID_COST, Params, Quadric, flag, state,
@@ -15,13 +16,15 @@ use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 /// What `edge_costs` decided for one edge, before it is written out.
 pub enum Verdict {
     Invalid,
-    /// Valid, but its error exceeds the maximum.
+    /// Valid so far, but its error exceeds the maximum.
     OverMaxError,
     Candidate(EdgeCandidate),
 }
 
+/// The survivor, its new position and the quadric error (`cost_bits`; `pos.w` = error relative
+/// to the diagonal, squared). Frozen vertices and two pinned ends are refused here.
 #[allow(clippy::too_many_arguments)]
-pub fn evaluate(
+pub fn placement(
     params: &Params,
     positions: &[[f32; 4]],
     quadrics: &[Quadric],
@@ -41,53 +44,6 @@ pub fn evaluate(
     if pin_a && pin_b {
         return Verdict::Invalid;
     }
-    let la = faces_of(offsets, vertex_faces, a);
-    let lb = faces_of(offsets, vertex_faces, b);
-
-    // Faces on the edge and their opposite vertices.
-    let mut edge_faces = 0u32;
-    let mut opp = [u32::MAX; 2];
-    for &f in la {
-        let t = face_of(indices, f);
-        if t.contains(&b) {
-            if edge_faces == 2 {
-                return Verdict::Invalid;
-            }
-            opp[edge_faces as usize] = t.into_iter().find(|&u| u != a && u != b).unwrap_or(a);
-            edge_faces += 1;
-        }
-    }
-    if edge_faces == 0 {
-        return Verdict::Invalid;
-    }
-    // Link condition: the common neighbours are exactly the opposite vertices.
-    let mut common = 0u32;
-    for (i, &f) in la.iter().enumerate() {
-        for u in face_of(indices, f) {
-            if u != a
-                && u != b
-                && !la[..i].iter().any(|&g| face_of(indices, g).contains(&u))
-                && lb.iter().any(|&g| face_of(indices, g).contains(&u))
-            {
-                common += 1;
-            }
-        }
-    }
-    if common != edge_faces {
-        return Verdict::Invalid;
-    }
-    let (bord_a, bord_b) = (fla & flag::BORDER != 0, flb & flag::BORDER != 0);
-    if edge_faces == 2 && bord_a && bord_b {
-        return Verdict::Invalid; // joining two border vertices through the interior pinches
-    }
-    if edge_faces == 1 {
-        let c = opp[0];
-        if count_containing(indices, la, c) == 1 && count_containing(indices, lb, c) == 1 {
-            return Verdict::Invalid; // a lone triangle: the whole component would go
-        }
-    }
-
-    // Placement, relative to a.
     let pa = xyz(positions[a as usize]);
     let pb = xyz(positions[b as usize]);
     let dab = sub(pb, pa);
@@ -129,16 +85,11 @@ pub fn evaluate(
     // Faces that move: normals may not turn past the limit (against the current and the input
     // normal), no needle may appear; the worst new quality scales the priority.
     let mut min_q = f32::INFINITY;
-    let mut on_cd = [false; 2];
-    for (side, (moved, other)) in [(keep, remove), (remove, keep)].into_iter().enumerate() {
-        let list = if moved == a { la } else { lb };
-        for &f in list {
+    for (moved, other) in [(keep, remove), (remove, keep)] {
+        for &f in faces_of(offsets, vertex_faces, moved) {
             let t = face_of(indices, f);
             if t.contains(&other) {
                 continue;
-            }
-            if edge_faces == 2 && t.contains(&opp[0]) && t.contains(&opp[1]) {
-                on_cd[side] = true;
             }
             let old = t.map(|u| xyz(positions[u as usize]));
             let new = t.map(|u| {
@@ -157,9 +108,8 @@ pub fn evaluate(
             if l_old > 0.0 && dot(n_old, n_new) < params.cos_max_angle * l_old * l_new {
                 return Verdict::Invalid;
             }
-            let n_ref = xyz(face_normals[f as usize]);
-            if face_normals[f as usize][3] > 0.0 && dot(n_ref, n_new) < params.cos_max_angle * l_new
-            {
+            let fr = face_normals[f as usize];
+            if fr[3] > 0.0 && dot(xyz(fr), n_new) < params.cos_max_angle * l_new {
                 return Verdict::Invalid;
             }
             let q_new = triangle_quality(new[0], new[1], new[2]);
@@ -168,9 +118,6 @@ pub fn evaluate(
             }
             min_q = min_q.min(q_new);
         }
-    }
-    if on_cd[0] && on_cd[1] {
-        return Verdict::Invalid; // faces (keep, c, d) and (remove, c, d) would coincide
     }
     let qt = params.quality_threshold;
     let priority = if qt > 0.0 && min_q < qt {
@@ -191,7 +138,7 @@ pub fn evaluate(
         keep,
         remove,
         cost_bits: priority.to_bits(),
-        faces: edge_faces,
+        faces: 0,
     })
 }
 
@@ -221,7 +168,7 @@ pub fn edge_costs(
         .with_min_len(256)
         .for_each(|(e, (out, st))| {
             let [a, b] = edges[e];
-            let verdict = evaluate(
+            let verdict = placement(
                 params,
                 positions,
                 quadrics,

@@ -18,6 +18,7 @@ pub mod face_planes;
 pub mod prefix_sum;
 pub mod select;
 pub mod trim;
+pub mod validate;
 pub mod vertex_flags;
 pub mod vertex_quadrics;
 
@@ -344,12 +345,25 @@ impl CpuRounds {
                 best,
                 id,
                 st,
+            );
+            let t3 = Instant::now();
+            validate::validate(
+                p,
+                &s.flags,
+                &s.indices,
+                &s.offsets,
+                &s.vertex_faces,
+                &s.edges,
+                &s.edge_offsets,
+                Scatter::new(&mut s.candidates),
+                st,
                 lock,
                 counters,
             );
             s.times.add("select_cost", (t1 - t).as_secs_f64());
             s.times.add("select_id", (t2 - t1).as_secs_f64());
-            s.times.add("select_win", t2.elapsed().as_secs_f64());
+            s.times.add("select_win", (t3 - t2).as_secs_f64());
+            s.times.add("validate", t3.elapsed().as_secs_f64());
         }
         if p.trim != 0 {
             self.time("trim_histogram", |s| {

@@ -3,8 +3,9 @@
 //! smallest over every candidate touching any face around either endpoint: 32-bit atomicMax of
 //! inverted keys per face, first on the cost, then on a hash of the id among equal costs (64-bit atomics
 //! are not portable). Two winners then share no face, so the checks each passed in
-//! `edge_costs` stay true when both collapse. Winners lock their faces; a candidate touching a
-//! locked face drops out at the next pass, and the others compete again (Luby-style).
+//! `validate` stay true when both collapse. The pass's winners are TENTATIVE until `validate`
+//! checks them; confirmed winners lock their faces; a candidate touching a locked face drops out
+//! at the next pass, and the others compete again (Luby-style).
 
 use super::common::tie_rank;
 use super::edge_costs::{CounterField, counter};
@@ -99,8 +100,6 @@ pub fn select_win(
     face_best: &[AtomicU32],
     face_id: &[AtomicU32],
     edge_state: &[AtomicU32],
-    face_lock: &[AtomicU32],
-    counters: &[AtomicU32],
 ) {
     par_for(edge_count(params, edge_offsets), |e| {
         let eu = e as usize;
@@ -116,12 +115,6 @@ pub fn select_win(
         if !wins {
             return;
         }
-        edge_state[eu].store(state::WON, Relaxed);
-        for f in around(offsets, vertex_faces, edges[eu]) {
-            face_lock[f as usize].store(1, Relaxed);
-        }
-        counter(counters, CounterField::Winners).fetch_add(1, Relaxed);
-        counter(counters, CounterField::Removed).fetch_add(c.faces, Relaxed);
-        counter(counters, CounterField::MaxErr2Bits).fetch_max(c.pos[3].to_bits(), Relaxed);
+        edge_state[eu].store(state::TENTATIVE, Relaxed);
     });
 }

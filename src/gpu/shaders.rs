@@ -75,6 +75,11 @@ pub const STAGES: &[(&str, &[&str], &str)] = &[
         include_str!("../../shaders/select_win.wgsl"),
     ),
     (
+        "validate",
+        &["validate"],
+        include_str!("../../shaders/validate.wgsl"),
+    ),
+    (
         "trim_histogram",
         &["trim_histogram"],
         include_str!("../../shaders/trim_histogram.wgsl"),

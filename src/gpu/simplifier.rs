@@ -599,7 +599,15 @@ impl RoundRunner for GpuRounds<'_> {
                 &mut enc,
                 "select_win",
                 &[
-                    &params, &offsets, &vf, &edges, &eoff, &cand, &fbest, &fid, &est, &flock,
+                    &params, &offsets, &vf, &edges, &eoff, &cand, &fbest, &fid, &est,
+                ],
+                wg(cap),
+            );
+            self.pass(
+                &mut enc,
+                "validate",
+                &[
+                    &params, &flags, &idx, &offsets, &vf, &edges, &eoff, &cand, &est, &flock,
                     &counters,
                 ],
                 wg(cap),

@@ -42,6 +42,8 @@ pub mod state {
     pub const CANDIDATE: u32 = 1;
     /// Collapses this round.
     pub const WON: u32 = 2;
+    /// Picked by a selection pass, waiting for `validate`'s checks.
+    pub const TENTATIVE: u32 = 3;
 }
 
 /// Per-round constants, a uniform. Keep in sync with `Params` in shaders/common.wgsl.
@@ -90,7 +92,7 @@ pub struct Counters {
     pub over_max_error: u32,
     /// Cost bits below which candidates compete (from `cost_ceiling`).
     pub ceiling: u32,
-    /// Winners of `select_win`, summed over the passes.
+    /// Winners confirmed by `validate`, summed over the passes.
     pub winners: u32,
     /// Faces the winners remove (before trimming).
     pub removed: u32,
@@ -124,9 +126,10 @@ pub struct EdgeCandidate {
     pub pos: [f32; 4],
     pub keep: u32,
     pub remove: u32,
-    /// f32 bits of the priority (error scaled by triangle quality); INVALID_COST if invalid.
+    /// f32 bits of the quadric error from `edge_costs`, raised to the full priority (error
+    /// scaled by triangle quality) by `validate`; INVALID_COST if invalid.
     pub cost_bits: u32,
-    /// Faces on the edge: 1 (border) or 2; what the collapse removes.
+    /// Faces on the edge, 1 (border) or 2, what the collapse removes; set by `validate`.
     pub faces: u32,
 }
 
