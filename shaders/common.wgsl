@@ -54,6 +54,7 @@ const C_TRIM_BIN: u32 = 6u;
 const C_TRIM_BUDGET: u32 = 7u;
 const C_VERTICES_OUT: u32 = 8u;
 const C_FACES_OUT: u32 = 9u;
+const C_TENTATIVE: u32 = 10u;
 const COUNTERS: u32 = 16u;
 
 struct Counters {
@@ -67,7 +68,8 @@ struct Counters {
     trim_budget: u32,
     vertices_out: u32,
     faces_out: u32,
-    _pad: array<u32, 6>,
+    tentative: u32,
+    _pad: array<u32, 5>,
 }
 
 // Relative to its vertex: [a00 a01 a02 a11] [a12 a22 b0 b1] [b2 c weight 0].

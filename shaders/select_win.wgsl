@@ -11,6 +11,8 @@
 @group(0) @binding(6) var<storage, read> face_best: array<u32>;           // per face
 @group(0) @binding(7) var<storage, read> face_id: array<u32>;             // per face
 @group(0) @binding(8) var<storage, read_write> edge_state: array<u32>;    // per edge
+@group(0) @binding(9) var<storage, read_write> tentative: array<u32>;     // per winner of the pass
+@group(0) @binding(10) var<storage, read_write> counters: array<atomic<u32>, 16>;
 
 @compute @workgroup_size(256)
 fn select_win(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -29,4 +31,6 @@ fn select_win(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         }
     }
     edge_state[e] = STATE_TENTATIVE;
+    // The list's order depends on timing; validate's results do not (one slot per edge).
+    tentative[atomicAdd(&counters[C_TENTATIVE], 1u)] = e;
 }

@@ -1,4 +1,5 @@
-// The edges a selection pass picked get the topological checks of the greedy reference: link
+// The edges a selection pass picked (listed by select_win, so that SIMD lanes are not spent on
+// the other edges) get the topological checks of the greedy reference: link
 // condition, no border pinch, no lone triangle, no tetrahedral fold. Those that pass win and lock
 // the faces around them; the rest drop out. Relies on tentative winners sharing no face.
 
@@ -8,7 +9,7 @@
 @group(0) @binding(3) var<storage, read> offsets: array<u32>;                // per vertex + 1
 @group(0) @binding(4) var<storage, read> vertex_faces: array<u32>;           // per corner
 @group(0) @binding(5) var<storage, read> edges: array<vec2<u32>>;            // per edge
-@group(0) @binding(6) var<storage, read> edge_offsets: array<u32>;           // per vertex + 1
+@group(0) @binding(6) var<storage, read> tentative: array<u32>;              // per winner of the pass
 @group(0) @binding(7) var<storage, read_write> candidates: array<EdgeCandidate>; // per edge
 @group(0) @binding(8) var<storage, read_write> edge_state: array<u32>;       // per edge
 @group(0) @binding(9) var<storage, read_write> face_lock: array<u32>;        // per face
@@ -97,10 +98,11 @@ fn check(keep: u32, remove: u32) -> u32 {
 
 @compute @workgroup_size(256)
 fn validate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let e = gid.x + gid.y * nwg.x * WG;
-    if (e >= edge_offsets[params.vertex_count] || edge_state[e] != STATE_TENTATIVE) {
+    let id = gid.x + gid.y * nwg.x * WG;
+    if (id >= min(atomicLoad(&counters[C_TENTATIVE]), params.edge_capacity)) {
         return;
     }
+    let e = tentative[id];
     var c = candidates[e];
     let faces = check(c.keep, c.remove);
     if (faces == 0u) {

@@ -213,6 +213,7 @@ pub enum CounterField {
     TrimBudget = 7,
     VerticesOut = 8,
     FacesOut = 9,
+    Tentative = 10,
 }
 
 pub fn counter(counters: &[AtomicU32], f: CounterField) -> &AtomicU32 {

@@ -148,6 +148,7 @@ pub struct CpuRounds {
     pub vertex_keep: Vec<u32>,
     pub face_keep: Vec<u32>,
     pub marks: Vec<u32>,
+    pub tentative: Vec<u32>,
     pub block_sums: Vec<u32>,
     pub counters: Vec<u32>,
     pub draw: DrawArgs,
@@ -299,9 +300,11 @@ impl CpuRounds {
     pub fn select(&mut self, p: &Params, ne: u32) {
         let nf = p.face_count as usize;
         reset(&mut self.face_lock, nf);
+        self.tentative.resize(ne as usize, 0);
         for _ in 0..self.selection_passes {
             reset(&mut self.face_best, nf);
             reset(&mut self.face_id, nf);
+            self.counters[edge_costs::CounterField::Tentative as usize] = 0;
             let s = &mut *self;
             let t = Instant::now();
             let (lock, st, counters) = (
@@ -345,6 +348,8 @@ impl CpuRounds {
                 best,
                 id,
                 st,
+                Scatter::new(&mut s.tentative),
+                counters,
             );
             let t3 = Instant::now();
             validate::validate(
@@ -354,7 +359,7 @@ impl CpuRounds {
                 &s.offsets,
                 &s.vertex_faces,
                 &s.edges,
-                &s.edge_offsets,
+                &s.tentative,
                 Scatter::new(&mut s.candidates),
                 st,
                 lock,

@@ -9,7 +9,7 @@
 
 use super::common::tie_rank;
 use super::edge_costs::{CounterField, counter};
-use super::{faces_of, par_for};
+use super::{Scatter, faces_of, par_for};
 use crate::gpu::types::{EdgeCandidate, Params, state};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
@@ -100,6 +100,8 @@ pub fn select_win(
     face_best: &[AtomicU32],
     face_id: &[AtomicU32],
     edge_state: &[AtomicU32],
+    tentative: Scatter<u32>, // per winner of the pass
+    counters: &[AtomicU32],
 ) {
     par_for(edge_count(params, edge_offsets), |e| {
         let eu = e as usize;
@@ -116,5 +118,8 @@ pub fn select_win(
             return;
         }
         edge_state[eu].store(state::TENTATIVE, Relaxed);
+        let slot = counter(counters, CounterField::Tentative).fetch_add(1, Relaxed);
+        // SAFETY: the atomic counter hands out each slot once.
+        unsafe { tentative.write(slot as usize, e) };
     });
 }

@@ -84,8 +84,7 @@ pub fn check(
     Some(edge_faces)
 }
 
-/// Per edge: TENTATIVE edges are checked; they win (and lock their faces), go back to compete
-/// with a higher priority, or drop out.
+/// Per listed tentative winner: it wins (and locks its faces) or drops out.
 #[allow(clippy::too_many_arguments)]
 pub fn validate(
     params: &Params,
@@ -94,17 +93,16 @@ pub fn validate(
     offsets: &[u32],
     vertex_faces: &[u32],
     edges: &[[u32; 2]],
-    edge_offsets: &[u32],
+    tentative: &[u32], // per winner of the pass
     candidates: Scatter<EdgeCandidate>,
     edge_state: &[AtomicU32],
     face_lock: &[AtomicU32],
     counters: &[AtomicU32],
 ) {
-    par_for(edge_offsets[params.vertex_count as usize], |e| {
-        let eu = e as usize;
-        if edge_state[eu].load(Relaxed) != state::TENTATIVE {
-            return;
-        }
+    let n = counter(counters, CounterField::Tentative).load(Relaxed);
+    par_for(n, |id| {
+        let eu = tentative[id as usize] as usize;
+        debug_assert_eq!(edge_state[eu].load(Relaxed), state::TENTATIVE);
         // SAFETY: each invocation reads and writes only its own edge's candidate.
         let mut c = unsafe { candidates.read(eu) };
         let Some(faces) = check(params, flags, indices, offsets, vertex_faces, &c) else {

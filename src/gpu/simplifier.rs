@@ -123,6 +123,7 @@ pub struct GpuRounds<'a> {
     vertex_keep: wgpu::Buffer,
     face_keep: wgpu::Buffer,
     marks: wgpu::Buffer,
+    tentative: wgpu::Buffer,
     block_sums: wgpu::Buffer,
     counters: wgpu::Buffer,
     readback: wgpu::Buffer,
@@ -244,6 +245,7 @@ impl<'a> GpuRounds<'a> {
             vertex_keep: mk("vertex_keep", (nv + 1) * 4, SU)?,
             face_keep: mk("face_keep", (nf + 1) * 4, SU)?,
             marks: mk("marks", (cap + 1) * 4, SU)?,
+            tentative: mk("tentative", cap * 4, SU)?,
             block_sums: mk("block_sums", blocks * 4, SU)?,
             counters: mk("counters", 64, SU)?,
             readback: mk(
@@ -508,6 +510,7 @@ impl RoundRunner for GpuRounds<'_> {
             c(&self.marks),
         );
         let draw = c(&self.draw_args);
+        let tent = c(&self.tentative);
 
         enc.clear_buffer(&counters, 0, None);
         enc.clear_buffer(&offsets, 0, None);
@@ -579,6 +582,8 @@ impl RoundRunner for GpuRounds<'_> {
         for _ in 0..self.selection_passes {
             enc.clear_buffer(&fbest, 0, None);
             enc.clear_buffer(&fid, 0, None);
+            // counters.tentative: the list select_win fills is per pass.
+            enc.clear_buffer(&counters, 40, Some(4));
             self.pass(
                 &mut enc,
                 "select_cost",
@@ -599,7 +604,8 @@ impl RoundRunner for GpuRounds<'_> {
                 &mut enc,
                 "select_win",
                 &[
-                    &params, &offsets, &vf, &edges, &eoff, &cand, &fbest, &fid, &est,
+                    &params, &offsets, &vf, &edges, &eoff, &cand, &fbest, &fid, &est, &tent,
+                    &counters,
                 ],
                 wg(cap),
             );
@@ -607,7 +613,7 @@ impl RoundRunner for GpuRounds<'_> {
                 &mut enc,
                 "validate",
                 &[
-                    &params, &flags, &idx, &offsets, &vf, &edges, &eoff, &cand, &est, &flock,
+                    &params, &flags, &idx, &offsets, &vf, &edges, &tent, &cand, &est, &flock,
                     &counters,
                 ],
                 wg(cap),

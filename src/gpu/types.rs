@@ -104,7 +104,9 @@ pub struct Counters {
     /// Vertex and face counts after compaction (copied from the prefix sums' totals).
     pub vertices_out: u32,
     pub faces_out: u32,
-    pub _pad: [u32; 6],
+    /// Tentative winners listed by `select_win` in this pass (reset before each pass).
+    pub tentative: u32,
+    pub _pad: [u32; 5],
 }
 
 /// A vertex's quadric in f32, relative to the vertex's own position: `E(y) = yᵀAy + 2bᵀy + c`
