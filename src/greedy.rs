@@ -1028,22 +1028,26 @@ impl<'a> State<'a> {
         (s, heap)
     }
 
-    /// Queues every unique edge of the live faces once, keyed by its quadric error.
+    /// Queues every unique edge of the live faces once, keyed by its quadric error, in
+    /// ascending (lower, higher) vertex order. Gathered per vertex from its face list instead of
+    /// sorting all edge keys: measured on the 1M scan at 10%, the global sort was 0.55 G of the
+    /// run's 15 G instructions.
     fn queue_all_edges(&self, heap: &mut Queue) {
-        let mut edges: Vec<u64> = Vec::with_capacity(self.faces * 3);
-        for (f, t) in self.topo_faces.iter().enumerate() {
-            if self.face_alive[f] {
-                for i in 0..3 {
-                    edges.push(edge_key(t[i], t[(i + 1) % 3]));
+        let mut nbrs: Vec<u32> = Vec::new();
+        for a in 0..self.p.pos.len() as u32 {
+            nbrs.clear();
+            for &f in self.vert_faces.get(a as usize) {
+                let t = self.topo_faces[f as usize];
+                if t[0] != DEAD {
+                    nbrs.extend(t.into_iter().filter(|&u| u > a));
                 }
             }
-        }
-        edges.par_sort_unstable();
-        edges.dedup();
-        for e in edges {
-            let (a, b) = ((e >> 32) as u32, e as u32);
-            if let Some((_, _, _, err)) = self.placement(a, b) {
-                heap.push(key(err), a, b, self.stamp(a, b));
+            nbrs.sort_unstable();
+            nbrs.dedup();
+            for &b in &nbrs {
+                if let Some((_, _, _, err)) = self.placement(a, b) {
+                    heap.push(key(err), a, b, self.stamp(a, b));
+                }
             }
         }
     }
