@@ -343,17 +343,29 @@ impl Prepared {
     /// mesh, and `face_origin` holds each face's index in `self.faces`, so results map straight
     /// back. Returns the sub-problem and its local → whole topological vertex map.
     pub(crate) fn subset(&self, faces: &[u32], pin: &[bool]) -> (Prepared, Vec<u32>) {
-        let mut topo_global: Vec<u32> = faces
+        // The vertices used, in ascending order, through a table over the span of their ids
+        // (a region is mostly one run of the Morton order): measured on the 1M scan, sorting
+        // the 400k corners of each of the 8 regions and binary-searching them took 0.05 s
+        // per region, twice the region's whole queue set-up.
+        let corner_topo = |f: u32| self.faces[f as usize].map(|v| self.topo[v as usize]);
+        let (lo, hi) = faces
             .iter()
-            .flat_map(|&f| self.faces[f as usize].map(|v| self.topo[v as usize]))
-            .collect();
-        topo_global.sort_unstable();
-        topo_global.dedup();
-        let local = |t: u32| {
-            topo_global
-                .binary_search(&t)
-                .expect("vertex of a listed face") as u32
-        };
+            .flat_map(|&f| corner_topo(f))
+            .fold((u32::MAX, 0), |(lo, hi), t| (lo.min(t), hi.max(t)));
+        let mut local_of = vec![u32::MAX; (hi + 1).saturating_sub(lo) as usize];
+        for &f in faces {
+            for t in corner_topo(f) {
+                local_of[(t - lo) as usize] = 0;
+            }
+        }
+        let mut topo_global = Vec::new();
+        for (i, l) in local_of.iter_mut().enumerate() {
+            if *l == 0 {
+                *l = topo_global.len() as u32;
+                topo_global.push(lo + i as u32);
+            }
+        }
+        let local = |t: u32| local_of[(t - lo) as usize];
         // Attribute vertices keep their global ids; `topo` must cover them all, so it is sized
         // for the whole mesh with unused entries left at 0.
         let mut topo = vec![0u32; self.topo.len()];
@@ -938,7 +950,11 @@ impl<'a> State<'a> {
                     }
                 });
                 let n_old = cross(sub(old[1], old[0]), sub(old[2], old[0]));
-                let e = [sub(new[1], new[0]), sub(new[2], new[0]), sub(new[1], new[2])];
+                let e = [
+                    sub(new[1], new[0]),
+                    sub(new[2], new[0]),
+                    sub(new[1], new[2]),
+                ];
                 let n_new = cross(e[0], e[1]);
                 let (l_old, l_new) = (norm(n_old), norm(n_new));
                 if l_new <= 0.0 {
