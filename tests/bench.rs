@@ -57,8 +57,14 @@ fn json_and_plot_have_every_backend_at_every_ratio() {
     assert!(!cpu.is_empty());
     assert!(json["machine"]["cores"].as_u64().unwrap() >= 1);
     let rows = json["rows"].as_array().unwrap();
-    assert_eq!(rows.len(), 2 * 3, "{text}");
-    for backend in ["cpu", "meshopt", "meshopt-sloppy"] {
+    // Every backend this machine can run: gpu only where there is an adapter.
+    let backends: Vec<&str> = meshslim::bench::available_backends()
+        .iter()
+        .map(|b| b.name)
+        .collect();
+    assert!(backends.len() >= 4, "{backends:?}");
+    assert_eq!(rows.len(), 2 * backends.len(), "{text}");
+    for &backend in &backends {
         for ratio in [0.5, 0.1] {
             let row = rows
                 .iter()
@@ -70,7 +76,12 @@ fn json_and_plot_have_every_backend_at_every_ratio() {
                     "{backend} at {ratio}: {field} missing or null:\n{row:#}"
                 );
             }
-            assert_eq!(row["device"], cpu);
+            // The device that ran it: the CPU, or the GPU adapter for the gpu backend.
+            if backend == "gpu" {
+                assert_ne!(row["device"], cpu, "{row:#}");
+            } else {
+                assert_eq!(row["device"], cpu);
+            }
             assert_eq!(row["mesh"], "builtin:sphere:1000");
             assert_eq!(row["input_faces"], 1280);
             let out = row["output_faces"].as_u64().unwrap();
@@ -87,11 +98,11 @@ fn json_and_plot_have_every_backend_at_every_ratio() {
 
     let svg = std::fs::read_to_string(dir.path().join("bench.svg")).unwrap();
     assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
-    for backend in ["cpu", "meshopt", "meshopt-sloppy"] {
+    for backend in &backends {
         let series = format!(r#"<g class="series" data-backend="{backend}">"#);
         assert_eq!(svg.matches(&series).count(), 1, "one series for {backend}");
     }
-    assert_eq!(svg.matches(r#"class="series""#).count(), 3);
+    assert_eq!(svg.matches(r#"class="series""#).count(), backends.len());
     for label in ["ratio 0.5", "ratio 0.1", "median simplify time (s)"] {
         assert!(svg.contains(label), "{label} missing from the plot");
     }
@@ -128,7 +139,8 @@ fn bad_usage_exits_2() {
     let o = meshslim(&["bench", "--backends", "nope"], dir.path());
     expect_code(&o, 2);
     assert!(
-        String::from_utf8_lossy(&o.stderr).contains("cpu, meshopt, meshopt-sloppy"),
+        String::from_utf8_lossy(&o.stderr)
+            .contains("cpu, cpu-parallel, gpu, meshopt, meshopt-sloppy"),
         "the error lists the backends"
     );
 }
