@@ -15,6 +15,10 @@ pub const SELECTION_PASSES: u32 = 4;
 /// The cost ceiling lets this many times the collapses still needed compete: fewer keeps the
 /// order closer to greedy, more needs fewer rounds.
 pub const CEILING_FACTOR: u32 = 2;
+/// ...but never fewer candidates than this share of the faces: near the target, a ceiling sized
+/// to the few collapses still needed let each round remove only a fraction of them (a long tail
+/// of small rounds); trimming lands the face count on the target instead.
+pub const CEILING_MIN_SHARE: f64 = 0.25;
 /// A round trims its winners once the faces still to remove fall below this share of the
 /// faces: a round never removes more than about a third of them.
 pub const TRIM_SHARE: f64 = 0.4;
@@ -303,7 +307,11 @@ pub fn drive(
             face_count: nf,
             edge_capacity: 3 * nf,
             needed_faces: needed,
-            ceiling_wanted: needed.div_ceil(2).saturating_mul(CEILING_FACTOR).max(1),
+            ceiling_wanted: needed
+                .div_ceil(2)
+                .saturating_mul(CEILING_FACTOR)
+                .max((nf as f64 * CEILING_MIN_SHARE) as u32)
+                .max(1),
             trim: ((needed as f64) < TRIM_SHARE * nf as f64) as u32,
             ..base
         };
