@@ -59,17 +59,17 @@ fn check(keep: u32, remove: u32) -> u32 {
         }
     }
     if (edge_faces == 0u) { return 0u; }
-    var n_shared = 0u;
-    for (var i = klo; i < khi; i = i + 1u) {
+    // Link condition: the opposite vertices are always common neighbours, so it fails when both
+    // faces have the same one, or when any other neighbour of remove is a neighbour of keep.
+    if (edge_faces == 2u && opp[0] == opp[1]) { return 0u; }
+    for (var i = rlo; i < rhi; i = i + 1u) {
         let t = face_of(vertex_faces[i]);
         for (var k = 0u; k < 3u; k = k + 1u) {
             let u = t[k];
-            if (u != keep && u != remove && !list_has(klo, i, u) && list_has(rlo, rhi, u)) {
-                n_shared = n_shared + 1u;
-            }
+            let is_opp = u == opp[0] || (edge_faces == 2u && u == opp[1]);
+            if (u != keep && u != remove && !is_opp && list_has(klo, khi, u)) { return 0u; }
         }
     }
-    if (n_shared != edge_faces) { return 0u; }
     let bk = (flags[keep] & FLAG_BORDER) != 0u;
     let br = (flags[remove] & FLAG_BORDER) != 0u;
     if (edge_faces == 2u && bk && br) { return 0u; }

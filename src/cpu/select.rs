@@ -43,15 +43,18 @@ pub fn select_cost(
     face_best: &[AtomicU32],  // per face, cleared
 ) {
     let ceiling = counter(counters, CounterField::Ceiling).load(Relaxed);
+    let any_locked = counter(counters, CounterField::Winners).load(Relaxed) > 0;
     par_for(edge_count(params, edge_offsets), |e| {
         let e = e as usize;
         if edge_state[e].load(Relaxed) != state::CANDIDATE {
             return;
         }
         let c = &candidates[e];
+        // No face is locked before the first winner: skip the scan in the first pass.
         if c.cost_bits >= ceiling
-            || around(offsets, vertex_faces, edges[e])
-                .any(|f| face_lock[f as usize].load(Relaxed) != 0)
+            || (any_locked
+                && around(offsets, vertex_faces, edges[e])
+                    .any(|f| face_lock[f as usize].load(Relaxed) != 0))
         {
             edge_state[e].store(state::OUT, Relaxed);
             return;

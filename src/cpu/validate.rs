@@ -43,20 +43,22 @@ pub fn check(
         return None;
     }
     // Link condition (Dey et al.): the common neighbours are exactly the opposite vertices.
-    let mut shared = 0u32;
-    for (i, &f) in lk.iter().enumerate() {
+    // Those always are common, so it fails when two faces share the edge with one opposite
+    // vertex, or when any other neighbour of `remove` is also a neighbour of `keep` — no need to
+    // count distinct neighbours.
+    if edge_faces == 2 && opp[0] == opp[1] {
+        return None;
+    }
+    for &f in lr {
         for u in face_of(indices, f) {
             if u != keep
                 && u != remove
-                && !lk[..i].iter().any(|&g| face_of(indices, g).contains(&u))
-                && lr.iter().any(|&g| face_of(indices, g).contains(&u))
+                && !opp[..edge_faces as usize].contains(&u)
+                && lk.iter().any(|&g| face_of(indices, g).contains(&u))
             {
-                shared += 1;
+                return None;
             }
         }
-    }
-    if shared != edge_faces {
-        return None;
     }
     let border = |v: u32| flags[v as usize] & flag::BORDER != 0;
     if edge_faces == 2 && border(keep) && border(remove) {
