@@ -17,16 +17,6 @@
 @group(0) @binding(12) var<storage, read_write> histogram: array<atomic<u32>>; // HIST_BINS
 @group(0) @binding(13) var<storage, read_write> counters: array<atomic<u32>, 16>;
 
-fn face_of(f: u32) -> vec3<u32> {
-    return vec3<u32>(indices[3u * f], indices[3u * f + 1u], indices[3u * f + 2u]);
-}
-
-fn has(t: vec3<u32>, u: u32) -> bool {
-    return t.x == u || t.y == u || t.z == u;
-}
-
-
-
 const VERDICT_INVALID: u32 = 0u;
 const VERDICT_OVER: u32 = 1u;
 const VERDICT_OK: u32 = 2u;

@@ -8,19 +8,6 @@
 @group(0) @binding(4) var<storage, read_write> edge_counts: array<u32>; // per vertex + 1
 @group(0) @binding(5) var<storage, read_write> remap: array<u32>;       // per vertex
 
-fn face_of(f: u32) -> vec3<u32> {
-    return vec3<u32>(indices[3u * f], indices[3u * f + 1u], indices[3u * f + 2u]);
-}
-
-// u occurs in a face of the list before position i.
-fn seen_before(lo: u32, i: u32, u: u32) -> bool {
-    for (var j = lo; j < i; j = j + 1u) {
-        let t = face_of(vertex_faces[j]);
-        if (t.x == u || t.y == u || t.z == u) { return true; }
-    }
-    return false;
-}
-
 @compute @workgroup_size(256)
 fn edges_count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let v = gid.x + gid.y * nwg.x * WG;
@@ -33,7 +20,7 @@ fn edges_count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     for (var i = lo; i < hi; i = i + 1u) {
         let t = face_of(vertex_faces[i]);
         for (var k = 0u; k < 3u; k = k + 1u) {
-            if (t[k] > v && !seen_before(lo, i, t[k])) { n = n + 1u; }
+            if (t[k] > v && !list_has(lo, i, t[k])) { n = n + 1u; }
         }
     }
     edge_counts[v] = n;

@@ -15,29 +15,6 @@
 @group(0) @binding(9) var<storage, read_write> face_lock: array<u32>;        // per face
 @group(0) @binding(10) var<storage, read_write> counters: array<atomic<u32>, 16>;
 
-fn face_of(f: u32) -> vec3<u32> {
-    return vec3<u32>(indices[3u * f], indices[3u * f + 1u], indices[3u * f + 2u]);
-}
-
-fn has(t: vec3<u32>, u: u32) -> bool {
-    return t.x == u || t.y == u || t.z == u;
-}
-
-fn list_has(lo: u32, hi: u32, u: u32) -> bool {
-    for (var i = lo; i < hi; i = i + 1u) {
-        if (has(face_of(vertex_faces[i]), u)) { return true; }
-    }
-    return false;
-}
-
-fn count_containing(lo: u32, hi: u32, u: u32) -> u32 {
-    var n = 0u;
-    for (var i = lo; i < hi; i = i + 1u) {
-        if (has(face_of(vertex_faces[i]), u)) { n = n + 1u; }
-    }
-    return n;
-}
-
 // Faces on the edge (1 or 2), or 0 when the collapse would break the topology.
 fn check(keep: u32, remove: u32) -> u32 {
     let klo = offsets[keep];

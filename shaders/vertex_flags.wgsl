@@ -8,22 +8,6 @@
 @group(0) @binding(3) var<storage, read> vertex_faces: array<u32>;  // per corner
 @group(0) @binding(4) var<storage, read_write> flags: array<u32>;   // per vertex
 
-fn face_of(f: u32) -> vec3<u32> {
-    return vec3<u32>(indices[3u * f], indices[3u * f + 1u], indices[3u * f + 2u]);
-}
-
-fn has(t: vec3<u32>, u: u32) -> bool {
-    return t.x == u || t.y == u || t.z == u;
-}
-
-fn count_containing(lo: u32, hi: u32, u: u32) -> u32 {
-    var n = 0u;
-    for (var i = lo; i < hi; i = i + 1u) {
-        if (has(face_of(vertex_faces[i]), u)) { n = n + 1u; }
-    }
-    return n;
-}
-
 // The corner of t other than v and not_this (v when there is none).
 fn other_corner(t: vec3<u32>, v: u32, not_this: u32) -> u32 {
     for (var k = 0u; k < 3u; k = k + 1u) {

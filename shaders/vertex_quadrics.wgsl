@@ -10,19 +10,6 @@
 @group(0) @binding(5) var<storage, read> face_normals: array<vec4<f32>>; // per face
 @group(0) @binding(6) var<storage, read_write> quadrics: array<Quadric>; // per vertex
 
-fn face_of(f: u32) -> vec3<u32> {
-    return vec3<u32>(indices[3u * f], indices[3u * f + 1u], indices[3u * f + 2u]);
-}
-
-fn count_containing(lo: u32, hi: u32, u: u32) -> u32 {
-    var n = 0u;
-    for (var i = lo; i < hi; i = i + 1u) {
-        let t = face_of(vertex_faces[i]);
-        if (t.x == u || t.y == u || t.z == u) { n = n + 1u; }
-    }
-    return n;
-}
-
 @compute @workgroup_size(256)
 fn vertex_quadrics(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let v = gid.x + gid.y * nwg.x * WG;

@@ -1,5 +1,6 @@
 //! The WGSL stages: each file in shaders/ is one stage (prefix_sum has its three steps), compiled
-//! as shaders/common.wgsl followed by the stage's own source. Tests parse and validate every
+//! as shaders/common.wgsl (and shaders/mesh.wgsl for stages reading the faces' CSR lists)
+//! followed by the stage's own source. Tests parse and validate every
 //! stage with naga — no GPU needed — and compare the WGSL structs with their Rust twins.
 
 /// (file stem, entry points, source) of every stage.
@@ -127,10 +128,18 @@ pub const STAGES: &[(&str, &[&str], &str)] = &[
 ];
 
 pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
+/// Face and CSR list accessors, for the stages that bind `indices` and `vertex_faces`.
+pub const MESH: &str = include_str!("../../shaders/mesh.wgsl");
 
-/// The full source of a stage: the common definitions, then the stage.
+/// The full source of a stage: the common definitions, the mesh accessors when the stage binds
+/// the buffers they read, then the stage.
 pub fn source(stage_source: &str) -> String {
-    format!("{COMMON}\n{stage_source}")
+    let binds = |var: &str| stage_source.contains(&format!("var<storage, read> {var}:"));
+    if binds("indices") && binds("vertex_faces") {
+        format!("{COMMON}\n{MESH}\n{stage_source}")
+    } else {
+        format!("{COMMON}\n{stage_source}")
+    }
 }
 
 #[cfg(test)]
@@ -170,7 +179,7 @@ mod tests {
             let name = entry.unwrap().file_name().into_string().unwrap();
             let stem = name.trim_end_matches(".wgsl");
             assert!(
-                stem == "common" || STAGES.iter().any(|s| s.0 == stem),
+                stem == "common" || stem == "mesh" || STAGES.iter().any(|s| s.0 == stem),
                 "shaders/{name} is not listed in STAGES"
             );
         }
