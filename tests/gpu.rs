@@ -275,3 +275,38 @@ fn gpu_report_names_adapter_and_stages() {
         );
     }
 }
+
+/// The simplified mesh stays on the GPU in buffers a renderer binds as they are: positions as a
+/// vertex buffer, indices as an index buffer, and indirect draw arguments the rounds keep current.
+#[test]
+fn gpu_mesh_is_drawable_from_the_simplifier_buffers() {
+    let Some(ctx) = context() else { return };
+    let sim = GpuSimplifier::new(&ctx.device, &ctx.queue).unwrap();
+    let m = meshslim::mesh::icosphere(3);
+    let up = Upload::new(&m);
+    let mut opts = SimplifyOptions::with_ratio(m.triangles.len(), 0.25).unwrap();
+    opts.backend = Backend::Gpu;
+    let mut rounds = GpuRounds::new(&sim, &up, SELECTION_PASSES).unwrap();
+    let driven = meshslim::parallel::drive(&mut rounds, &up, &opts, &mut |_| {}).unwrap();
+    let faces = up.face_count() - driven.removed.iter().sum::<usize>();
+    assert_eq!(faces, opts.target_faces);
+    let args: DrawArgs = *bytemuck::from_bytes(&rounds.read_buffer("draw_args", 20).unwrap());
+    assert_eq!(
+        (args.index_count as usize, args.instance_count),
+        (3 * faces, 1)
+    );
+    let mesh = rounds.into_mesh(&up).unwrap();
+    use wgpu::BufferUsages as U;
+    assert!(
+        mesh.positions
+            .usage()
+            .contains(U::VERTEX | U::STORAGE | U::COPY_SRC)
+    );
+    assert!(
+        mesh.indices
+            .usage()
+            .contains(U::INDEX | U::STORAGE | U::COPY_SRC)
+    );
+    assert!(mesh.draw_args.usage().contains(U::INDIRECT));
+    assert!(mesh.scale > 0.0);
+}
