@@ -164,6 +164,19 @@ fn each_stage_matches_its_cpu_twin() {
             cpu.edge_state,
             "{name}: edge_state after selection"
         );
+        // dispatch_args, as it last ran: after the last pass's select_win.
+        let mut args = [0u32; 8];
+        meshslim::cpu::dispatch_args::dispatch_args(
+            &p,
+            &cpu.edge_offsets,
+            meshslim::cpu::atomics(&mut cpu.counters),
+            &mut args,
+        );
+        assert_eq!(
+            pod::<u32>(rd("dispatch", 32)),
+            args,
+            "{name}: dispatch_args"
+        );
         let faces = |v: &[EdgeCandidate]| v.iter().map(|c| c.faces).collect::<Vec<_>>();
         let g_after: Vec<EdgeCandidate> = pod(rd("candidates", 32 * ne));
         assert_eq!(

@@ -12,6 +12,7 @@ pub mod collapse;
 pub mod common;
 pub mod compact;
 pub mod cost_ceiling;
+pub mod dispatch_args;
 pub mod edge_costs;
 pub mod edges;
 pub mod face_planes;

@@ -121,6 +121,11 @@ pub const STAGES: &[(&str, &[&str], &str)] = &[
         include_str!("../../shaders/compact_faces.wgsl"),
     ),
     (
+        "dispatch_args",
+        &["dispatch_args"],
+        include_str!("../../shaders/dispatch_args.wgsl"),
+    ),
+    (
         "draw_args",
         &["draw_args"],
         include_str!("../../shaders/draw_args.wgsl"),

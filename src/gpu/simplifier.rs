@@ -124,6 +124,7 @@ pub struct GpuRounds<'a> {
     face_keep: wgpu::Buffer,
     marks: wgpu::Buffer,
     tentative: wgpu::Buffer,
+    dispatch: wgpu::Buffer,
     block_sums: wgpu::Buffer,
     counters: wgpu::Buffer,
     readback: wgpu::Buffer,
@@ -136,9 +137,23 @@ pub struct GpuRounds<'a> {
     pub transfer_seconds: f64,
 }
 
-fn wg(n: u32) -> u32 {
-    n.div_ceil(WG).max(1)
+/// How many workgroups a pass runs.
+#[derive(Clone, Copy)]
+enum Grid {
+    Direct(u32),
+    /// From the `dispatch` buffer at this byte offset, written by `dispatch_args`.
+    Indirect(u64),
 }
+
+/// Workgroups for `n` invocations.
+fn wg(n: u32) -> Grid {
+    Grid::Direct(n.div_ceil(WG).max(1))
+}
+
+/// Byte offsets in the `dispatch` buffer: one grid per edge, one per tentative winner.
+const PER_EDGE: Grid = Grid::Indirect(0);
+const PER_TENTATIVE: Grid = Grid::Indirect(16);
+const ONE: Grid = Grid::Direct(1);
 
 impl<'a> GpuRounds<'a> {
     /// Uploads `up` and allocates every working buffer for its size (they only shrink).
@@ -246,6 +261,7 @@ impl<'a> GpuRounds<'a> {
             face_keep: mk("face_keep", (nf + 1) * 4, SU)?,
             marks: mk("marks", (cap + 1) * 4, SU)?,
             tentative: mk("tentative", cap * 4, SU)?,
+            dispatch: mk("dispatch", 32, SU | wgpu::BufferUsages::INDIRECT)?,
             block_sums: mk("block_sums", blocks * 4, SU)?,
             counters: mk("counters", 64, SU)?,
             readback: mk(
@@ -265,14 +281,14 @@ impl<'a> GpuRounds<'a> {
         Ok(r)
     }
 
-    /// One compute pass: `entry` with `bindings` in the shader's binding order, over
-    /// `workgroups` workgroups (split over y beyond the per-dimension limit).
+    /// One compute pass: `entry` with `bindings` in the shader's binding order, over `grid`
+    /// (split over y beyond the per-dimension limit).
     fn pass(
         &mut self,
         enc: &mut wgpu::CommandEncoder,
         entry: &'static str,
         bindings: &[&wgpu::Buffer],
-        workgroups: u32,
+        grid: Grid,
     ) {
         let pipeline = &self.sim.pipelines[entry];
         let layout = pipeline.get_bind_group_layout(0);
@@ -297,10 +313,12 @@ impl<'a> GpuRounds<'a> {
             .device
             .limits()
             .max_compute_workgroups_per_dimension;
-        let (x, y) = if workgroups <= max_x {
-            (workgroups, 1)
-        } else {
-            (max_x, workgroups.div_ceil(max_x))
+        let split = |groups: u32| {
+            if groups <= max_x {
+                (groups, 1)
+            } else {
+                (max_x, groups.div_ceil(max_x))
+            }
         };
         let qi = self.query_stages.len() as u32 * 2;
         let timestamp_writes = match &self.queries {
@@ -320,16 +338,27 @@ impl<'a> GpuRounds<'a> {
         });
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bg, &[]);
-        pass.dispatch_workgroups(x, y, 1);
+        match grid {
+            Grid::Direct(groups) => {
+                let (x, y) = split(groups);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            Grid::Indirect(offset) => pass.dispatch_workgroups_indirect(&self.dispatch, offset),
+        }
     }
 
     /// Exclusive prefix sum of `data` (n + 1 values; `scan` holds n) in three passes.
     fn prefix_sum(&mut self, enc: &mut wgpu::CommandEncoder, scan: &str, data: &str, n: u32) {
         let (s, d, b) = (self.buf(scan), self.buf(data), self.block_sums.clone());
         let blocks = n.div_ceil(SCAN_BLOCK).max(1);
-        self.pass(enc, "prefix_sum_reduce", &[&s, &d, &b], blocks);
-        self.pass(enc, "prefix_sum_spine", &[&s, &d, &b], 1);
-        self.pass(enc, "prefix_sum_apply", &[&s, &d, &b], blocks);
+        self.pass(
+            enc,
+            "prefix_sum_reduce",
+            &[&s, &d, &b],
+            Grid::Direct(blocks),
+        );
+        self.pass(enc, "prefix_sum_spine", &[&s, &d, &b], ONE);
+        self.pass(enc, "prefix_sum_apply", &[&s, &d, &b], Grid::Direct(blocks));
     }
 
     fn buf(&self, name: &str) -> wgpu::Buffer {
@@ -407,6 +436,7 @@ impl<'a> GpuRounds<'a> {
             "vertex_keep" => &self.vertex_keep,
             "face_keep" => &self.face_keep,
             "draw_args" => &self.draw_args,
+            "dispatch" => &self.dispatch,
             _ => return Err(Error::Internal(format!("no GPU buffer named {name}"))),
         };
         self.read(b, bytes)
@@ -567,6 +597,13 @@ impl RoundRunner for GpuRounds<'_> {
             &[&params, &idx, &offsets, &vf, &eoff, &edges],
             wg(nv),
         );
+        let dispatch = c(&self.dispatch);
+        self.pass(
+            &mut enc,
+            "dispatch_args",
+            &[&params, &eoff, &counters, &dispatch],
+            ONE,
+        );
         enc.clear_buffer(&hist, 0, None);
         self.pass(
             &mut enc,
@@ -575,9 +612,9 @@ impl RoundRunner for GpuRounds<'_> {
                 &params, &pos, &quad, &flags, &idx, &offsets, &vf, &fnorm, &edges, &eoff, &cand,
                 &est, &hist, &counters,
             ],
-            wg(cap),
+            PER_EDGE,
         );
-        self.pass(&mut enc, "cost_ceiling", &[&params, &hist, &counters], 1);
+        self.pass(&mut enc, "cost_ceiling", &[&params, &hist, &counters], ONE);
         enc.clear_buffer(&flock, 0, None);
         for _ in 0..self.selection_passes {
             enc.clear_buffer(&fbest, 0, None);
@@ -590,7 +627,7 @@ impl RoundRunner for GpuRounds<'_> {
                 &[
                     &params, &offsets, &vf, &edges, &eoff, &cand, &flock, &counters, &est, &fbest,
                 ],
-                wg(cap),
+                PER_EDGE,
             );
             self.pass(
                 &mut enc,
@@ -598,7 +635,7 @@ impl RoundRunner for GpuRounds<'_> {
                 &[
                     &params, &offsets, &vf, &edges, &eoff, &cand, &fbest, &est, &fid,
                 ],
-                wg(cap),
+                PER_EDGE,
             );
             self.pass(
                 &mut enc,
@@ -607,7 +644,13 @@ impl RoundRunner for GpuRounds<'_> {
                     &params, &offsets, &vf, &edges, &eoff, &cand, &fbest, &fid, &est, &tent,
                     &counters,
                 ],
-                wg(cap),
+                PER_EDGE,
+            );
+            self.pass(
+                &mut enc,
+                "dispatch_args",
+                &[&params, &eoff, &counters, &dispatch],
+                ONE,
             );
             self.pass(
                 &mut enc,
@@ -616,7 +659,7 @@ impl RoundRunner for GpuRounds<'_> {
                     &params, &flags, &idx, &offsets, &vf, &edges, &tent, &cand, &est, &flock,
                     &counters,
                 ],
-                wg(cap),
+                PER_TENTATIVE,
             );
         }
         if p.trim != 0 {
@@ -625,9 +668,9 @@ impl RoundRunner for GpuRounds<'_> {
                 &mut enc,
                 "trim_histogram",
                 &[&params, &cand, &est, &eoff, &hist],
-                wg(cap),
+                PER_EDGE,
             );
-            self.pass(&mut enc, "trim_ceiling", &[&params, &hist, &counters], 1);
+            self.pass(&mut enc, "trim_ceiling", &[&params, &hist, &counters], ONE);
             self.pass(
                 &mut enc,
                 "trim_mark",
@@ -639,14 +682,14 @@ impl RoundRunner for GpuRounds<'_> {
                 &mut enc,
                 "trim_apply",
                 &[&params, &cand, &marks, &counters, &eoff, &est],
-                wg(cap),
+                PER_EDGE,
             );
         }
         self.pass(
             &mut enc,
             "collapse",
             &[&params, &cand, &est, &eoff, &pos, &quad, &flags, &remap],
-            wg(cap),
+            PER_EDGE,
         );
         self.pass(
             &mut enc,
@@ -676,7 +719,7 @@ impl RoundRunner for GpuRounds<'_> {
             &mut enc,
             "draw_args",
             &[&params, &vkeep, &fkeep, &counters, &draw],
-            1,
+            ONE,
         );
 
         enc.copy_buffer_to_buffer(&counters, 0, &self.readback, 0, 64);

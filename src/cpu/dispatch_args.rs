@@ -1,0 +1,25 @@
+//! Twin of shaders/dispatch_args.wgsl: the indirect dispatch sizes of the per-edge stages and of
+//! `validate`. The CPU runs loops of the exact length; this twin exists so tests can diff the GPU
+//! stage.
+
+use super::edge_costs::{CounterField, counter};
+use crate::gpu::types::{Params, WG};
+use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+
+fn grid(n: u32) -> [u32; 4] {
+    let groups = n.div_ceil(WG).max(1);
+    let x = groups.min(65535);
+    [x, groups.div_ceil(x), 1, 0]
+}
+
+pub fn dispatch_args(
+    params: &Params,
+    edge_offsets: &[u32],
+    counters: &[AtomicU32],
+    args: &mut [u32; 8],
+) {
+    let edges = grid(edge_offsets[params.vertex_count as usize]);
+    let tentative = grid(counter(counters, CounterField::Tentative).load(Relaxed));
+    args[..4].copy_from_slice(&edges);
+    args[4..].copy_from_slice(&tentative);
+}
