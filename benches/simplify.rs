@@ -1,4 +1,5 @@
-//! Every backend of `meshslim bench` (`meshslim::bench::BACKENDS`: meshslim's greedy `cpu`,
+//! Every backend of `meshslim bench` this machine can run (`meshslim::bench::available_backends`:
+//! meshslim's greedy `cpu`, its rounds on `cpu-parallel` and — with an adapter — `gpu`,
 //! meshoptimizer's `simplify` and `simplifySloppy`) on the same meshes, through the same calls.
 //!
 //! Inputs: horse.ply and igea.ply from the models folder when present (see
@@ -42,7 +43,7 @@ fn simplify(c: &mut Criterion) {
                 .sampling_mode(SamplingMode::Flat)
                 .warm_up_time(Duration::from_millis(500))
                 .measurement_time(Duration::from_secs(if faces > 500_000 { 40 } else { 5 }));
-            for backend in bench::BACKENDS {
+            for backend in bench::available_backends() {
                 group.bench_function(BenchmarkId::from_parameter(backend.name), |b| {
                     b.iter(|| (backend.simplify)(mesh, opts.target_faces).expect("simplify"))
                 });
