@@ -186,6 +186,18 @@ fn quadric_optimum(q: Quadric) -> Optimum {
     return Optimum(true, y);
 }
 
+// Quality from |cross| already at hand (the flip test computes it). Twin of quality_from_area2.
+fn quality_from_area2(area2: f32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> f32 {
+    let d10 = p1 - p0;
+    let d20 = p2 - p0;
+    let d12 = p1 - p2;
+    let longest = max(max(dot(d10, d10), dot(d20, d20)), dot(d12, d12));
+    if (longest > 0.0) {
+        return area2 / longest;
+    }
+    return 0.0;
+}
+
 fn triangle_quality(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> f32 {
     let d10 = p1 - p0;
     let d20 = p2 - p0;

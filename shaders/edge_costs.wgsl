@@ -97,7 +97,7 @@ fn evaluate(a: u32, b: u32) -> Verdict {
             if (l_old > 0.0 && dot(n_old, n_new) < params.cos_max_angle * l_old * l_new) { return invalid(); }
             let fr = face_normals[f];
             if (fr.w > 0.0 && dot(fr.xyz, n_new) < params.cos_max_angle * l_new) { return invalid(); }
-            let q_new = triangle_quality(n0, n1, n2);
+            let q_new = quality_from_area2(l_new, n0, n1, n2);
             if (q_new < params.min_quality && q_new < triangle_quality(o0, o1, o2)) { return invalid(); }
             min_q = min(min_q, q_new);
         }

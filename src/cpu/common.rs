@@ -146,6 +146,16 @@ pub fn quadric_optimum(q: &Quadric) -> Option<V3> {
     y.iter().all(|x| x.is_finite()).then_some(y)
 }
 
+/// Quality from |cross| already at hand (the flip test computes it): the same value as
+/// [`triangle_quality`], one cross product and square root fewer.
+pub fn quality_from_area2(area2: f32, p0: V3, p1: V3, p2: V3) -> f32 {
+    let d10 = sub(p1, p0);
+    let d20 = sub(p2, p0);
+    let d12 = sub(p1, p2);
+    let longest = dot(d10, d10).max(dot(d20, d20)).max(dot(d12, d12));
+    if longest > 0.0 { area2 / longest } else { 0.0 }
+}
+
 /// |cross| / longest edge²: 0 for a needle, √3/2 for an equilateral triangle (vcglib's measure,
 /// as `crate::greedy::triangle_quality`).
 pub fn triangle_quality(p0: V3, p1: V3, p2: V3) -> f32 {

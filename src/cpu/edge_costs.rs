@@ -112,7 +112,7 @@ pub fn placement(
             if fr[3] > 0.0 && dot(xyz(fr), n_new) < params.cos_max_angle * l_new {
                 return Verdict::Invalid;
             }
-            let q_new = triangle_quality(new[0], new[1], new[2]);
+            let q_new = quality_from_area2(l_new, new[0], new[1], new[2]);
             if q_new < params.min_quality && q_new < triangle_quality(old[0], old[1], old[2]) {
                 return Verdict::Invalid;
             }
