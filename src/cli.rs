@@ -114,6 +114,93 @@ pub enum Command {
     /// Time every backend on the same meshes and measure their error: a table, JSON and a plot
     #[command(after_help = BENCH_AFTER_HELP)]
     Bench(BenchArgs),
+    /// Look at a mesh simplified on the GPU, drawn from the simplifier's own buffers (today: one
+    /// frame to a PNG with --screenshot; works without a window system)
+    #[command(after_help = VIEW_AFTER_HELP)]
+    View(ViewArgs),
+}
+
+const VIEW_AFTER_HELP: &str = "\
+Examples:
+  meshslim view ../shared/models/horse.ply --screenshot horse.png --ratio 0.1
+  meshslim view scan.ply --screenshot err.png --ratio 0.01 --mode heatmap --size 1600x1200";
+
+#[derive(Debug, Args)]
+pub struct ViewArgs {
+    /// The mesh: a file or builtin:NAME[:FACES]
+    #[arg(value_name = "MESH", value_parser = parse_input_arg)]
+    pub input: Input,
+
+    /// Render one frame to this PNG file and exit (the interactive window is not built yet)
+    #[arg(long, value_name = "FILE.png")]
+    pub screenshot: Option<PathBuf>,
+
+    /// Simplify to this fraction of the faces on the GPU first, in (0, 1]; 1 draws the mesh as is
+    #[arg(long, value_name = "R", default_value_t = 1.0, value_parser = parse_ratio)]
+    pub ratio: f64,
+
+    /// What the surface shows
+    #[arg(long, value_enum, default_value_t = crate::viewer::Mode::Shaded)]
+    pub mode: crate::viewer::Mode,
+
+    /// Image size, WIDTHxHEIGHT
+    #[arg(long, value_name = "WxH", default_value = "1024x768", value_parser = parse_size)]
+    pub size: (u32, u32),
+}
+
+fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let bad = || format!("{s:?}: write the size as WIDTHxHEIGHT, e.g. 1024x768");
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let (w, h) = (w.trim().parse::<u32>(), h.trim().parse::<u32>());
+    match (w, h) {
+        (Ok(w), Ok(h)) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => Ok((w, h)),
+        _ => Err(bad()),
+    }
+}
+
+fn run_view(args: ViewArgs) -> Result<ExitCode> {
+    let Some(png) = args.screenshot else {
+        return Err(UsageError(
+            "the interactive viewer window is not built yet; render a frame with \
+             --screenshot FILE.png"
+                .into(),
+        )
+        .into());
+    };
+    if !png
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+    {
+        return Err(UsageError(format!(
+            "{}: the screenshot is a PNG; name it FILE.png",
+            png.display()
+        ))
+        .into());
+    }
+    let progress = Progress::new(std::io::stderr().is_terminal());
+    let mesh = load(&args.input, &progress)?;
+    let frame = progress
+        .spinner("simplifying and rendering on the GPU".to_string(), || {
+            crate::viewer::screenshot(&mesh, args.ratio, args.mode, args.size)
+        })
+        .map_err(lib)?;
+    crate::io::write_atomic(&png, |w| w.write_all(&frame.png))
+        .map_err(lib)
+        .context("cannot write the screenshot")?;
+    let heat = if args.mode == crate::viewer::Mode::Heatmap {
+        format!(", heatmap red at {:.3e} of the diagonal", frame.max_error)
+    } else {
+        String::new()
+    };
+    println!(
+        "{}: {} faces drawn from the GPU buffers on {}, {}x{}{heat}",
+        png.display(),
+        frame.faces,
+        frame.adapter,
+        args.size.0,
+        args.size.1
+    );
+    Ok(ExitCode::SUCCESS)
 }
 
 /// A mesh to read: a file, or a generated mesh `builtin:NAME[:FACES]`.
@@ -579,6 +666,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Some(Command::Info(args)) => run_info(args),
         Some(Command::Compare(args)) => run_compare(args),
         Some(Command::Bench(args)) => run_bench(args),
+        Some(Command::View(args)) => run_view(args),
     }
 }
 

@@ -41,6 +41,7 @@ pub mod metrics;
 pub mod parallel;
 pub mod quadric;
 pub mod simplify;
+pub mod viewer;
 
 pub use error::{Error, Location, Result};
 pub use mesh::{Aabb, Material, Mesh};

@@ -275,6 +275,14 @@ impl<'a> GpuRounds<'a> {
             selection_passes,
             transfer_seconds: 0.0,
         };
+        // Draw arguments for the mesh as uploaded: a renderer can draw it before any round.
+        let args = DrawArgs {
+            index_count: up.indices.len() as u32,
+            instance_count: 1,
+            ..Default::default()
+        };
+        sim.queue
+            .write_buffer(&r.draw_args, 0, bytemuck::bytes_of(&args));
         sim.errors.check("uploading the mesh")?;
         let mut r = r;
         r.transfer_seconds += t.elapsed().as_secs_f64();

@@ -113,6 +113,31 @@ pub fn write_format(
     options: &WriteOptions,
 ) -> Result<()> {
     mesh.validate()?;
+    write_atomic(path, |w| match format {
+        Format::Obj => obj::write_obj(w, mesh),
+        Format::Ply => ply::write_ply(
+            w,
+            mesh,
+            if options.ply_ascii {
+                ply::PlyEncoding::Ascii
+            } else {
+                ply::PlyEncoding::BinaryLittleEndian
+            },
+        ),
+        Format::Stl if options.stl_ascii => stl::write_ascii(w, mesh),
+        Format::Stl => stl::write_binary(w, mesh),
+        Format::Gltf => gltf::write_gltf(w, mesh, false),
+        Format::Glb => gltf::write_gltf(w, mesh, true),
+    })
+}
+
+/// Writes a file atomically: `fill` writes into a temporary file in the same directory, which
+/// then replaces `path` by a rename, so a reader never sees half a file and a failure leaves the
+/// old one in place.
+pub fn write_atomic(
+    path: &Path,
+    fill: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> std::io::Result<()>,
+) -> Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -124,23 +149,9 @@ pub fn write_format(
         .map_err(|e| Error::io(path, e))?;
     {
         let mut w = BufWriter::with_capacity(1 << 16, tmp.as_file_mut());
-        let r = match format {
-            Format::Obj => obj::write_obj(&mut w, mesh),
-            Format::Ply => ply::write_ply(
-                &mut w,
-                mesh,
-                if options.ply_ascii {
-                    ply::PlyEncoding::Ascii
-                } else {
-                    ply::PlyEncoding::BinaryLittleEndian
-                },
-            ),
-            Format::Stl if options.stl_ascii => stl::write_ascii(&mut w, mesh),
-            Format::Stl => stl::write_binary(&mut w, mesh),
-            Format::Gltf => gltf::write_gltf(&mut w, mesh, false),
-            Format::Glb => gltf::write_gltf(&mut w, mesh, true),
-        };
-        r.and_then(|()| w.flush()).map_err(|e| Error::io(path, e))?;
+        fill(&mut w)
+            .and_then(|()| w.flush())
+            .map_err(|e| Error::io(path, e))?;
     }
     tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
     // A temporary file is created private (0600); give the result the permissions the target had,

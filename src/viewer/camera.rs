@@ -1,0 +1,143 @@
+//! An orbit camera in the mesh's normalized frame (centred, unit bounding-box diagonal): a target,
+//! a distance and two angles. Orbiting keeps the distance; framing fits the bounding sphere.
+
+use glam::{Mat4, Vec3};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Camera {
+    pub target: Vec3,
+    pub distance: f32,
+    /// Around the vertical axis, radians.
+    pub yaw: f32,
+    /// Above the horizontal plane, radians, kept inside (-90°, 90°).
+    pub pitch: f32,
+    /// Vertical field of view, radians.
+    pub fov_y: f32,
+    /// Turns the mesh before viewing (see [`Camera::upright`]).
+    pub model: Mat4,
+}
+
+const PITCH_LIMIT: f32 = 1.55;
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera {
+            target: Vec3::ZERO,
+            distance: 2.0,
+            yaw: 0.6,
+            pitch: 0.35,
+            fov_y: 45f32.to_radians(),
+            model: Mat4::IDENTITY,
+        }
+    }
+}
+
+impl Camera {
+    pub fn eye(&self) -> Vec3 {
+        let dir = Vec3::new(
+            self.pitch.cos() * self.yaw.sin(),
+            self.pitch.sin(),
+            self.pitch.cos() * self.yaw.cos(),
+        );
+        self.target + dir * self.distance
+    }
+
+    /// Turns around the target by the given angles; the distance stays.
+    pub fn orbit(&mut self, d_yaw: f32, d_pitch: f32) {
+        self.yaw += d_yaw;
+        self.pitch = (self.pitch + d_pitch).clamp(-PITCH_LIMIT, PITCH_LIMIT);
+    }
+
+    /// Moves toward the target by a factor (< 1 closer), never through it.
+    pub fn zoom(&mut self, factor: f32) {
+        self.distance = (self.distance * factor).max(1e-4);
+    }
+
+    /// Looks at a sphere of `radius` around `center` so that it fills the view.
+    pub fn fit(&mut self, center: Vec3, radius: f32, aspect: f32) {
+        self.target = center;
+        let half_v = 0.5 * self.fov_y;
+        let half_h = (half_v.tan() * aspect.max(1e-3)).atan();
+        let half = half_v.min(half_h);
+        self.distance = radius / half.sin() * 1.05;
+    }
+
+    pub fn view_proj(&self, aspect: f32) -> Mat4 {
+        let near = (self.distance * 0.01).max(1e-5);
+        let far = self.distance * 10.0 + 10.0;
+        let proj = Mat4::perspective_rh(self.fov_y, aspect, near, far);
+        proj * Mat4::look_at_rh(self.eye(), self.target, Vec3::Y) * self.model
+    }
+
+    /// A rotation that shows a box of these `extent`s by its largest silhouette: the longest
+    /// axis across the screen, the middle one up, the shortest toward the viewer — a scan of a
+    /// horse or a statue is seen from the side whichever axis its file calls up.
+    pub fn upright(extent: Vec3) -> Mat4 {
+        let mut axes = [
+            (extent.x, Vec3::X),
+            (extent.y, Vec3::Y),
+            (extent.z, Vec3::Z),
+        ];
+        axes.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let (across, up) = (axes[0].1, axes[1].1);
+        let toward = across.cross(up);
+        // Rows map the mesh's axes onto screen x, y, z.
+        Mat4::from_cols(
+            Vec3::new(across.x, up.x, toward.x).extend(0.0),
+            Vec3::new(across.y, up.y, toward.y).extend(0.0),
+            Vec3::new(across.z, up.z, toward.z).extend(0.0),
+            glam::Vec4::W,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orbit_keeps_the_target_distance() {
+        let mut c = Camera::default();
+        let d0 = (c.eye() - c.target).length();
+        c.orbit(1.3, -0.4);
+        c.orbit(-3.0, 2.0); // pitch clamps below the pole
+        assert!(((c.eye() - c.target).length() - d0).abs() < 1e-5);
+        assert!(c.pitch <= PITCH_LIMIT);
+    }
+
+    #[test]
+    fn upright_shows_the_largest_silhouette() {
+        // Long in z, tall in x, thin in y: z goes across, x up, y toward the viewer.
+        let m = Camera::upright(Vec3::new(0.5, 0.1, 0.8));
+        assert!((m.transform_vector3(Vec3::Z) - Vec3::X).length() < 1e-6);
+        assert!((m.transform_vector3(Vec3::X) - Vec3::Y).length() < 1e-6);
+        assert!((m.transform_vector3(Vec3::Y).abs() - Vec3::Z).length() < 1e-6);
+        assert!(
+            (m.determinant() - 1.0).abs() < 1e-6,
+            "a rotation, not a mirror"
+        );
+    }
+
+    #[test]
+    fn fit_frames_the_bounding_box() {
+        for aspect in [0.5f32, 1.0, 2.0] {
+            let mut c = Camera::default();
+            let (lo, hi) = (Vec3::new(-0.4, -0.2, -0.1), Vec3::new(0.3, 0.25, 0.2));
+            let center = 0.5 * (lo + hi);
+            c.fit(center, 0.5 * (hi - lo).length(), aspect);
+            let vp = c.view_proj(aspect);
+            for i in 0..8 {
+                let p = Vec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                );
+                let q = vp.project_point3(p);
+                assert!(
+                    q.x.abs() <= 1.0 && q.y.abs() <= 1.0 && (0.0..=1.0).contains(&q.z),
+                    "{aspect}: {q}"
+                );
+            }
+        }
+    }
+}
