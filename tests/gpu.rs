@@ -185,7 +185,7 @@ fn each_stage_matches_its_cpu_twin() {
             "{name}: faces on each validated edge"
         );
         // collapse, compact_*, draw_args
-        cpu.apply_and_compact(&p, ne as u32);
+        cpu.apply_and_compact(&p);
         assert_eq!(pod::<u32>(rd("remap", 4 * nv)), cpu.remap, "{name}: remap");
         assert_eq!(
             gc.faces_out as usize * 3,

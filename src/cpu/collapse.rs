@@ -12,13 +12,13 @@ pub fn collapse(
     params: &Params,
     candidates: &[EdgeCandidate], // per edge
     edge_state: &[u32],           // per edge
-    edge_count: u32,
+    edge_offsets: &[u32],         // per vertex + 1: the edge count at [vertex_count]
     positions: Scatter<[f32; 4]>, // per vertex
     quadrics: Scatter<Quadric>,   // per vertex
     flags: Scatter<u32>,          // per vertex
     remap: Scatter<u32>,          // per vertex
 ) {
-    let _ = params;
+    let edge_count = edge_offsets[params.vertex_count as usize];
     par_for(edge_count, |e| {
         if edge_state[e as usize] != state::WON {
             return;

@@ -378,7 +378,7 @@ impl CpuRounds {
                     p,
                     &s.candidates,
                     &s.edge_state,
-                    ne,
+                    &s.edge_offsets,
                     atomics(&mut s.histogram),
                 )
             });
@@ -391,7 +391,7 @@ impl CpuRounds {
                     p,
                     &s.candidates,
                     &s.edge_state,
-                    ne,
+                    &s.edge_offsets,
                     atomics(&mut s.counters),
                     &mut s.marks,
                 )
@@ -405,21 +405,21 @@ impl CpuRounds {
                     &s.candidates,
                     &s.marks,
                     atomics(&mut s.counters),
-                    ne,
+                    &s.edge_offsets,
                     &mut s.edge_state,
                 )
             });
         }
     }
 
-    pub fn apply_and_compact(&mut self, p: &Params, ne: u32) {
+    pub fn apply_and_compact(&mut self, p: &Params) {
         let (nv, nf) = (p.vertex_count as usize, p.face_count as usize);
         self.time("collapse", |s| {
             collapse::collapse(
                 p,
                 &s.candidates,
                 &s.edge_state,
-                ne,
+                &s.edge_offsets,
                 Scatter::new(&mut s.positions),
                 Scatter::new(&mut s.quadrics),
                 Scatter::new(&mut s.flags),
@@ -508,7 +508,7 @@ impl RoundRunner for CpuRounds {
         let ne = self.build_edges(p);
         self.costs(p, ne);
         self.select(p, ne);
-        self.apply_and_compact(p, ne);
+        self.apply_and_compact(p);
         Ok(*bytemuck::from_bytes::<Counters>(bytemuck::cast_slice(
             &self.counters,
         )))

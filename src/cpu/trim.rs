@@ -14,10 +14,10 @@ pub fn trim_histogram(
     params: &Params,
     candidates: &[EdgeCandidate],
     edge_state: &[u32],
-    edge_count: u32,
+    edge_offsets: &[u32], // per vertex + 1: the edge count at [vertex_count]
     histogram: &[AtomicU32],
 ) {
-    let _ = params;
+    let edge_count = edge_offsets[params.vertex_count as usize];
     par_for(edge_count, |e| {
         if edge_state[e as usize] == state::WON {
             let c = &candidates[e as usize];
@@ -53,10 +53,11 @@ pub fn trim_mark(
     params: &Params,
     candidates: &[EdgeCandidate],
     edge_state: &[u32],
-    edge_count: u32,
+    edge_offsets: &[u32], // per vertex + 1: the edge count at [vertex_count]
     counters: &[AtomicU32],
     marks: &mut [u32],
 ) {
+    let edge_count = edge_offsets[params.vertex_count as usize];
     let trim_bin = counter(counters, CounterField::TrimBin).load(Relaxed);
     par_for_mut(&mut marks[..params.edge_capacity as usize], |e, m| {
         let eu = e as usize;
@@ -77,10 +78,10 @@ pub fn trim_apply(
     candidates: &[EdgeCandidate],
     marks: &[u32],
     counters: &[AtomicU32],
-    edge_count: u32,
+    edge_offsets: &[u32], // per vertex + 1: the edge count at [vertex_count]
     edge_state: &mut [u32],
 ) {
-    let _ = params;
+    let edge_count = edge_offsets[params.vertex_count as usize];
     let trim_bin = counter(counters, CounterField::TrimBin).load(Relaxed);
     let budget = counter(counters, CounterField::TrimBudget).load(Relaxed);
     par_for_mut(&mut edge_state[..edge_count as usize], |e, st| {

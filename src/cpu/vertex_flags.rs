@@ -19,7 +19,7 @@ fn fan_size(indices: &[u32], list: &[u32], v: u32) -> usize {
     let t = face_of(indices, first);
     let others: Vec<u32> = t.iter().copied().filter(|&u| u != v).collect();
     let mut visited = 1;
-    for (dir, &start) in others.iter().enumerate() {
+    for &start in &others {
         let (mut cur, mut through) = (first, start);
         for _ in 0..list.len() {
             let next = list
@@ -38,7 +38,6 @@ fn fan_size(indices: &[u32], list: &[u32], v: u32) -> usize {
                 .unwrap_or(v);
             cur = g;
         }
-        let _ = dir;
     }
     visited
 }
