@@ -1,5 +1,6 @@
-// Counts each vertex's edges to higher-id neighbours (first occurrence in its sorted face list)
-// and resets its collapse remap to itself. Relies on sorted face lists for stable edge ids.
+// Lists each vertex's higher-id neighbours (first occurrence in its sorted face list) into two
+// slots per corner of its list, counts them, and resets its collapse remap to itself. Relies on
+// sorted face lists for stable edge ids; a face adds at most two neighbours.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> indices: array<u32>;          // per face × 3
@@ -7,6 +8,7 @@
 @group(0) @binding(3) var<storage, read> vertex_faces: array<u32>;     // per corner
 @group(0) @binding(4) var<storage, read_write> edge_counts: array<u32>; // per vertex + 1
 @group(0) @binding(5) var<storage, read_write> remap: array<u32>;       // per vertex
+@group(0) @binding(6) var<storage, read_write> neighbours: array<u32>;  // 2 per corner
 
 @compute @workgroup_size(256)
 fn edges_count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -20,7 +22,10 @@ fn edges_count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     for (var i = lo; i < hi; i = i + 1u) {
         let t = face_of(vertex_faces[i]);
         for (var k = 0u; k < 3u; k = k + 1u) {
-            if (t[k] > v && !list_has(lo, i, t[k])) { n = n + 1u; }
+            if (t[k] > v && !list_has(lo, i, t[k])) {
+                neighbours[2u * lo + n] = t[k];
+                n = n + 1u;
+            }
         }
     }
     edge_counts[v] = n;

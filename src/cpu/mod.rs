@@ -150,6 +150,7 @@ pub struct CpuRounds {
     pub face_keep: Vec<u32>,
     pub marks: Vec<u32>,
     pub tentative: Vec<u32>,
+    pub neighbours: Vec<u32>,
     pub block_sums: Vec<u32>,
     pub counters: Vec<u32>,
     pub draw: DrawArgs,
@@ -244,13 +245,15 @@ impl CpuRounds {
         self.time("edges_count", |s| {
             reset(&mut s.edge_offsets, nv + 1);
             s.remap.resize(nv, 0);
+            s.neighbours.resize(2 * s.vertex_faces.len(), 0);
             edges::edges_count(
                 p,
                 &s.indices,
                 &s.offsets,
                 &s.vertex_faces,
-                &mut s.edge_offsets,
-                &mut s.remap,
+                Scatter::new(&mut s.edge_offsets),
+                Scatter::new(&mut s.remap),
+                Scatter::new(&mut s.neighbours),
             );
         });
         let ne = self.time("prefix_sum", |s| {
@@ -260,9 +263,8 @@ impl CpuRounds {
             s.edges.resize(ne as usize, [0; 2]);
             edges::edges_fill(
                 p,
-                &s.indices,
                 &s.offsets,
-                &s.vertex_faces,
+                &s.neighbours,
                 &s.edge_offsets,
                 Scatter::new(&mut s.edges),
             );

@@ -125,6 +125,7 @@ pub struct GpuRounds<'a> {
     marks: wgpu::Buffer,
     tentative: wgpu::Buffer,
     dispatch: wgpu::Buffer,
+    neighbours: wgpu::Buffer,
     block_sums: wgpu::Buffer,
     counters: wgpu::Buffer,
     readback: wgpu::Buffer,
@@ -262,6 +263,7 @@ impl<'a> GpuRounds<'a> {
             marks: mk("marks", (cap + 1) * 4, SU)?,
             tentative: mk("tentative", cap * 4, SU)?,
             dispatch: mk("dispatch", 32, SU | wgpu::BufferUsages::INDIRECT)?,
+            neighbours: mk("neighbours", nf * 24, SU)?,
             block_sums: mk("block_sums", blocks * 4, SU)?,
             counters: mk("counters", 64, SU)?,
             readback: mk(
@@ -549,6 +551,7 @@ impl RoundRunner for GpuRounds<'_> {
         );
         let draw = c(&self.draw_args);
         let tent = c(&self.tentative);
+        let nbrs = c(&self.neighbours);
 
         enc.clear_buffer(&counters, 0, None);
         enc.clear_buffer(&offsets, 0, None);
@@ -595,14 +598,14 @@ impl RoundRunner for GpuRounds<'_> {
         self.pass(
             &mut enc,
             "edges_count",
-            &[&params, &idx, &offsets, &vf, &eoff, &remap],
+            &[&params, &idx, &offsets, &vf, &eoff, &remap, &nbrs],
             wg(nv),
         );
         self.prefix_sum(&mut enc, "scan_v", "edge_offsets", nv);
         self.pass(
             &mut enc,
             "edges_fill",
-            &[&params, &idx, &offsets, &vf, &eoff, &edges],
+            &[&params, &offsets, &nbrs, &eoff, &edges],
             wg(nv),
         );
         let dispatch = c(&self.dispatch);
