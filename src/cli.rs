@@ -50,6 +50,9 @@ Examples:
   meshslim simplify builtin:bumpy-sphere bumpy-10.ply --ratio 0.1
   # a real file to 5000 faces, with the collapse statistics
   meshslim simplify scan.ply scan-5k.obj --faces 5000 --stats
+  # on the GPU when there is one (else the same rounds on the CPU's cores), with the
+  # rounds and per-stage times
+  meshslim simplify scan.ply scan-1.ply --ratio 0.01 --backend auto --stats
   # keep the outline of an open mesh exactly
   meshslim simplify terrain.obj terrain-small.obj --ratio 0.05 --lock-border
   # simplify as far as an error of 0.1% of the bounding-box diagonal allows
