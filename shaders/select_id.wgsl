@@ -1,5 +1,5 @@
-// Selection pass, step 2: among the candidates whose cost is the best at a face, the lowest tie rank
-// (a hash of the edge id) wins the face (atomicMax of the inverted rank). Relies on face_id being cleared.
+// Selection pass, step 2: among the candidates whose cost is the best at every face around them,
+// the lowest tie rank (a hash of the edge id) wins each face (atomicMax of the inverted rank). Relies on face_id being cleared.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> offsets: array<u32>;             // per vertex + 1
@@ -19,13 +19,18 @@ fn select_id(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     }
     let inv = ~candidates[e].cost_bits;
     let ab = edges[e];
+    // Only an edge with the best cost at every face around it can win; the others need not
+    // post their rank (a winner is still the only one best at each of its faces).
     for (var s = 0u; s < 2u; s = s + 1u) {
         let v = ab[s];
         for (var i = offsets[v]; i < offsets[v + 1u]; i = i + 1u) {
-            let f = vertex_faces[i];
-            if (face_best[f] == inv) {
-                atomicMax(&face_id[f], ~tie_rank(e));
-            }
+            if (face_best[vertex_faces[i]] != inv) { return; }
+        }
+    }
+    for (var s = 0u; s < 2u; s = s + 1u) {
+        let v = ab[s];
+        for (var i = offsets[v]; i < offsets[v + 1u]; i = i + 1u) {
+            atomicMax(&face_id[vertex_faces[i]], ~tie_rank(e));
         }
     }
 }

@@ -84,10 +84,15 @@ pub fn select_id(
             return;
         }
         let inv = !candidates[eu].cost_bits;
+        // Only an edge with the best cost at every face around it can win; the others need not
+        // post their rank (a winner is still the only one best at each of its faces).
+        if !around(offsets, vertex_faces, edges[eu])
+            .all(|f| face_best[f as usize].load(Relaxed) == inv)
+        {
+            return;
+        }
         for f in around(offsets, vertex_faces, edges[eu]) {
-            if face_best[f as usize].load(Relaxed) == inv {
-                face_id[f as usize].fetch_max(!tie_rank(e), Relaxed);
-            }
+            face_id[f as usize].fetch_max(!tie_rank(e), Relaxed);
         }
     });
 }
