@@ -302,7 +302,11 @@ fn gpu_mesh_is_drawable_from_the_simplifier_buffers() {
     let mut rounds = GpuRounds::new(&sim, &up, SELECTION_PASSES).unwrap();
     let driven = meshslim::parallel::drive(&mut rounds, &up, &opts, &mut |_| {}).unwrap();
     let faces = up.face_count() - driven.removed.iter().sum::<usize>();
-    assert_eq!(faces, opts.target_faces);
+    // On the target or one above (an interior collapse removes two faces).
+    assert!(
+        (opts.target_faces..=opts.target_faces + 1).contains(&faces),
+        "{faces} faces"
+    );
     let args: DrawArgs = *bytemuck::from_bytes(&rounds.read_buffer("draw_args", 20).unwrap());
     assert_eq!(
         (args.index_count as usize, args.instance_count),
