@@ -774,8 +774,9 @@ fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     };
     opts.backend = match args.backend.fixed() {
         Some(b) => b,
-        None => match crate::gpu::GpuContext::new() {
-            Ok(ctx) => {
+        // The process's shared device: the adapter found here is the one that simplifies.
+        None => match crate::gpu::shared() {
+            Ok((ctx, _)) => {
                 say(format!("backend auto: gpu on {}", ctx.adapter_name));
                 Backend::Gpu
             }

@@ -7,23 +7,9 @@ mod common;
 use common::*;
 use meshslim::cpu::CpuRounds;
 use meshslim::gpu::types::*;
-use meshslim::gpu::{GpuContext, GpuRounds, GpuSimplifier};
+use meshslim::gpu::{GpuRounds, GpuSimplifier};
 use meshslim::parallel::{RoundRunner, SELECTION_PASSES, Upload};
 use meshslim::{Backend, Mesh, SimplifyOptions, simplify};
-
-/// The device, or None (with a note) when this machine has no adapter outside CI.
-fn context() -> Option<GpuContext> {
-    match GpuContext::new() {
-        Ok(c) => Some(c),
-        Err(e) if std::env::var("CI").is_ok_and(|v| v == "true") => {
-            panic!("CI=true but no GPU adapter: {e}")
-        }
-        Err(e) => {
-            eprintln!("note: GPU tests skipped, no adapter: {e}");
-            None
-        }
-    }
-}
 
 fn pod<T: bytemuck::Pod>(bytes: Vec<u8>) -> Vec<T> {
     bytemuck::pod_collect_to_vec(&bytes)
@@ -39,7 +25,7 @@ fn close(a: f32, b: f32, tol: f32) -> bool {
 /// comparison of the later stages fail for a reason that is not theirs.
 #[test]
 fn each_stage_matches_its_cpu_twin() {
-    let Some(ctx) = context() else { return };
+    let Some(ctx) = gpu_context() else { return };
     let sim = GpuSimplifier::new(&ctx.device, &ctx.queue).unwrap();
     for (name, m) in generated_meshes() {
         let up = Upload::new(&m);
@@ -231,7 +217,7 @@ fn run(m: &Mesh, backend: Backend, ratio: f64) -> (Mesh, meshslim::SimplifyRepor
 
 #[test]
 fn pipeline_keeps_invariants_and_agrees_with_cpu_parallel() {
-    if context().is_none() {
+    if gpu_context().is_none() {
         return;
     }
     for (name, m) in generated_meshes() {
@@ -258,7 +244,7 @@ fn pipeline_keeps_invariants_and_agrees_with_cpu_parallel() {
 
 #[test]
 fn gpu_runs_are_deterministic() {
-    if context().is_none() {
+    if gpu_context().is_none() {
         return;
     }
     let m = meshslim::mesh::noisy_sphere(4, 0.01, 3);
@@ -269,7 +255,7 @@ fn gpu_runs_are_deterministic() {
 
 #[test]
 fn gpu_report_names_adapter_and_stages() {
-    if context().is_none() {
+    if gpu_context().is_none() {
         return;
     }
     let m = meshslim::mesh::icosphere(3);
@@ -293,7 +279,7 @@ fn gpu_report_names_adapter_and_stages() {
 /// vertex buffer, indices as an index buffer, and indirect draw arguments the rounds keep current.
 #[test]
 fn gpu_mesh_is_drawable_from_the_simplifier_buffers() {
-    let Some(ctx) = context() else { return };
+    let Some(ctx) = gpu_context() else { return };
     let sim = GpuSimplifier::new(&ctx.device, &ctx.queue).unwrap();
     let m = meshslim::mesh::icosphere(3);
     let up = Upload::new(&m);

@@ -8,19 +8,6 @@ use common::*;
 use meshslim::viewer::{Mode, screenshot};
 use resvg::tiny_skia::Pixmap;
 
-fn have_gpu() -> bool {
-    match meshslim::gpu::GpuContext::new() {
-        Ok(_) => true,
-        Err(e) if std::env::var("CI").is_ok_and(|v| v == "true") => {
-            panic!("CI=true but no GPU adapter: {e}")
-        }
-        Err(e) => {
-            eprintln!("note: viewer tests skipped, no adapter: {e}");
-            false
-        }
-    }
-}
-
 const BACKGROUND: [u8; 3] = [28, 31, 36]; // the clear colour (0.11, 0.12, 0.14) in 8 bits
 
 fn is_background(px: &[u8]) -> bool {
@@ -32,7 +19,7 @@ fn is_background(px: &[u8]) -> bool {
 
 #[test]
 fn frames_cover_the_mesh_and_modes_differ() {
-    if !have_gpu() {
+    if gpu_context().is_none() {
         return;
     }
     let m = meshslim::mesh::noisy_sphere(4, 0.01, 5);
@@ -87,7 +74,7 @@ fn frames_cover_the_mesh_and_modes_differ() {
 
 #[test]
 fn screenshot_command_writes_a_png() {
-    if !have_gpu() {
+    if gpu_context().is_none() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

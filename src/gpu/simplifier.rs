@@ -27,6 +27,8 @@ pub struct GpuSimplifier {
     pub pipeline_seconds: f64,
     timestamps: bool,
     errors: ErrorSink,
+    /// The device's `max_compute_workgroups_per_dimension`, read once.
+    max_workgroups: u32,
 }
 
 impl GpuSimplifier {
@@ -68,6 +70,7 @@ impl GpuSimplifier {
             pipeline_seconds: t.elapsed().as_secs_f64(),
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
             errors,
+            max_workgroups: limits.max_compute_workgroups_per_dimension,
         })
     }
 
@@ -318,11 +321,7 @@ impl<'a> GpuRounds<'a> {
                 layout: &layout,
                 entries: &entries,
             });
-        let max_x = self
-            .sim
-            .device
-            .limits()
-            .max_compute_workgroups_per_dimension;
+        let max_x = self.sim.max_workgroups;
         let split = |groups: u32| {
             if groups <= max_x {
                 (groups, 1)

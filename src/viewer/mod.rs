@@ -8,7 +8,7 @@ pub mod camera;
 pub mod render;
 
 use crate::error::{Error, Result};
-use crate::gpu::{GpuContext, GpuRounds, GpuSimplifier};
+use crate::gpu::GpuRounds;
 use crate::mesh::Mesh;
 use crate::metrics::TriangleBvh;
 use crate::parallel::{SELECTION_PASSES, Upload, drive};
@@ -31,15 +31,14 @@ pub struct Frame {
 /// Simplifies `mesh` to `ratio` on the GPU (1 = as is) and renders one `size` frame of the
 /// result in `mode`, framed to fit, straight from the simplifier's buffers; returns a PNG.
 pub fn screenshot(mesh: &Mesh, ratio: f64, mode: Mode, size: (u32, u32)) -> Result<Frame> {
-    let ctx = GpuContext::new()?;
-    let sim = GpuSimplifier::new(&ctx.device, &ctx.queue)?;
+    let (ctx, sim) = crate::gpu::shared()?;
     let up = Upload::new(mesh);
     if up.face_count() == 0 {
         return Err(Error::InvalidMesh(
             "nothing to draw: the mesh has no faces".into(),
         ));
     }
-    let mut rounds = GpuRounds::new(&sim, &up, SELECTION_PASSES)?;
+    let mut rounds = GpuRounds::new(sim, &up, SELECTION_PASSES)?;
     let mut opts = SimplifyOptions::with_ratio(up.face_count(), ratio)?;
     opts.backend = Backend::Gpu;
     let faces = if ratio < 1.0 {
