@@ -117,34 +117,57 @@ pub enum Command {
     /// Time every backend on the same meshes and measure their error: a table, JSON and a plot
     #[command(after_help = BENCH_AFTER_HELP)]
     Bench(BenchArgs),
-    /// Look at a mesh simplified on the GPU, drawn from the simplifier's own buffers (today: one
-    /// frame to a PNG with --screenshot; works without a window system)
+    /// Look at a mesh and its simplification in a window (orbit, modes, side by side, LOD
+    /// scene), drawn from the simplifier's own GPU buffers; or one frame to a PNG with
+    /// --screenshot, which needs no window system
     #[command(after_help = VIEW_AFTER_HELP)]
     View(ViewArgs),
 }
 
 const VIEW_AFTER_HELP: &str = "\
+In the window: left drag orbits, right or middle drag pans, the wheel zooms, G flies (W A S D),
+F frames the mesh, 1-4 switch shaded / normals / heatmap / texture, X wireframe, B side by side,
+Enter simplifies to the target, Esc cancels, Ctrl+O opens, Ctrl+S saves, P takes a screenshot;
+F1 lists them all. Simplification runs beside the drawing: the window keeps drawing (frame time
+in the side panel) and the run can be cancelled.
+
 Examples:
+  meshslim view ../shared/models/horse.ply
+  meshslim view ../shared/models/spot/spot_triangulated.obj --mode texture --screenshot spot.png
   meshslim view ../shared/models/horse.ply --screenshot horse.png --ratio 0.1
   meshslim view scan.ply --screenshot err.png --ratio 0.01 --mode heatmap --size 1600x1200";
 
 #[derive(Debug, Args)]
 pub struct ViewArgs {
-    /// The mesh: a file or builtin:NAME[:FACES]
+    /// The mesh: a file or builtin:NAME[:FACES]; without one the window opens empty (Ctrl+O or
+    /// drop a file on it)
     #[arg(value_name = "MESH", value_parser = parse_input_arg)]
-    pub input: Input,
+    pub input: Option<Input>,
 
-    /// Render one frame to this PNG file and exit (the interactive window is not built yet)
+    /// Render one frame to this PNG file and exit, without a window
     #[arg(long, value_name = "FILE.png")]
     pub screenshot: Option<PathBuf>,
 
-    /// Simplify to this fraction of the faces on the GPU first, in (0, 1]; 1 draws the mesh as is
-    #[arg(long, value_name = "R", default_value_t = 1.0, value_parser = parse_ratio)]
-    pub ratio: f64,
+    /// A PNG texture for the texture mode (default: the OBJ material's map_Kd)
+    #[arg(long, value_name = "FILE.png")]
+    pub texture: Option<PathBuf>,
+
+    /// With --screenshot: simplify to this fraction of the faces on the GPU first, in (0, 1]
+    /// (default 1: the mesh as is). In the window: the starting target (default 0.1)
+    #[arg(long, value_name = "R", value_parser = parse_ratio)]
+    pub ratio: Option<f64>,
 
     /// What the surface shows
     #[arg(long, value_enum, default_value_t = crate::viewer::Mode::Shaded)]
     pub mode: crate::viewer::Mode,
+
+    /// Smooth shading (per-vertex normals) instead of flat faces
+    #[arg(long)]
+    pub smooth: bool,
+
+    /// Draw the edges over the surface
+    #[arg(long)]
+    pub wireframe: bool,
 
     /// Image size, WIDTHxHEIGHT
     #[arg(long, value_name = "WxH", default_value = "1024x768", value_parser = parse_size)]
@@ -162,13 +185,36 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
 }
 
 fn run_view(args: ViewArgs) -> Result<ExitCode> {
-    let Some(png) = args.screenshot else {
-        return Err(UsageError(
-            "the interactive viewer window is not built yet; render a frame with \
-             --screenshot FILE.png"
-                .into(),
-        )
-        .into());
+    let progress = Progress::new(std::io::stderr().is_terminal());
+    let model = |input: &Input| -> Result<crate::viewer::Model> {
+        match input {
+            Input::File(path) => progress
+                .spinner(format!("reading {}", path.display()), || {
+                    crate::viewer::Model::open(path, args.texture.as_deref())
+                })
+                .map_err(lib)
+                .context("cannot read the input"),
+            Input::Builtin { .. } => {
+                let mesh = load(input, &progress)?;
+                let mut m = crate::viewer::Model::from_mesh(input.display(), mesh).map_err(lib)?;
+                if let Some(t) = &args.texture {
+                    m.texture = Some(crate::viewer::scene::read_png(t).map_err(lib)?);
+                }
+                Ok(m)
+            }
+        }
+    };
+    let Some(png) = args.screenshot.clone() else {
+        let start = match &args.input {
+            Some(Input::File(p)) if args.texture.is_none() => crate::viewer::Start::Open(p.clone()),
+            Some(input) => crate::viewer::Start::Model(model(input)?),
+            None => crate::viewer::Start::Nothing,
+        };
+        crate::viewer::run_window(start, args.ratio.unwrap_or(0.1)).map_err(lib)?;
+        return Ok(ExitCode::SUCCESS);
+    };
+    let Some(input) = &args.input else {
+        return Err(UsageError("--screenshot needs a MESH to draw".into()).into());
     };
     if !png
         .extension()
@@ -180,11 +226,16 @@ fn run_view(args: ViewArgs) -> Result<ExitCode> {
         ))
         .into());
     }
-    let progress = Progress::new(std::io::stderr().is_terminal());
-    let mesh = load(&args.input, &progress)?;
+    let model = model(input)?;
+    let style = crate::viewer::Style {
+        mode: args.mode,
+        smooth: args.smooth,
+        wireframe: args.wireframe,
+        error_scale: 0.0,
+    };
     let frame = progress
         .spinner("simplifying and rendering on the GPU".to_string(), || {
-            crate::viewer::screenshot(&mesh, args.ratio, args.mode, args.size)
+            crate::viewer::screenshot(&model, args.ratio.unwrap_or(1.0), style, args.size)
         })
         .map_err(lib)?;
     crate::io::write_atomic(&png, |w| w.write_all(&frame.png))
@@ -692,19 +743,20 @@ fn load(input: &Input, progress: &Progress) -> Result<Mesh> {
 /// The checks that need no mesh, so that a wrong output path fails before any work.
 fn check_output(input: &Input, output: &Path) -> Result<()> {
     Format::from_path(output).map_err(lib)?;
-    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if !dir.is_dir() {
-            anyhow::bail!(
-                "{}: the output directory {} does not exist",
-                output.display(),
-                dir.display()
-            );
-        }
+    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        anyhow::bail!(
+            "{}: the output directory {} does not exist",
+            output.display(),
+            dir.display()
+        );
     }
-    if let Input::File(input) = input {
-        if output.exists() && same_file(input, output) {
-            return Err(lib(crate::Error::WouldOverwriteInput(input.clone())));
-        }
+    if let Input::File(input) = input
+        && output.exists()
+        && same_file(input, output)
+    {
+        return Err(lib(crate::Error::WouldOverwriteInput(input.clone())));
     }
     Ok(())
 }
@@ -712,10 +764,10 @@ fn check_output(input: &Input, output: &Path) -> Result<()> {
 /// Whether two existing paths name one file: the same canonical path, or (on Unix) the same
 /// inode, which also catches hard links.
 fn same_file(a: &Path, b: &Path) -> bool {
-    if let (Ok(ca), Ok(cb)) = (a.canonicalize(), b.canonicalize()) {
-        if ca == cb {
-            return true;
-        }
+    if let (Ok(ca), Ok(cb)) = (a.canonicalize(), b.canonicalize())
+        && ca == cb
+    {
+        return true;
     }
     #[cfg(unix)]
     {
@@ -1124,27 +1176,26 @@ fn run_compare(args: CompareArgs) -> Result<ExitCode> {
 fn run_bench(args: BenchArgs) -> Result<ExitCode> {
     let json_stdout = args.json.as_deref() == Some(Path::new("-"));
     // Wrong output paths fail before the minutes of work.
-    if let Some(plot) = &args.plot {
-        if !plot
+    if let Some(plot) = &args.plot
+        && !plot
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("svg") || e.eq_ignore_ascii_case("png"))
-        {
-            return Err(UsageError(format!(
-                "{}: the plot is written as SVG or PNG; name it FILE.svg or FILE.png",
-                plot.display()
-            ))
-            .into());
-        }
+    {
+        return Err(UsageError(format!(
+            "{}: the plot is written as SVG or PNG; name it FILE.svg or FILE.png",
+            plot.display()
+        ))
+        .into());
     }
     for file in args.json.iter().filter(|_| !json_stdout).chain(&args.plot) {
-        if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
-            if !dir.is_dir() {
-                anyhow::bail!(
-                    "{}: the output directory {} does not exist",
-                    file.display(),
-                    dir.display()
-                );
-            }
+        if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty())
+            && !dir.is_dir()
+        {
+            anyhow::bail!(
+                "{}: the output directory {} does not exist",
+                file.display(),
+                dir.display()
+            );
         }
     }
     let progress = Progress::new(std::io::stderr().is_terminal());

@@ -64,6 +64,9 @@ pub enum Error {
         limit: u64,
         which: &'static str,
     },
+    /// Stopped on request ([`crate::simplify::Cancel`]); nothing was written.
+    #[error("cancelled")]
+    Cancelled,
     /// A broken invariant inside the library: a bug, reported instead of a panic.
     #[error("internal error (please report): {0}")]
     Internal(String),

@@ -1182,6 +1182,10 @@ impl<'a> State<'a> {
             if self.collapses >= next_report {
                 progress(self.faces);
                 next_report = self.collapses + 4096;
+                if self.opts.cancel.is_cancelled() {
+                    // The caller turns this into Error::Cancelled.
+                    return false;
+                }
             }
         }
         false
@@ -1231,10 +1235,12 @@ pub fn simplify_greedy(
     } else {
         (p, PhaseStats::default())
     };
+    opts.cancel.check()?;
     let (mut s, mut heap) = State::new(p, opts);
     s.run(&mut heap, target, u32::MAX, &mut |faces| {
         progress((nf - faces) as f32 / need)
     });
+    opts.cancel.check()?;
     progress(1.0);
 
     let stop_reason = if s.faces <= target {
@@ -1367,7 +1373,11 @@ fn partitioned_phase(
             .collect();
         let faces = total(&subs);
         progress(faces);
-        if faces <= stop_at || !more.iter().any(|&m| m) || !ceiling.is_finite() {
+        if faces <= stop_at
+            || !more.iter().any(|&m| m)
+            || !ceiling.is_finite()
+            || opts.cancel.is_cancelled()
+        {
             break;
         }
         ceiling *= 2.0;

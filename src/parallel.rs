@@ -284,68 +284,115 @@ pub fn drive(
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<Driven> {
-    let base = up.base_params(opts);
-    let (mut nv, mut nf) = (base.vertex_count, base.face_count);
-    let target = base.target_faces;
-    let start = nf.saturating_sub(target).max(1) as f32;
-    let mut removed = Vec::new();
-    let mut max_err2 = 0f32;
-    let mut collapses = 0usize;
-    let mut first = true;
-    let reason = loop {
-        // An interior collapse removes two faces: one above the target is as close as it gets
-        // when only interior collapses remain.
-        if nf <= target.saturating_add(1) && (nf <= target || !first) {
-            break StopReason::TargetReached;
+    let mut d = Driver::new(up, opts);
+    let reason = d.run_to(runner, opts.target_faces, progress)?;
+    Ok(d.finish(reason))
+}
+
+/// The rounds' loop, resumable: [`Driver::run_to`] a target, look at (or copy) the mesh, then
+/// run on to a smaller target with the quadrics and history kept — the levels of detail of the
+/// viewer's LOD scene are made in one run this way.
+pub struct Driver {
+    base: Params,
+    cancel: crate::simplify::Cancel,
+    pub vertices: usize,
+    pub faces: usize,
+    first: bool,
+    removed: Vec<usize>,
+    max_err2: f32,
+    collapses: usize,
+}
+
+impl Driver {
+    pub fn new(up: &Upload, opts: &SimplifyOptions) -> Driver {
+        let base = up.base_params(opts);
+        Driver {
+            vertices: base.vertex_count as usize,
+            faces: base.face_count as usize,
+            base,
+            cancel: opts.cancel.clone(),
+            first: true,
+            removed: Vec::new(),
+            max_err2: 0.0,
+            collapses: 0,
         }
-        if removed.len() >= MAX_ROUNDS {
-            break StopReason::NoValidCollapse;
-        }
-        let needed = nf - target;
-        let params = Params {
-            vertex_count: nv,
-            face_count: nf,
-            edge_capacity: 3 * nf,
-            needed_faces: needed,
-            ceiling_wanted: needed
-                .div_ceil(2)
-                .saturating_mul(CEILING_FACTOR)
-                .max((nf as f64 * CEILING_MIN_SHARE) as u32)
-                .max(1),
-            trim: ((needed as f64) < TRIM_SHARE * nf as f64) as u32,
-            ..base
-        };
-        let c = runner.round(&params, first)?;
-        first = false;
-        if c.faces_out > nf || c.vertices_out > nv {
-            return Err(crate::error::Error::Internal(format!(
-                "round {} grew the mesh: {nf} -> {} faces",
-                removed.len() + 1,
-                c.faces_out
-            )));
-        }
-        if c.faces_out == nf {
-            break if c.over_max_error > 0 && c.candidates == 0 {
-                StopReason::MaxError
-            } else {
-                StopReason::NoValidCollapse
+    }
+
+    /// Runs rounds until `target` faces (±1), the error bound, or no valid collapse; `progress`
+    /// gets the fraction of the way from where this call started.
+    pub fn run_to(
+        &mut self,
+        runner: &mut dyn RoundRunner,
+        target: usize,
+        progress: &mut dyn FnMut(f32),
+    ) -> Result<StopReason> {
+        let target = target.min(u32::MAX as usize) as u32;
+        let (mut nv, mut nf) = (self.vertices as u32, self.faces as u32);
+        let from = nf;
+        let start = nf.saturating_sub(target).max(1) as f32;
+        let reason = loop {
+            // An interior collapse removes two faces: one above the target is as close as it
+            // gets when only interior collapses remain.
+            if nf <= target.saturating_add(1) && (nf <= target || !self.first) {
+                break StopReason::TargetReached;
+            }
+            if self.removed.len() >= MAX_ROUNDS {
+                break StopReason::NoValidCollapse;
+            }
+            self.cancel.check()?;
+            let needed = nf - target;
+            let params = Params {
+                vertex_count: nv,
+                face_count: nf,
+                target_faces: target,
+                edge_capacity: 3 * nf,
+                needed_faces: needed,
+                ceiling_wanted: needed
+                    .div_ceil(2)
+                    .saturating_mul(CEILING_FACTOR)
+                    .max((nf as f64 * CEILING_MIN_SHARE) as u32)
+                    .max(1),
+                trim: ((needed as f64) < TRIM_SHARE * nf as f64) as u32,
+                ..self.base
             };
+            let c = runner.round(&params, self.first)?;
+            self.first = false;
+            if c.faces_out > nf || c.vertices_out > nv {
+                return Err(crate::error::Error::Internal(format!(
+                    "round {} grew the mesh: {nf} -> {} faces",
+                    self.removed.len() + 1,
+                    c.faces_out
+                )));
+            }
+            if c.faces_out == nf {
+                break if c.over_max_error > 0 && c.candidates == 0 {
+                    StopReason::MaxError
+                } else {
+                    StopReason::NoValidCollapse
+                };
+            }
+            if c.winners > 0 {
+                self.max_err2 = self.max_err2.max(f32::from_bits(c.max_err2_bits));
+            }
+            self.removed.push((nf - c.faces_out) as usize);
+            self.collapses += (nv - c.vertices_out) as usize;
+            nv = c.vertices_out;
+            nf = c.faces_out;
+            self.vertices = nv as usize;
+            self.faces = nf as usize;
+            progress((from - nf) as f32 / start);
+        };
+        Ok(reason)
+    }
+
+    pub fn finish(self, stop_reason: StopReason) -> Driven {
+        Driven {
+            stop_reason,
+            max_error: (self.max_err2 as f64).sqrt(),
+            removed: self.removed,
+            collapses: self.collapses,
         }
-        if c.winners > 0 {
-            max_err2 = max_err2.max(f32::from_bits(c.max_err2_bits));
-        }
-        removed.push((nf - c.faces_out) as usize);
-        collapses += (nv - c.vertices_out) as usize;
-        nv = c.vertices_out;
-        nf = c.faces_out;
-        progress((base.face_count - nf) as f32 / start);
-    };
-    Ok(Driven {
-        stop_reason: reason,
-        max_error: (max_err2 as f64).sqrt(),
-        removed,
-        collapses,
-    })
+    }
 }
 
 /// Runs the rounds on `runner` over `up` and assembles the report.

@@ -54,6 +54,36 @@ pub struct SimplifyOptions {
     /// phase; `None` picks 8 for meshes of 100,000 faces or more and 1 (purely sequential)
     /// below. The result depends on this number, never on the number of threads.
     pub partitions: Option<usize>,
+    /// Set from another thread to stop a running simplification (the viewer's Cancel button):
+    /// it then returns [`Error::Cancelled`] within one round or a few thousand collapses.
+    pub cancel: Cancel,
+}
+
+/// A shared stop flag; every clone sees the same flag. Options compare equal whatever it holds.
+#[derive(Debug, Clone, Default)]
+pub struct Cancel(std::sync::Arc<std::sync::atomic::AtomicBool>);
+
+impl Cancel {
+    pub fn cancel(&self) {
+        self.0.store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+    pub fn is_cancelled(&self) -> bool {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+    /// `Err(Cancelled)` once cancelled, for `?` at the points where work may stop.
+    pub fn check(&self) -> Result<()> {
+        if self.is_cancelled() {
+            Err(Error::Cancelled)
+        } else {
+            Ok(())
+        }
+    }
+}
+
+impl PartialEq for Cancel {
+    fn eq(&self, _: &Cancel) -> bool {
+        true
+    }
 }
 
 impl SimplifyOptions {
@@ -80,15 +110,16 @@ impl SimplifyOptions {
             quality_threshold: 0.3,
             backend: Backend::Cpu,
             partitions: None,
+            cancel: Cancel::default(),
         }
     }
 
     pub(crate) fn check(&self) -> Result<()> {
         let bad = |m: String| Err(Error::InvalidOption(m));
-        if let Some(e) = self.max_error {
-            if !(e >= 0.0 && e.is_finite()) {
-                return bad(format!("max error must be a finite number >= 0, got {e}"));
-            }
+        if let Some(e) = self.max_error
+            && !(e >= 0.0 && e.is_finite())
+        {
+            return bad(format!("max error must be a finite number >= 0, got {e}"));
         }
         if !(self.border_weight >= 0.0 && self.border_weight.is_finite()) {
             return bad(format!(

@@ -5,7 +5,7 @@
 mod common;
 
 use common::*;
-use meshslim::viewer::{Mode, screenshot};
+use meshslim::viewer::{Mode, Model, Style, screenshot};
 use resvg::tiny_skia::Pixmap;
 
 const BACKGROUND: [u8; 3] = [28, 31, 36]; // the clear colour (0.11, 0.12, 0.14) in 8 bits
@@ -22,11 +22,18 @@ fn frames_cover_the_mesh_and_modes_differ() {
     if gpu_context().is_none() {
         return;
     }
-    let m = meshslim::mesh::noisy_sphere(4, 0.01, 5);
+    let mut m = meshslim::mesh::noisy_sphere(4, 0.01, 5);
+    m.uvs = Some(spherical_uvs(&m.positions));
+    let mut model = Model::from_mesh("noisy sphere".into(), m).unwrap();
+    model.texture = Some(checker(64));
     let size = (160, 120);
     let mut images = Vec::new();
-    for mode in [Mode::Shaded, Mode::Normals, Mode::Heatmap] {
-        let frame = screenshot(&m, 0.2, mode, size).unwrap();
+    for mode in Mode::ALL {
+        let style = Style {
+            mode,
+            ..Style::default()
+        };
+        let frame = screenshot(&model, 0.2, style, size).unwrap();
         // The target (a fifth of 5120) or one above: the rounds land on it ±1.
         assert!(
             (1024..=1025).contains(&frame.faces),
@@ -67,9 +74,55 @@ fn frames_cover_the_mesh_and_modes_differ() {
         }
         images.push(img.data().to_vec());
     }
-    assert_ne!(images[0], images[1], "shaded and normals look the same");
-    assert_ne!(images[0], images[2], "shaded and heatmap look the same");
-    assert_ne!(images[1], images[2], "normals and heatmap look the same");
+    for i in 0..images.len() {
+        for j in i + 1..images.len() {
+            assert_ne!(
+                images[i],
+                images[j],
+                "{:?} and {:?} look the same",
+                Mode::ALL[i],
+                Mode::ALL[j]
+            );
+        }
+    }
+    // Smooth shading and the wireframe overlay change the shaded image too.
+    let shaded = |smooth, wireframe| {
+        let style = Style {
+            smooth,
+            wireframe,
+            ..Style::default()
+        };
+        let f = screenshot(&model, 0.2, style, size).unwrap();
+        Pixmap::decode_png(&f.png).unwrap().data().to_vec()
+    };
+    assert_eq!(shaded(false, false), images[0], "the same frame twice");
+    assert_ne!(shaded(true, false), images[0], "smooth looks flat");
+    assert_ne!(shaded(false, true), images[0], "no wireframe drawn");
+}
+
+/// Longitude and latitude as UVs.
+fn spherical_uvs(p: &[[f32; 3]]) -> Vec<[f32; 2]> {
+    p.iter()
+        .map(|v| {
+            let r = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt().max(1e-9);
+            [
+                0.5 + v[2].atan2(v[0]) / std::f32::consts::TAU,
+                0.5 + (v[1] / r).asin() / std::f32::consts::PI,
+            ]
+        })
+        .collect()
+}
+
+/// A red and white checkerboard.
+fn checker(n: u32) -> meshslim::viewer::scene::Image {
+    let mut rgba = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            let on = (x / 8 + y / 8) % 2 == 0;
+            rgba.extend_from_slice(&if on { [220, 40, 40, 255] } else { [250; 4] });
+        }
+    }
+    meshslim::viewer::scene::Image { rgba, size: (n, n) }
 }
 
 #[test]
@@ -99,8 +152,35 @@ fn screenshot_command_writes_a_png() {
         img.data().chunks(4).any(|p| !is_background(p)),
         "the torus is drawn"
     );
-    // Without --screenshot it says what exists today; a bad size is a usage error.
-    expect_code(&meshslim(&["view", "builtin:torus"], dir.path()), 2);
+    // Without a display the window cannot open: an error that points at --screenshot (the
+    // window itself is tested in tests/viewer_app.rs).
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_meshslim"))
+        .args(["view", "builtin:torus"])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    expect_code(&o, 1);
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--screenshot"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    // --mode texture on a mesh without UVs says why; a bad size is a usage error.
+    let o = meshslim(
+        &[
+            "view",
+            "builtin:torus",
+            "--screenshot",
+            "t.png",
+            "--mode",
+            "texture",
+        ],
+        dir.path(),
+    );
+    expect_code(&o, 1);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("texture"));
     expect_code(
         &meshslim(
             &[

@@ -31,19 +31,28 @@ impl GpuContext {
             ))
         })?;
         let info = adapter.get_info();
-        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("meshslim"),
-            required_features: features,
-            required_limits: adapter.limits(),
-            ..Default::default()
-        }))
-        .map_err(|e| Error::Gpu(format!("adapter {} refused a device: {e}", info.name)))?;
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&device_descriptor(&adapter)))
+                .map_err(|e| Error::Gpu(format!("adapter {} refused a device: {e}", info.name)))?;
         Ok(GpuContext {
             device,
             queue,
             adapter_name: info.name,
         })
+    }
+}
+
+/// What meshslim asks of a device, whoever creates it (the simplifier here, eframe for the
+/// viewer's window, the viewer's tests): the adapter's own limits, so that million-triangle
+/// meshes fit; timestamp queries for the per-stage table and line polygons for the viewer's
+/// wireframe, each only when the adapter has it.
+pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
+    wgpu::DeviceDescriptor {
+        label: Some("meshslim"),
+        required_features: adapter.features()
+            & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::POLYGON_MODE_LINE),
+        required_limits: adapter.limits(),
+        ..Default::default()
     }
 }
 

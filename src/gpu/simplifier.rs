@@ -90,6 +90,64 @@ pub struct GpuMesh {
     pub scale: f64,
 }
 
+/// Usages of a [`GpuMesh`]'s positions and indices: the rounds' storage, a renderer's vertex and
+/// index buffers, copies.
+const MESH_USAGE: wgpu::BufferUsages = SU
+    .union(wgpu::BufferUsages::VERTEX)
+    .union(wgpu::BufferUsages::INDEX);
+const DRAW_ARGS_USAGE: wgpu::BufferUsages = SU.union(wgpu::BufferUsages::INDIRECT);
+
+impl GpuMesh {
+    /// A mesh made on the host — the input as loaded, or a CPU backend's result — with the
+    /// simplifier's usages and draw arguments, so that one renderer draws every backend's output
+    /// the same way. `positions` are in the frame of `center` and `scale`.
+    pub fn from_arrays(
+        device: &wgpu::Device,
+        positions: &[[f32; 4]],
+        indices: &[u32],
+        center: [f64; 3],
+        scale: f64,
+    ) -> Result<GpuMesh> {
+        let limits = device.limits();
+        let init = |label: &str, data: &[u8], usage| -> Result<wgpu::Buffer> {
+            check_buffer(&limits, label, data.len() as u64)?;
+            let mut bytes = data.to_vec();
+            bytes.resize(bytes.len().max(16), 0);
+            Ok(
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: &bytes,
+                    usage,
+                }),
+            )
+        };
+        let args = DrawArgs {
+            index_count: indices.len() as u32,
+            instance_count: 1,
+            ..Default::default()
+        };
+        Ok(GpuMesh {
+            positions: init(
+                "meshslim.mesh.positions",
+                bytemuck::cast_slice(positions),
+                MESH_USAGE,
+            )?,
+            indices: init(
+                "meshslim.mesh.indices",
+                bytemuck::cast_slice(indices),
+                MESH_USAGE,
+            )?,
+            draw_args: init(
+                "meshslim.mesh.draw_args",
+                bytemuck::bytes_of(&args),
+                DRAW_ARGS_USAGE,
+            )?,
+            center,
+            scale,
+        })
+    }
+}
+
 /// One ping-pong half of the per-vertex and per-face buffers.
 struct Half {
     positions: wgpu::Buffer,
@@ -139,6 +197,10 @@ pub struct GpuRounds<'a> {
     selection_passes: u32,
     /// Upload and download seconds.
     pub transfer_seconds: f64,
+    /// Submit each pass on its own and wait for it: set when the device also draws a window,
+    /// whose frames then come between passes (a round on a 1M-face mesh keeps lavapipe busy
+    /// for over a second, which would otherwise be one frame's wait). Off for the command line.
+    pub share_queue: bool,
 }
 
 /// How many workgroups a pass runs.
@@ -193,7 +255,7 @@ impl<'a> GpuRounds<'a> {
                 usage,
             }))
         };
-        let mesh_usage = SU | wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::INDEX;
+        let mesh_usage = MESH_USAGE;
         let qsize = std::mem::size_of::<Quadric>() as u64;
         let half0 = Half {
             positions: init("positions", bytemuck::cast_slice(&up.positions), mesh_usage)?,
@@ -239,7 +301,7 @@ impl<'a> GpuRounds<'a> {
             draw_args: mk(
                 "draw_args",
                 std::mem::size_of::<DrawArgs>() as u64,
-                SU | wgpu::BufferUsages::INDIRECT,
+                DRAW_ARGS_USAGE,
             )?,
             params: mk("params", std::mem::size_of::<Params>() as u64, uniform)?,
             scan_v: mk("scan_v", 16, uniform)?,
@@ -279,6 +341,7 @@ impl<'a> GpuRounds<'a> {
             times: StageTimes::default(),
             selection_passes,
             transfer_seconds: 0.0,
+            share_queue: false,
         };
         // Draw arguments for the mesh as uploaded: a renderer can draw it before any round.
         let args = DrawArgs {
@@ -354,6 +417,25 @@ impl<'a> GpuRounds<'a> {
             }
             Grid::Indirect(offset) => pass.dispatch_workgroups_indirect(&self.dispatch, offset),
         }
+        drop(pass);
+        if self.share_queue {
+            // Submit this pass alone and wait for it, so that work others put on the queue
+            // meanwhile (the viewer's frames) runs between passes instead of after the round.
+            let done = std::mem::replace(
+                enc,
+                self.sim
+                    .device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                        label: Some("meshslim.round"),
+                    }),
+            );
+            let index = self.sim.queue.submit([done.finish()]);
+            // A failed wait shows up at the round's own wait, which reports it.
+            let _ = self.sim.device.poll(wgpu::PollType::Wait {
+                submission_index: Some(index),
+                timeout: None,
+            });
+        }
     }
 
     /// Exclusive prefix sum of `data` (n + 1 values; `scan` holds n) in three passes.
@@ -417,6 +499,49 @@ impl<'a> GpuRounds<'a> {
             center: up.center,
             scale: up.scale,
         })
+    }
+
+    /// A copy of the mesh as it stands, made on the GPU (nothing goes through the host), while
+    /// the rounds go on: a level of detail. `vertices` and `faces` are the counts after the last
+    /// round ([`crate::parallel::Driver`] knows them).
+    pub fn snapshot(&self, up: &Upload, vertices: usize, faces: usize) -> Result<GpuMesh> {
+        let dev = &self.sim.device;
+        let limits = dev.limits();
+        let h = &self.half[self.cur];
+        let mk = |label: &str, size: u64, usage| -> Result<wgpu::Buffer> {
+            check_buffer(&limits, label, size)?;
+            Ok(dev.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(16).next_multiple_of(4),
+                usage,
+                mapped_at_creation: false,
+            }))
+        };
+        let (pb, ib) = (vertices as u64 * 16, faces as u64 * 12);
+        let mesh = GpuMesh {
+            positions: mk("meshslim.lod.positions", pb, MESH_USAGE)?,
+            indices: mk("meshslim.lod.indices", ib, MESH_USAGE)?,
+            draw_args: mk(
+                "meshslim.lod.draw_args",
+                std::mem::size_of::<DrawArgs>() as u64,
+                DRAW_ARGS_USAGE,
+            )?,
+            center: up.center,
+            scale: up.scale,
+        };
+        let mut enc = dev.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(&h.positions, 0, &mesh.positions, 0, pb);
+        enc.copy_buffer_to_buffer(&h.indices, 0, &mesh.indices, 0, ib);
+        enc.copy_buffer_to_buffer(
+            &self.draw_args,
+            0,
+            &mesh.draw_args,
+            0,
+            std::mem::size_of::<DrawArgs>() as u64,
+        );
+        self.sim.queue.submit([enc.finish()]);
+        self.sim.errors.check("copying a level of detail")?;
+        Ok(mesh)
     }
 
     /// The first `bytes` of a working buffer, by its WGSL variable name (the buffers of the
@@ -734,11 +859,11 @@ impl RoundRunner for GpuRounds<'_> {
 
         enc.copy_buffer_to_buffer(&counters, 0, &self.readback, 0, 64);
         let used = self.query_stages.len() as u32 * 2;
-        if let Some((set, resolve)) = &self.queries {
-            if used > 0 {
-                enc.resolve_query_set(set, 0..used, resolve, 0);
-                enc.copy_buffer_to_buffer(resolve, 0, &self.readback, 64, used as u64 * 8);
-            }
+        if let Some((set, resolve)) = &self.queries
+            && used > 0
+        {
+            enc.resolve_query_set(set, 0..used, resolve, 0);
+            enc.copy_buffer_to_buffer(resolve, 0, &self.readback, 64, used as u64 * 8);
         }
         let t = Instant::now();
         q.submit([enc.finish()]);

@@ -440,45 +440,45 @@ pub fn write_obj<W: Write>(w: &mut W, mesh: &Mesh) -> io::Result<()> {
     }
     let mut cur_group = NONE;
     let mut cur_mat = NONE;
-    if let Some(fg) = &mesh.face_groups {
-        if !in_first_use_order(fg, mesh.groups.len()) {
-            out.push_str("# groups in id order\n");
-            for (i, g) in mesh.groups.iter().enumerate() {
-                let _ = writeln!(out, "g {}", one_line(g));
-                cur_group = i as u32;
-            }
+    if let Some(fg) = &mesh.face_groups
+        && !in_first_use_order(fg, mesh.groups.len())
+    {
+        out.push_str("# groups in id order\n");
+        for (i, g) in mesh.groups.iter().enumerate() {
+            let _ = writeln!(out, "g {}", one_line(g));
+            cur_group = i as u32;
         }
     }
-    if let Some(fm) = &mesh.face_materials {
-        if !in_first_use_order(fm, mesh.materials.len()) {
-            out.push_str("# materials in id order\n");
-            for (i, m) in mesh.materials.iter().enumerate() {
-                let _ = writeln!(out, "usemtl {}", one_line(&m.name));
-                cur_mat = i as u32;
-            }
+    if let Some(fm) = &mesh.face_materials
+        && !in_first_use_order(fm, mesh.materials.len())
+    {
+        out.push_str("# materials in id order\n");
+        for (i, m) in mesh.materials.iter().enumerate() {
+            let _ = writeln!(out, "usemtl {}", one_line(&m.name));
+            cur_mat = i as u32;
         }
     }
     let (has_t, has_n) = (mesh.uvs.is_some(), mesh.normals.is_some());
     for (f, t) in mesh.triangles.iter().enumerate() {
-        if let Some(fg) = &mesh.face_groups {
-            if fg[f] != cur_group {
-                cur_group = fg[f];
-                let name = mesh
-                    .groups
-                    .get(cur_group as usize)
-                    .map_or("default", String::as_str);
-                let _ = writeln!(out, "g {}", one_line(name));
-            }
+        if let Some(fg) = &mesh.face_groups
+            && fg[f] != cur_group
+        {
+            cur_group = fg[f];
+            let name = mesh
+                .groups
+                .get(cur_group as usize)
+                .map_or("default", String::as_str);
+            let _ = writeln!(out, "g {}", one_line(name));
         }
-        if let Some(fm) = &mesh.face_materials {
-            if fm[f] != cur_mat {
-                cur_mat = fm[f];
-                let name = mesh
-                    .materials
-                    .get(cur_mat as usize)
-                    .map_or("default", |m| m.name.as_str());
-                let _ = writeln!(out, "usemtl {}", one_line(name));
-            }
+        if let Some(fm) = &mesh.face_materials
+            && fm[f] != cur_mat
+        {
+            cur_mat = fm[f];
+            let name = mesh
+                .materials
+                .get(cur_mat as usize)
+                .map_or("default", |m| m.name.as_str());
+            let _ = writeln!(out, "usemtl {}", one_line(name));
         }
         out.push('f');
         for &v in t {

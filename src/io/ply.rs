@@ -307,14 +307,14 @@ fn read_header(r: &mut impl BufRead, path: &Path) -> Result<Header> {
                         ));
                     }
                 };
-                if let Kind::List { count, .. } = kind {
-                    if count.is_float() {
-                        return Err(Error::parse(
-                            path,
-                            at,
-                            "a list count must have an integer type",
-                        ));
-                    }
+                if let Kind::List { count, .. } = kind
+                    && count.is_float()
+                {
+                    return Err(Error::parse(
+                        path,
+                        at,
+                        "a list count must have an integer type",
+                    ));
                 }
                 el.props.push(Property {
                     name: name.to_string(),
@@ -668,7 +668,7 @@ pub fn read(path: &Path) -> Result<Mesh> {
                                 };
                                 if strips {
                                     if k >= 2 {
-                                        let t = if k % 2 == 0 {
+                                        let t = if k.is_multiple_of(2) {
                                             [prev[0], prev[1], idx]
                                         } else {
                                             [prev[1], prev[0], idx]

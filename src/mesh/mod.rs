@@ -135,23 +135,23 @@ impl Mesh {
             nf,
         )?;
         check_len("face_groups", self.face_groups.as_ref().map(Vec::len), nf)?;
-        if let Some(m) = &self.face_materials {
-            if let Some(f) = m.iter().position(|&m| m as usize >= self.materials.len()) {
-                return Err(Error::InvalidMesh(format!(
-                    "face {f} uses material {}, but only {} are defined",
-                    m[f],
-                    self.materials.len()
-                )));
-            }
+        if let Some(m) = &self.face_materials
+            && let Some(f) = m.iter().position(|&m| m as usize >= self.materials.len())
+        {
+            return Err(Error::InvalidMesh(format!(
+                "face {f} uses material {}, but only {} are defined",
+                m[f],
+                self.materials.len()
+            )));
         }
-        if let Some(g) = &self.face_groups {
-            if let Some(f) = g.iter().position(|&g| g as usize >= self.groups.len()) {
-                return Err(Error::InvalidMesh(format!(
-                    "face {f} is in group {}, but only {} are defined",
-                    g[f],
-                    self.groups.len()
-                )));
-            }
+        if let Some(g) = &self.face_groups
+            && let Some(f) = g.iter().position(|&g| g as usize >= self.groups.len())
+        {
+            return Err(Error::InvalidMesh(format!(
+                "face {f} is in group {}, but only {} are defined",
+                g[f],
+                self.groups.len()
+            )));
         }
         Ok(())
     }

@@ -62,11 +62,54 @@ impl Camera {
         self.distance = radius / half.sin() * 1.05;
     }
 
+    /// Unit vector from the target to the eye.
+    fn back(&self) -> Vec3 {
+        (self.eye() - self.target) / self.distance
+    }
+
+    /// Screen right and up in world terms.
+    fn right_up(&self) -> (Vec3, Vec3) {
+        let back = self.back();
+        let right = Vec3::Y.cross(back).normalize_or(Vec3::X);
+        (right, back.cross(right))
+    }
+
+    /// Slides the view by a fraction of the view's height (`dx` right, `dy` down, as a mouse
+    /// drags): the surface under the pointer follows it at the target's depth.
+    pub fn pan(&mut self, dx: f32, dy: f32) {
+        let (right, up) = self.right_up();
+        // The visible height at the target's distance.
+        let h = 2.0 * self.distance * (0.5 * self.fov_y).tan();
+        self.target += (-dx * right + dy * up) * h;
+    }
+
+    /// Fly mode: turns the view around the eye (the eye stays; the target swings).
+    pub fn look(&mut self, d_yaw: f32, d_pitch: f32) {
+        let eye = self.eye();
+        self.yaw += d_yaw;
+        self.pitch = (self.pitch + d_pitch).clamp(-PITCH_LIMIT, PITCH_LIMIT);
+        self.target = eye - self.back() * self.distance;
+    }
+
+    /// Fly mode: moves eye and target together, `forward` along the view, `right` across it,
+    /// `up` along the world's vertical.
+    pub fn fly(&mut self, forward: f32, right: f32, up: f32) {
+        let (r, _) = self.right_up();
+        self.target += -self.back() * forward + r * right + Vec3::Y * up;
+    }
+
+    /// Clip space from the mesh's frame: [`Camera::proj_view`] after [`Camera::model`].
     pub fn view_proj(&self, aspect: f32) -> Mat4 {
+        self.proj_view(aspect) * self.model
+    }
+
+    /// Clip space from the world (the model turn not included): a renderer places each
+    /// instance with its own matrix, the turn included.
+    pub fn proj_view(&self, aspect: f32) -> Mat4 {
         let near = (self.distance * 0.01).max(1e-5);
         let far = self.distance * 10.0 + 10.0;
         let proj = Mat4::perspective_rh(self.fov_y, aspect, near, far);
-        proj * Mat4::look_at_rh(self.eye(), self.target, Vec3::Y) * self.model
+        proj * Mat4::look_at_rh(self.eye(), self.target, Vec3::Y)
     }
 
     /// A rotation that shows a box of these `extent`s by its largest silhouette: the longest
@@ -103,6 +146,37 @@ mod tests {
         c.orbit(-3.0, 2.0); // pitch clamps below the pole
         assert!(((c.eye() - c.target).length() - d0).abs() < 1e-5);
         assert!(c.pitch <= PITCH_LIMIT);
+    }
+
+    #[test]
+    fn pan_and_fly_move_eye_and_target_together() {
+        let mut c = Camera::default();
+        let (e0, t0) = (c.eye(), c.target);
+        c.pan(0.25, -0.1);
+        let moved = c.target - t0;
+        assert!(moved.length() > 1e-3);
+        assert!(
+            ((c.eye() - e0) - moved).length() < 1e-5,
+            "pan does not turn the view"
+        );
+        let (e1, d) = (c.eye(), c.distance);
+        c.fly(0.3, 0.0, 0.0);
+        let step = c.eye() - e1;
+        assert!((step.length() - 0.3).abs() < 1e-5);
+        assert!(
+            step.dot(c.target - c.eye()) > 0.0,
+            "forward goes toward what is seen"
+        );
+        assert_eq!(c.distance, d);
+    }
+
+    #[test]
+    fn look_turns_around_the_eye() {
+        let mut c = Camera::default();
+        let e0 = c.eye();
+        c.look(0.7, -0.3);
+        assert!((c.eye() - e0).length() < 1e-5, "the eye stays");
+        assert!(((c.eye() - c.target).length() - c.distance).abs() < 1e-5);
     }
 
     #[test]

@@ -1,21 +1,20 @@
 //! Looking at a simplification: the renderer draws the simplifier's own GPU buffers
 //! ([`crate::gpu::GpuMesh`]) with the indirect draw arguments its rounds write, on the device the
-//! simplifier ran on. Today: one offscreen frame to a PNG (`meshslim view MESH --screenshot`),
-//! which works without a window system (lavapipe included); the interactive window is not
-//! built yet.
+//! simplifier ran on. `meshslim view MESH` opens the interactive window ([`app`], eframe on
+//! wgpu, sharing eframe's device with the simplifier); `--screenshot` renders one frame offscreen
+//! to a PNG, which needs no window system (lavapipe included).
 
+pub mod app;
 pub mod camera;
 pub mod render;
+pub mod scene;
 
 use crate::error::{Error, Result};
-use crate::gpu::GpuRounds;
-use crate::mesh::Mesh;
-use crate::metrics::TriangleBvh;
-use crate::parallel::{SELECTION_PASSES, Upload, drive};
 use crate::simplify::{Backend, SimplifyOptions};
+pub use app::{Start, ViewerApp};
 use camera::Camera;
-pub use render::Mode;
-use wgpu::util::DeviceExt;
+pub use render::{Mode, Renderer, Style};
+pub use scene::Model;
 
 /// What `screenshot` did, for the command line to report.
 #[derive(Debug, Clone)]
@@ -23,91 +22,106 @@ pub struct Frame {
     pub adapter: String,
     pub faces: usize,
     /// Largest per-vertex distance to the original surface, relative to its diagonal (the top of
-    /// the heatmap's colour ramp); 0 when not measured.
+    /// the heatmap's colour ramp); 0 when not simplified.
     pub max_error: f64,
     pub png: Vec<u8>,
 }
 
-/// Simplifies `mesh` to `ratio` on the GPU (1 = as is) and renders one `size` frame of the
-/// result in `mode`, framed to fit, straight from the simplifier's buffers; returns a PNG.
-pub fn screenshot(mesh: &Mesh, ratio: f64, mode: Mode, size: (u32, u32)) -> Result<Frame> {
+/// Simplifies `model` to `ratio` on the GPU (1 = as is) and renders one `size` frame of the
+/// result in `style`, framed to fit, straight from the simplifier's buffers; returns a PNG.
+pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> Result<Frame> {
     let (ctx, sim) = crate::gpu::shared()?;
-    let up = Upload::new(mesh);
-    if up.face_count() == 0 {
-        return Err(Error::InvalidMesh(
-            "nothing to draw: the mesh has no faces".into(),
-        ));
-    }
-    let mut rounds = GpuRounds::new(sim, &up, SELECTION_PASSES)?;
-    let mut opts = SimplifyOptions::with_ratio(up.face_count(), ratio)?;
-    opts.backend = Backend::Gpu;
-    let faces = if ratio < 1.0 {
-        let d = drive(&mut rounds, &up, &opts, &mut |_| {})?;
-        up.face_count() - d.removed.iter().sum::<usize>()
+    let mut style = style;
+    let (scene, faces) = if ratio < 1.0 {
+        let mut opts = SimplifyOptions::with_ratio(model.up.face_count(), ratio)?;
+        opts.backend = Backend::Gpu;
+        let s = scene::simplify(
+            &ctx.device,
+            Some(sim),
+            model,
+            &opts,
+            false,
+            &mut |_| {},
+            &|_| {},
+        )?;
+        let faces = s.report.output_faces;
+        (s.scene, faces)
     } else {
-        up.face_count()
+        (model.original(&ctx.device)?, model.faces())
     };
-    // The heatmap needs each vertex's distance to the original surface: the positions come back
-    // to be measured (the BVH is on the CPU), the mesh that is drawn does not.
-    let (errors, max_error) = if mode == Mode::Heatmap {
-        let d = crate::parallel::RoundRunner::download(&mut rounds)?;
-        let bvh = TriangleBvh::new(mesh);
-        let diag = mesh
-            .bounds()
-            .map_or(1.0, |b| b.diagonal())
-            .max(f64::MIN_POSITIVE);
-        let errors: Vec<f32> = d
-            .positions
-            .iter()
-            .map(|p| {
-                let w = [0, 1, 2].map(|i| p[i] as f64 / up.scale + up.center[i]);
-                bvh.closest(w, None)
-                    .map_or(0.0, |h| (h.dist2.sqrt() / diag) as f32)
+    if style.mode == Mode::Texture && !(scene.has_uvs && model.texture.is_some()) {
+        return Err(Error::InvalidOption(format!(
+            "--mode texture: {}",
+            model.texture_note.clone().unwrap_or_else(|| {
+                "the mesh has no UVs or no texture (give one with --texture)".into()
             })
-            .collect();
-        let max = errors.iter().fold(0f32, |m, &e| m.max(e));
-        (errors, max as f64)
-    } else {
-        (vec![0f32; up.positions.len()], 0.0)
-    };
-    let error_buf = ctx
-        .device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("meshslim.viewer.vertex_error"),
-            contents: bytemuck::cast_slice(&errors),
-            usage: wgpu::BufferUsages::VERTEX,
-        });
-    let gpu_mesh = rounds.into_mesh(&up)?;
-    let (lo, hi) = up.positions.iter().fold(
-        (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
-        |(lo, hi), p| {
-            let v = glam::Vec3::new(p[0], p[1], p[2]);
-            (lo.min(v), hi.max(v))
-        },
-    );
+        )));
+    }
+    style.error_scale = scene.max_error;
+    let mut renderer = Renderer::new(&ctx.device, &ctx.queue);
+    if let Some(t) = &model.texture {
+        renderer.set_texture(&ctx.device, &ctx.queue, Some((&t.rgba, t.size)));
+    }
     let mut cam = Camera {
-        model: Camera::upright(hi - lo),
+        model: Camera::upright(model.extent()),
         yaw: 0.35,
         pitch: 0.2,
         ..Camera::default()
     };
     // The normalized frame: centred, bounding-box diagonal 1, so a sphere of radius 0.5 holds it.
     cam.fit(glam::Vec3::ZERO, 0.5, size.0 as f32 / size.1 as f32);
+    let items = [(&scene, cam.model)];
     let rgba = render::render_rgba(
         &ctx.device,
         &ctx.queue,
-        &gpu_mesh,
-        &error_buf,
+        &mut renderer,
+        &items,
         &cam,
-        mode,
-        max_error as f32,
+        &style,
         size,
     )?;
     Ok(Frame {
         adapter: ctx.adapter_name.clone(),
         faces,
-        max_error,
+        max_error: scene.max_error as f64,
         png: encode_png(&rgba, size)?,
+    })
+}
+
+/// Opens the interactive window with `ratio` as the starting target (blocks until it is
+/// closed).
+pub fn run_window(start: Start, ratio: f64) -> Result<()> {
+    let options = eframe::NativeOptions {
+        viewport: eframe::egui::ViewportBuilder::default()
+            .with_title("meshslim")
+            .with_inner_size([1280.0, 800.0])
+            .with_drag_and_drop(true),
+        wgpu_options: eframe::egui_wgpu::WgpuConfiguration {
+            wgpu_setup: app::wgpu_setup(),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let start = std::sync::Mutex::new(Some(start));
+    eframe::run_native(
+        "meshslim",
+        options,
+        Box::new(move |cc| {
+            let start = start
+                .lock()
+                .ok()
+                .and_then(|mut s| s.take())
+                .unwrap_or(Start::Nothing);
+            let mut app = ViewerApp::new(cc, start)?;
+            app.set_ratio(ratio);
+            Ok(Box::new(app))
+        }),
+    )
+    .map_err(|e| {
+        Error::Gpu(format!(
+            "cannot open the viewer window ({e}); without a display, render a frame with \
+             --screenshot FILE.png"
+        ))
     })
 }
 

@@ -1,20 +1,152 @@
-//! Draws a [`GpuMesh`] — the simplifier's own position and index buffers, with the indirect draw
-//! arguments its last round wrote — into a texture: the mesh never goes through the CPU between
-//! simplification and the screen.
+//! Draws [`GpuMesh`]es — the simplifier's own position and index buffers, with the indirect draw
+//! arguments its rounds wrote — into a texture: the mesh never goes through the CPU between
+//! simplification and the screen. The window shows that texture through egui; a screenshot reads
+//! the same texture back, so the PNG is what the window showed.
 
 use super::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::GpuMesh;
+use glam::Mat4;
+use wgpu::util::DeviceExt;
 
 /// What the fragments show.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Mode {
-    /// Flat shading, lit from the camera.
+    /// Lit from the camera (flat, or smooth with per-vertex normals).
     Shaded,
-    /// Face normals as colours.
+    /// Surface normals as colours.
     Normals,
     /// Per-vertex distance to the original surface, blue (0) to red (the largest).
     Heatmap,
+    /// The mesh's texture through its UVs (OBJ with a material's map_Kd).
+    Texture,
+}
+
+impl Mode {
+    pub const ALL: [Mode; 4] = [Mode::Shaded, Mode::Normals, Mode::Heatmap, Mode::Texture];
+    pub fn label(self) -> &'static str {
+        match self {
+            Mode::Shaded => "shaded",
+            Mode::Normals => "normals",
+            Mode::Heatmap => "error heatmap",
+            Mode::Texture => "texture",
+        }
+    }
+}
+
+/// How a frame is drawn, apart from the camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Style {
+    pub mode: Mode,
+    /// Per-vertex normals instead of flat faces.
+    pub smooth: bool,
+    /// Edges drawn over the surface (needs the device's line polygons).
+    pub wireframe: bool,
+    /// The error at the top of the heatmap's ramp (relative to the diagonal).
+    pub error_scale: f32,
+}
+
+impl Default for Style {
+    fn default() -> Self {
+        Style {
+            mode: Mode::Shaded,
+            smooth: false,
+            wireframe: false,
+            error_scale: 0.0,
+        }
+    }
+}
+
+/// A drawable mesh: the [`GpuMesh`] as the simplifier left it, and per-vertex extras beside it,
+/// one entry per vertex of the GpuMesh, in its order.
+pub struct SceneMesh {
+    pub gpu: GpuMesh,
+    /// f32 per vertex: distance to the original surface, relative to its diagonal.
+    pub error: wgpu::Buffer,
+    /// [f32; 3] per vertex: area-weighted normal (zero where unknown: flat shading there).
+    pub normals: wgpu::Buffer,
+    /// [f32; 2] per vertex.
+    pub uvs: wgpu::Buffer,
+    pub vertices: usize,
+    pub faces: usize,
+    pub has_uvs: bool,
+    /// Largest value in `error`.
+    pub max_error: f32,
+}
+
+/// Per-vertex extras made on the host.
+#[derive(Debug, Clone, Default)]
+pub struct Extras {
+    pub error: Vec<f32>,
+    pub normals: Vec<[f32; 3]>,
+    pub uvs: Option<Vec<[f32; 2]>>,
+}
+
+impl SceneMesh {
+    /// `gpu` with `extras` uploaded beside it; missing extras are zeros.
+    pub fn new(
+        device: &wgpu::Device,
+        gpu: GpuMesh,
+        vertices: usize,
+        faces: usize,
+        extras: &Extras,
+    ) -> Result<SceneMesh> {
+        let limits = device.limits();
+        let buf = |label: &str, data: &[u8], len: usize| -> Result<wgpu::Buffer> {
+            crate::gpu::context::check_buffer(&limits, label, len as u64)?;
+            let mut bytes = data.to_vec();
+            // Zeros where the extra is missing; at least 16 bytes, wgpu refuses empty buffers.
+            bytes.resize(len.max(16), 0);
+            Ok(
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: &bytes,
+                    usage: wgpu::BufferUsages::VERTEX,
+                }),
+            )
+        };
+        let max_error = extras.error.iter().fold(0f32, |m, &e| m.max(e));
+        let uvs = extras.uvs.as_deref().unwrap_or(&[]);
+        Ok(SceneMesh {
+            error: buf(
+                "meshslim.viewer.vertex_error",
+                bytemuck::cast_slice(&extras.error),
+                vertices * 4,
+            )?,
+            normals: buf(
+                "meshslim.viewer.vertex_normals",
+                bytemuck::cast_slice(&extras.normals),
+                vertices * 12,
+            )?,
+            uvs: buf(
+                "meshslim.viewer.vertex_uvs",
+                bytemuck::cast_slice(uvs),
+                vertices * 8,
+            )?,
+            has_uvs: extras.uvs.is_some(),
+            gpu,
+            vertices,
+            faces,
+            max_error,
+        })
+    }
+}
+
+/// Area-weighted vertex normals of an indexed triangle list (smooth shading).
+pub fn vertex_normals(positions: &[[f32; 4]], indices: &[u32]) -> Vec<[f32; 3]> {
+    let mut n = vec![glam::Vec3::ZERO; positions.len()];
+    let p = |i: u32| glam::Vec4::from(positions[i as usize]).truncate();
+    for t in indices.chunks_exact(3) {
+        let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+        // The cross product's length is twice the area: the weight comes with it.
+        let f = (b - a).cross(c - a);
+        for &v in t {
+            n[v as usize] += f;
+        }
+    }
+    n.into_iter()
+        .map(|v| v.normalize_or_zero().to_array())
+        .collect()
 }
 
 /// Keep in sync with `View` in shaders/viewer/mesh.wgsl.
@@ -26,108 +158,428 @@ struct ViewUniform {
     mode: [f32; 4],
 }
 
+/// Each instance's uniform sits at a multiple of this (the dynamic-offset alignment wgpu
+/// guarantees on every device).
+const SLOT: u64 = 256;
+
 pub const SHADER: &str = include_str!("../../shaders/viewer/mesh.wgsl");
 pub const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// The colour of the frames: stored as the shader writes it, which is also how egui 0.37 reads
+/// a texture (gamma-encoded), so the window and a PNG show the same values.
+pub const COLOR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
-/// The mesh pipeline for one colour format.
+/// A colour and a depth texture to draw into.
+pub struct Target {
+    pub color: wgpu::Texture,
+    pub color_view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+    pub size: (u32, u32),
+}
+
+impl Target {
+    pub fn new(device: &wgpu::Device, (width, height): (u32, u32)) -> Result<Target> {
+        let max = device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(Error::InvalidOption(format!(
+                "image size {width}x{height}: each side must be 1..={max} on this device"
+            )));
+        }
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
+        let texture = |label, format, usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let color = texture(
+            "meshslim.viewer.color",
+            COLOR,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let depth = texture(
+            "meshslim.viewer.depth",
+            DEPTH,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        Ok(Target {
+            color_view: color.create_view(&Default::default()),
+            depth_view: depth.create_view(&Default::default()),
+            color,
+            size: (width, height),
+        })
+    }
+
+    /// The pixels as RGBA8 rows (waits for the GPU).
+    pub fn read_rgba(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<u8>> {
+        let (width, height) = self.size;
+        // Rows of a texture copy are padded to 256 bytes.
+        let row = (width * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("meshslim.viewer.readback"),
+            size: row as u64 * height as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.color,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(height),
+                },
+            },
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        );
+        queue.submit([enc.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        readback.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| Error::Gpu(format!("waiting for the frame: {e}")))?;
+        rx.recv()
+            .map_err(|_| Error::Gpu("the device dropped the frame".into()))?
+            .map_err(|e| Error::Gpu(format!("reading the frame: {e}")))?;
+        let view = readback
+            .get_mapped_range(..)
+            .map_err(|e| Error::Gpu(format!("reading the frame: {e}")))?;
+        let mut rgba = Vec::with_capacity((width * height * 4) as usize);
+        for y in 0..height as usize {
+            let start = y * row as usize;
+            rgba.extend_from_slice(&view[start..start + width as usize * 4]);
+        }
+        drop(view);
+        readback.unmap();
+        Ok(rgba)
+    }
+}
+
+/// The mesh pipelines (fill, and wireframe where the device draws line polygons) and the
+/// per-instance uniforms.
 pub struct Renderer {
-    pipeline: wgpu::RenderPipeline,
-    uniform: wgpu::Buffer,
-    bind_group: wgpu::BindGroup,
+    fill: wgpu::RenderPipeline,
+    wire: Option<wgpu::RenderPipeline>,
+    view_layout: wgpu::BindGroupLayout,
+    texture_layout: wgpu::BindGroupLayout,
+    slots: wgpu::Buffer,
+    slot_count: u64,
+    view_group: wgpu::BindGroup,
+    texture_group: wgpu::BindGroup,
+    has_texture: bool,
 }
 
 impl Renderer {
-    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Renderer {
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Renderer {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("meshslim.viewer.mesh"),
             source: wgpu::ShaderSource::Wgsl(SHADER.into()),
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("meshslim.viewer.mesh"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[
-                    // GpuMesh positions: vec4 per vertex, as the simplifier writes them.
-                    Some(wgpu::VertexBufferLayout {
-                        array_stride: 16,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &wgpu::vertex_attr_array![0 => Float32x4],
-                    }),
-                    Some(wgpu::VertexBufferLayout {
-                        array_stride: 4,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &wgpu::vertex_attr_array![1 => Float32],
-                    }),
-                ],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(format.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("meshslim.viewer.view"),
-            size: std::mem::size_of::<ViewUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("meshslim.viewer.view"),
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[wgpu::BindGroupEntry {
+            entries: &[wgpu::BindGroupLayoutEntry {
                 binding: 0,
-                resource: uniform.as_entire_binding(),
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: wgpu::BufferSize::new(
+                        std::mem::size_of::<ViewUniform>() as u64
+                    ),
+                },
+                count: None,
             }],
         });
+        let texture_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("meshslim.viewer.albedo"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("meshslim.viewer.mesh"),
+            bind_group_layouts: &[Some(&view_layout), Some(&texture_layout)],
+            immediate_size: 0,
+        });
+        let buffers = [
+            // GpuMesh positions: vec4 per vertex, as the simplifier writes them.
+            Some(wgpu::VertexBufferLayout {
+                array_stride: 16,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x4],
+            }),
+            Some(wgpu::VertexBufferLayout {
+                array_stride: 4,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![1 => Float32],
+            }),
+            Some(wgpu::VertexBufferLayout {
+                array_stride: 12,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![2 => Float32x3],
+            }),
+            Some(wgpu::VertexBufferLayout {
+                array_stride: 8,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![3 => Float32x2],
+            }),
+        ];
+        let pipeline = |label: &str, fs: &str, line: bool| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &buffers,
+                },
+                primitive: wgpu::PrimitiveState {
+                    polygon_mode: if line {
+                        wgpu::PolygonMode::Line
+                    } else {
+                        wgpu::PolygonMode::Fill
+                    },
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH,
+                    depth_write_enabled: Some(!line),
+                    depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                    stencil: Default::default(),
+                    // The surface is pushed back a little so that the wireframe's lines, drawn
+                    // at the true depth, are not hidden by the faces they bound.
+                    bias: if line {
+                        Default::default()
+                    } else {
+                        wgpu::DepthBiasState {
+                            constant: 2,
+                            slope_scale: 1.0,
+                            clamp: 0.0,
+                        }
+                    },
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets: &[Some(COLOR.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let fill = pipeline("meshslim.viewer.mesh", "fs_main", false);
+        let wire = device
+            .features()
+            .contains(wgpu::Features::POLYGON_MODE_LINE)
+            .then(|| pipeline("meshslim.viewer.wireframe", "fs_wire", true));
+        let slot_count = 4;
+        let slots = Self::slot_buffer(device, slot_count);
+        let view_group = Self::view_group(device, &view_layout, &slots);
+        let white = Self::texture_group_for(device, queue, &texture_layout, None);
         Renderer {
-            pipeline,
-            uniform,
-            bind_group,
+            fill,
+            wire,
+            view_layout,
+            texture_layout,
+            view_group,
+            slots,
+            slot_count,
+            texture_group: white,
+            has_texture: false,
         }
     }
 
-    /// Records the draw: clears `color` and `depth`, draws `mesh` with its indirect arguments.
-    /// `vertex_error` holds one f32 per vertex (the heatmap), at least as long as the mesh.
+    /// Whether the device draws the wireframe overlay (line polygons).
+    pub fn has_wireframe(&self) -> bool {
+        self.wire.is_some()
+    }
+
+    pub fn has_texture(&self) -> bool {
+        self.has_texture
+    }
+
+    /// The texture for [`Mode::Texture`]: RGBA8 rows of `size`, or none (white).
+    pub fn set_texture(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        image: Option<(&[u8], (u32, u32))>,
+    ) {
+        self.has_texture = image.is_some();
+        self.texture_group = Self::texture_group_for(device, queue, &self.texture_layout, image);
+    }
+
+    fn texture_group_for(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        layout: &wgpu::BindGroupLayout,
+        image: Option<(&[u8], (u32, u32))>,
+    ) -> wgpu::BindGroup {
+        let white = [255u8; 4];
+        let (rgba, (w, h)) = image.unwrap_or((&white[..], (1, 1)));
+        let size = wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        };
+        let desc = wgpu::TextureDescriptor {
+            label: Some("meshslim.viewer.albedo"),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            // The image's bytes are sRGB: sampled as such they light in linear terms, and are
+            // written out as the shader returns them.
+            format: wgpu::TextureFormat::Rgba8Unorm,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        };
+        let texture = device.create_texture_with_data(
+            queue,
+            &desc,
+            wgpu::util::TextureDataOrder::LayerMajor,
+            rgba,
+        );
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("meshslim.viewer.albedo"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            ..Default::default()
+        });
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("meshslim.viewer.albedo"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(
+                        &texture.create_view(&Default::default()),
+                    ),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+            ],
+        })
+    }
+
+    fn slot_buffer(device: &wgpu::Device, count: u64) -> wgpu::Buffer {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("meshslim.viewer.view"),
+            size: count * SLOT,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    fn view_group(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        slots: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("meshslim.viewer.view"),
+            layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: slots,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<ViewUniform>() as u64),
+                }),
+            }],
+        })
+    }
+
+    /// Records one pass into `target`: clears it, then draws each `(mesh, placement)` with the
+    /// mesh's indirect arguments — the counts the simplifier's last round wrote.
     #[allow(clippy::too_many_arguments)]
     pub fn draw(
-        &self,
+        &mut self,
+        device: &wgpu::Device,
         queue: &wgpu::Queue,
         enc: &mut wgpu::CommandEncoder,
-        color: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
-        mesh: &GpuMesh,
-        vertex_error: &wgpu::Buffer,
+        target: &Target,
         camera: &Camera,
-        aspect: f32,
-        mode: Mode,
-        error_scale: f32,
+        style: &Style,
+        items: &[(&SceneMesh, Mat4)],
     ) {
-        let u = ViewUniform {
-            view_proj: camera.view_proj(aspect).to_cols_array_2d(),
-            eye: camera.eye().extend(1.0).to_array(),
-            mode: [mode as u32 as f32, error_scale, 0.0, 0.0],
-        };
-        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&u));
+        let n = items.len().max(1) as u64;
+        if n > self.slot_count {
+            self.slot_count = n.next_power_of_two();
+            self.slots = Self::slot_buffer(device, self.slot_count);
+            self.view_group = Self::view_group(device, &self.view_layout, &self.slots);
+        }
+        let aspect = target.size.0 as f32 / target.size.1 as f32;
+        // Each item's matrix places it in the world (the camera's model turn included).
+        let view_proj = camera.proj_view(aspect);
+        let eye = camera.eye();
+        let mut bytes = vec![0u8; (n * SLOT) as usize];
+        for (i, (_, model)) in items.iter().enumerate() {
+            let u = ViewUniform {
+                view_proj: (view_proj * *model).to_cols_array_2d(),
+                eye: model.inverse().transform_point3(eye).extend(1.0).to_array(),
+                mode: [
+                    style.mode as u32 as f32,
+                    style.error_scale,
+                    style.smooth as u32 as f32,
+                    0.0,
+                ],
+            };
+            let at = i * SLOT as usize;
+            bytes[at..at + std::mem::size_of::<ViewUniform>()]
+                .copy_from_slice(bytemuck::bytes_of(&u));
+        }
+        queue.write_buffer(&self.slots, 0, &bytes);
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("meshslim.viewer.mesh"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: color,
+                view: &target.color_view,
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
@@ -141,7 +593,7 @@ impl Renderer {
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
+                view: &target.depth_view,
                 depth_ops: Some(wgpu::Operations {
                     load: wgpu::LoadOp::Clear(1.0),
                     store: wgpu::StoreOp::Store,
@@ -152,125 +604,38 @@ impl Renderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.bind_group, &[]);
-        pass.set_vertex_buffer(0, mesh.positions.slice(..));
-        pass.set_vertex_buffer(1, vertex_error.slice(..));
-        pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed_indirect(&mesh.draw_args, 0);
+        pass.set_bind_group(1, &self.texture_group, &[]);
+        let wire = self.wire.as_ref().filter(|_| style.wireframe);
+        for pipeline in std::iter::once(&self.fill).chain(wire) {
+            pass.set_pipeline(pipeline);
+            for (i, (mesh, _)) in items.iter().enumerate() {
+                pass.set_bind_group(0, &self.view_group, &[(i as u64 * SLOT) as u32]);
+                pass.set_vertex_buffer(0, mesh.gpu.positions.slice(..));
+                pass.set_vertex_buffer(1, mesh.error.slice(..));
+                pass.set_vertex_buffer(2, mesh.normals.slice(..));
+                pass.set_vertex_buffer(3, mesh.uvs.slice(..));
+                pass.set_index_buffer(mesh.gpu.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed_indirect(&mesh.gpu.draw_args, 0);
+            }
+        }
     }
 }
 
-/// Renders one frame of `width` × `height` offscreen and returns it as RGBA8 rows.
-#[allow(clippy::too_many_arguments)]
+/// Renders one frame of `size` offscreen and returns it as RGBA8 rows.
 pub fn render_rgba(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
-    mesh: &GpuMesh,
-    vertex_error: &wgpu::Buffer,
+    renderer: &mut Renderer,
+    items: &[(&SceneMesh, Mat4)],
     camera: &Camera,
-    mode: Mode,
-    error_scale: f32,
-    (width, height): (u32, u32),
+    style: &Style,
+    size: (u32, u32),
 ) -> Result<Vec<u8>> {
-    let max = device.limits().max_texture_dimension_2d;
-    if width == 0 || height == 0 || width > max || height > max {
-        return Err(Error::InvalidOption(format!(
-            "image size {width}x{height}: each side must be 1..={max} on this device"
-        )));
-    }
-    let format = wgpu::TextureFormat::Rgba8Unorm;
-    let size = wgpu::Extent3d {
-        width,
-        height,
-        depth_or_array_layers: 1,
-    };
-    let texture = |label, format, usage| {
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage,
-            view_formats: &[],
-        })
-    };
-    let color = texture(
-        "meshslim.viewer.color",
-        format,
-        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-    );
-    let depth = texture(
-        "meshslim.viewer.depth",
-        DEPTH,
-        wgpu::TextureUsages::RENDER_ATTACHMENT,
-    );
-    let renderer = Renderer::new(device, format);
-    // Rows of a texture copy are padded to 256 bytes.
-    let row = (width * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-    let readback = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("meshslim.viewer.readback"),
-        size: row as u64 * height as u64,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let target = Target::new(device, size)?;
     let mut enc = device.create_command_encoder(&Default::default());
-    let cv = color.create_view(&Default::default());
-    let dv = depth.create_view(&Default::default());
-    let aspect = width as f32 / height as f32;
-    renderer.draw(
-        queue,
-        &mut enc,
-        &cv,
-        &dv,
-        mesh,
-        vertex_error,
-        camera,
-        aspect,
-        mode,
-        error_scale,
-    );
-    enc.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture: &color,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &readback,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(row),
-                rows_per_image: Some(height),
-            },
-        },
-        size,
-    );
+    renderer.draw(device, queue, &mut enc, &target, camera, style, items);
     queue.submit([enc.finish()]);
-    let (tx, rx) = std::sync::mpsc::channel();
-    readback.map_async(wgpu::MapMode::Read, .., move |r| {
-        let _ = tx.send(r);
-    });
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| Error::Gpu(format!("waiting for the frame: {e}")))?;
-    rx.recv()
-        .map_err(|_| Error::Gpu("the device dropped the frame".into()))?
-        .map_err(|e| Error::Gpu(format!("reading the frame: {e}")))?;
-    let view = readback
-        .get_mapped_range(..)
-        .map_err(|e| Error::Gpu(format!("reading the frame: {e}")))?;
-    let mut rgba = Vec::with_capacity((width * height * 4) as usize);
-    for y in 0..height as usize {
-        let start = y * row as usize;
-        rgba.extend_from_slice(&view[start..start + width as usize * 4]);
-    }
-    drop(view);
-    readback.unmap();
-    Ok(rgba)
+    target.read_rgba(device, queue)
 }
 
 #[cfg(test)]
@@ -294,5 +659,19 @@ mod tests {
             view.inner.size(module.to_ctx()) as usize,
             std::mem::size_of::<super::ViewUniform>()
         );
+    }
+
+    #[test]
+    fn vertex_normals_of_a_flat_square_point_up() {
+        let p = [
+            [0.0, 0.0, 0.0, 1.0],
+            [1.0, 0.0, 0.0, 1.0],
+            [1.0, 1.0, 0.0, 1.0],
+            [0.0, 1.0, 0.0, 1.0],
+        ];
+        let n = super::vertex_normals(&p, &[0, 1, 2, 0, 2, 3]);
+        for v in n {
+            assert!((glam::Vec3::from(v) - glam::Vec3::Z).length() < 1e-6);
+        }
     }
 }

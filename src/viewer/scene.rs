@@ -1,0 +1,348 @@
+//! What the viewer shows, made off the UI thread: a loaded model (the mesh, the rounds' upload,
+//! a BVH for distances, its texture), the original and simplified [`SceneMesh`]es, and levels of
+//! detail. Nothing here touches egui; the window (`app.rs`) and the tests drive it alike.
+
+use super::render::{Extras, SceneMesh, vertex_normals};
+use crate::error::{Error, Result};
+use crate::gpu::{GpuMesh, GpuRounds, GpuSimplifier};
+use crate::mesh::Mesh;
+use crate::metrics::{CompareOptions, TriangleBvh, compare};
+use crate::parallel::{Driver, RoundRunner, RoundsReport, SELECTION_PASSES, Upload};
+use crate::simplify::{Backend, SimplifyOptions, SimplifyReport};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// An RGBA8 image.
+#[derive(Clone)]
+pub struct Image {
+    pub rgba: Vec<u8>,
+    pub size: (u32, u32),
+}
+
+/// A mesh ready to be drawn and simplified.
+pub struct Model {
+    /// Where it came from: a file, or how it was generated.
+    pub name: String,
+    pub path: Option<PathBuf>,
+    pub mesh: Arc<Mesh>,
+    /// The rounds' input (welded, position classes, normalized): both the GPU and the
+    /// cpu-parallel runs start from it, and the original is drawn from it.
+    pub up: Arc<Upload>,
+    /// The original surface, for each vertex's distance in the heatmap.
+    pub bvh: Arc<TriangleBvh>,
+    pub diagonal: f64,
+    pub texture: Option<Image>,
+    /// A texture that was named but could not be used, and why.
+    pub texture_note: Option<String>,
+    pub load_seconds: f64,
+}
+
+impl Model {
+    /// Reads `path` (and, for an OBJ, the first material's `map_Kd` PNG, or `texture` if given).
+    pub fn open(path: &Path, texture: Option<&Path>) -> Result<Model> {
+        let t = Instant::now();
+        let mesh = crate::io::read(path)?;
+        let (texture, note) = match texture {
+            Some(t) => (Some(read_png(t)?), None),
+            None => find_texture(path, &mesh),
+        };
+        let mut m = Model::from_mesh(path.display().to_string(), mesh)?;
+        m.path = Some(path.to_path_buf());
+        m.texture = texture;
+        m.texture_note = note;
+        m.load_seconds = t.elapsed().as_secs_f64();
+        Ok(m)
+    }
+
+    pub fn from_mesh(name: String, mesh: Mesh) -> Result<Model> {
+        let t = Instant::now();
+        let up = Upload::new(&mesh);
+        if up.face_count() == 0 {
+            return Err(Error::InvalidMesh(format!(
+                "{name}: nothing to draw, the mesh has no faces"
+            )));
+        }
+        let bvh = TriangleBvh::new(&mesh);
+        let diagonal = mesh
+            .bounds()
+            .map_or(1.0, |b| b.diagonal())
+            .max(f64::MIN_POSITIVE);
+        Ok(Model {
+            name,
+            path: None,
+            mesh: Arc::new(mesh),
+            up: Arc::new(up),
+            bvh: Arc::new(bvh),
+            diagonal,
+            texture: None,
+            texture_note: None,
+            load_seconds: t.elapsed().as_secs_f64(),
+        })
+    }
+
+    pub fn faces(&self) -> usize {
+        self.mesh.triangles.len()
+    }
+
+    /// The box the normalized positions fill (centred on the origin, diagonal 1).
+    pub fn extent(&self) -> glam::Vec3 {
+        let (lo, hi) = self.up.positions.iter().fold(
+            (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
+            |(lo, hi), p| {
+                let v = glam::Vec3::new(p[0], p[1], p[2]);
+                (lo.min(v), hi.max(v))
+            },
+        );
+        (hi - lo).max(glam::Vec3::ZERO)
+    }
+
+    /// The input as the rounds see it, drawn with the same renderer as every result.
+    pub fn original(&self, device: &wgpu::Device) -> Result<SceneMesh> {
+        let up = &self.up;
+        let gpu = GpuMesh::from_arrays(device, &up.positions, &up.indices, up.center, up.scale)?;
+        let uvs = up.welded.uvs.as_ref().map(|uv| {
+            up.vertex_attr
+                .iter()
+                .map(|&a| uv[a as usize])
+                .collect::<Vec<_>>()
+        });
+        let extras = Extras {
+            error: Vec::new(),
+            normals: vertex_normals(&up.positions, &up.indices),
+            uvs,
+        };
+        SceneMesh::new(device, gpu, up.positions.len(), up.face_count(), &extras)
+    }
+
+    /// Each vertex's distance to the original surface, relative to the diagonal; `positions`
+    /// are in the normalized frame.
+    fn errors(&self, positions: &[[f32; 4]]) -> Vec<f32> {
+        use rayon::prelude::*;
+        let up = &self.up;
+        positions
+            .par_iter()
+            .map(|p| {
+                let w = [0, 1, 2].map(|i| p[i] as f64 / up.scale + up.center[i]);
+                self.bvh
+                    .closest(w, None)
+                    .map_or(0.0, |h| (h.dist2.sqrt() / self.diagonal) as f32)
+            })
+            .collect()
+    }
+
+    fn normalized(&self, mesh: &Mesh) -> Vec<[f32; 4]> {
+        let (c, s) = (self.up.center, self.up.scale);
+        mesh.positions
+            .iter()
+            .map(|p| {
+                let q = [0, 1, 2].map(|i| ((p[i] as f64 - c[i]) * s) as f32);
+                [q[0], q[1], q[2], 1.0]
+            })
+            .collect()
+    }
+}
+
+/// The first material library's first `map_Kd`, read as PNG; a note when one is named but
+/// unusable (the texture mode says why it is off).
+fn find_texture(path: &Path, mesh: &Mesh) -> (Option<Image>, Option<String>) {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    for lib in &mesh.material_libs {
+        let mtl = dir.join(lib);
+        let Ok(text) = std::fs::read_to_string(&mtl) else {
+            return (None, Some(format!("{}: cannot read", mtl.display())));
+        };
+        let Some(name) = text
+            .lines()
+            .find_map(|l| l.trim().strip_prefix("map_Kd"))
+            // Options (-s, -o …) precede the file name, which comes last.
+            .and_then(|rest| rest.split_whitespace().last())
+        else {
+            continue;
+        };
+        let file = mtl.parent().unwrap_or(dir).join(name);
+        return match read_png(&file) {
+            Ok(img) => (Some(img), None),
+            Err(e) => (None, Some(e.to_string())),
+        };
+    }
+    (None, None)
+}
+
+/// A PNG file as RGBA8.
+pub fn read_png(path: &Path) -> Result<Image> {
+    let is_png = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !is_png {
+        return Err(Error::InvalidOption(format!(
+            "{}: only PNG textures are read",
+            path.display()
+        )));
+    }
+    let bytes = std::fs::read(path).map_err(|e| Error::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    let pixmap = resvg::tiny_skia::Pixmap::decode_png(&bytes).map_err(|e| Error::Parse {
+        path: path.to_path_buf(),
+        location: crate::error::Location::Unknown,
+        message: format!("not a readable PNG: {e}"),
+    })?;
+    // tiny-skia keeps premultiplied alpha; textures are drawn opaque, so undo it.
+    let mut rgba = pixmap.data().to_vec();
+    for px in rgba.chunks_exact_mut(4) {
+        let a = px[3] as u32;
+        if a != 0 && a != 255 {
+            for c in &mut px[..3] {
+                *c = ((*c as u32 * 255 + a / 2) / a).min(255) as u8;
+            }
+        }
+    }
+    Ok(Image {
+        rgba,
+        size: (pixmap.width(), pixmap.height()),
+    })
+}
+
+/// Samples per direction for the window's mean and max error.
+pub const VIEWER_SAMPLES: usize = 200_000;
+
+/// A simplification as the viewer keeps it.
+pub struct Simplified {
+    pub scene: SceneMesh,
+    /// The result on the host, for saving.
+    pub mesh: Mesh,
+    pub report: SimplifyReport,
+    pub seconds: f64,
+    /// Two-sided distance to the original, relative to its diagonal.
+    pub mean_error: f64,
+    pub max_error: f64,
+}
+
+/// Simplifies `model` with `opts.backend`. The `gpu` backend runs on `sim` (the window's own
+/// device) and the result stays there: its [`GpuMesh`] is the rounds' buffers. The CPU backends'
+/// results are uploaded once so that one renderer draws them all.
+/// `share_queue`: the device also draws a window (see [`GpuRounds::share_queue`]).
+pub fn simplify(
+    device: &wgpu::Device,
+    sim: Option<&GpuSimplifier>,
+    model: &Model,
+    opts: &SimplifyOptions,
+    share_queue: bool,
+    progress: &mut dyn FnMut(f32),
+    phase: &dyn Fn(&str),
+) -> Result<Simplified> {
+    let t = Instant::now();
+    phase(&format!(
+        "simplifying ({})",
+        super::app::backend_name(opts.backend)
+    ));
+    let (gpu, positions, indices, mesh, report, uvs) = match opts.backend {
+        Backend::Gpu => {
+            let sim = sim.ok_or_else(|| Error::Gpu("the GPU backend is not available".into()))?;
+            let up = &model.up;
+            let mut rounds = GpuRounds::new(sim, up, SELECTION_PASSES)?;
+            rounds.share_queue = share_queue;
+            let report = RoundsReport {
+                gpu_timestamps: sim.has_timestamps(),
+                pipeline_seconds: sim.pipeline_seconds,
+                ..Default::default()
+            };
+            let (mesh, report) = crate::parallel::simplify_rounds(
+                &mut rounds,
+                up,
+                &model.mesh,
+                opts,
+                progress,
+                report,
+            )?;
+            // The per-vertex extras (heatmap, normals, UVs) are made from the result read
+            // back; what is drawn is the rounds' own buffers.
+            let d = rounds.download()?;
+            let indices = d.indices.clone();
+            let uvs = up.welded.uvs.as_ref().map(|uv| {
+                d.vertex_attr
+                    .iter()
+                    .map(|&a| uv[a as usize])
+                    .collect::<Vec<_>>()
+            });
+            let gpu = rounds.into_mesh(up)?;
+            (gpu, d.positions, indices, mesh, report, uvs)
+        }
+        _ => {
+            let (mesh, report) =
+                crate::simplify::simplify_with_progress(&model.mesh, opts, progress)?;
+            let positions = model.normalized(&mesh);
+            let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+            let gpu = GpuMesh::from_arrays(
+                device,
+                &positions,
+                &indices,
+                model.up.center,
+                model.up.scale,
+            )?;
+            let uvs = mesh.uvs.clone();
+            (gpu, positions, indices, mesh, report, uvs)
+        }
+    };
+    let seconds = t.elapsed().as_secs_f64();
+    opts.cancel.check()?;
+    phase("measuring the error");
+    let extras = Extras {
+        error: model.errors(&positions),
+        normals: vertex_normals(&positions, &indices),
+        uvs,
+    };
+    let scene = SceneMesh::new(device, gpu, positions.len(), indices.len() / 3, &extras)?;
+    // The mean and max shown in the window: the same two-sided measure as `meshslim compare`,
+    // on fewer samples (on a 1M-face input the default takes several seconds more).
+    let sampling = CompareOptions {
+        samples: Some(VIEWER_SAMPLES),
+        ..CompareOptions::default()
+    };
+    let d = compare(&model.mesh, &mesh, &sampling)?.distance.two_sided;
+    Ok(Simplified {
+        scene,
+        mesh,
+        report,
+        seconds,
+        mean_error: d.mean_rel,
+        max_error: d.max_rel,
+    })
+}
+
+/// Levels of detail for the LOD scene, made in one run of the GPU rounds: the rounds stop at
+/// each ratio in turn (falling), the mesh is copied on the GPU, and they go on from there with
+/// their quadrics. Level 0 is the original.
+pub fn lod_levels(
+    device: &wgpu::Device,
+    sim: &GpuSimplifier,
+    model: &Model,
+    ratios: &[f64],
+    cancel: &crate::simplify::Cancel,
+    progress: &mut dyn FnMut(f32),
+) -> Result<Vec<SceneMesh>> {
+    let up = &model.up;
+    let mut levels = vec![model.original(device)?];
+    let mut rounds = GpuRounds::new(sim, up, SELECTION_PASSES)?;
+    rounds.share_queue = true;
+    let mut opts = SimplifyOptions::with_faces(up.face_count());
+    opts.backend = Backend::Gpu;
+    opts.cancel = cancel.clone();
+    let mut driver = Driver::new(up, &opts);
+    for (i, &r) in ratios.iter().enumerate() {
+        let target = (up.face_count() as f64 * r).round() as usize;
+        let n = ratios.len() as f32;
+        driver.run_to(&mut rounds, target, &mut |f| progress((i as f32 + f) / n))?;
+        let gpu = rounds.snapshot(up, driver.vertices, driver.faces)?;
+        levels.push(SceneMesh::new(
+            device,
+            gpu,
+            driver.vertices,
+            driver.faces,
+            &Extras::default(),
+        )?);
+    }
+    Ok(levels)
+}
