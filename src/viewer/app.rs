@@ -269,6 +269,8 @@ impl ViewerApp {
 
     fn set_model(&mut self, m: Model, original: SceneMesh) {
         self.generation += 1;
+        // Framed again at the next frame, for the view's real shape.
+        self.drawn = None;
         self.texture_note = m.texture_note.clone();
         let tex = m.texture.as_ref().map(|i| (&i.rgba[..], i.size));
         let max = self.gpu.device.limits().max_texture_dimension_2d;
@@ -600,6 +602,11 @@ impl ViewerApp {
         if let Err(e) = self.ensure_views(&panes, ppp) {
             self.status = format!("cannot draw: {e}");
             return;
+        }
+        // Going into or out of side by side halves or doubles each pane's width: frame the
+        // mesh again for the new shape (a model's first frame too, now that the size is known).
+        if self.drawn.as_ref().is_none_or(|d| d.split != split) && !lod {
+            self.frame_to_fit();
         }
         // The 3D view is drawn again only when what it shows changed (the LOD scene always, it
         // measures frame rates): frames that only move the progress bar stay cheap, which on a
@@ -1104,8 +1111,10 @@ impl ViewerApp {
 
     fn stats_ui(&self, ui: &mut egui::Ui) {
         ui.label(format!("device: {}", self.gpu.adapter));
+        // The time between the last frames drawn: the window redraws on input, on its own a few
+        // times a second during a job, and continuously in the LOD scene and fly mode.
         ui.label(format!(
-            "frame: {:.1} ms ({:.0} FPS)",
+            "frames: {:.1} ms apart ({:.0} FPS)",
             self.clock.smoothed * 1e3,
             if self.clock.smoothed > 0.0 {
                 1.0 / self.clock.smoothed
@@ -1319,7 +1328,7 @@ fn heatmap_legend(painter: &egui::Painter, rect: egui::Rect, top: f32) {
     painter.text(
         bar.center_bottom() + egui::vec2(0.0, 4.0),
         egui::Align2::CENTER_TOP,
-        "error / diagonal",
+        "vertex distance / diagonal",
         font,
         text,
     );

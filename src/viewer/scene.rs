@@ -39,7 +39,8 @@ pub struct Model {
 }
 
 impl Model {
-    /// Reads `path` (and, for an OBJ, the first material's `map_Kd` PNG, or `texture` if given).
+    /// Reads `path` and its texture: `texture` if given, else the first material's `map_Kd`
+    /// PNG, else the only PNG in the mesh's folder when the mesh has UVs.
     pub fn open(path: &Path, texture: Option<&Path>) -> Result<Model> {
         let t = Instant::now();
         let mesh = crate::io::read(path)?;
@@ -165,6 +166,23 @@ fn find_texture(path: &Path, mesh: &Mesh) -> (Option<Image>, Option<String>) {
             Ok(img) => (Some(img), None),
             Err(e) => (None, Some(e.to_string())),
         };
+    }
+    // No material names one: a mesh with UVs whose folder holds exactly one PNG (a scan and its
+    // texture, as ../shared/models/spot ships) takes that one.
+    if mesh.uvs.is_some() {
+        let pngs: Vec<PathBuf> = std::fs::read_dir(dir)
+            .into_iter()
+            .flatten()
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")))
+            .collect();
+        if let [only] = &pngs[..] {
+            return match read_png(only) {
+                Ok(img) => (Some(img), None),
+                Err(e) => (None, Some(e.to_string())),
+            };
+        }
     }
     (None, None)
 }
