@@ -169,9 +169,10 @@ pub struct ViewArgs {
     #[arg(long)]
     pub wireframe: bool,
 
-    /// Image size, WIDTHxHEIGHT
-    #[arg(long, value_name = "WxH", default_value = "1024x768", value_parser = parse_size)]
-    pub size: (u32, u32),
+    /// Image size for --screenshot (default 1024x768), or the window's size (default 1280x800),
+    /// WIDTHxHEIGHT
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
 }
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
@@ -186,6 +187,12 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
 
 fn run_view(args: ViewArgs) -> Result<ExitCode> {
     let progress = Progress::new(std::io::stderr().is_terminal());
+    let style = crate::viewer::Style {
+        mode: args.mode,
+        smooth: args.smooth,
+        wireframe: args.wireframe,
+        error_scale: 0.0,
+    };
     let model = |input: &Input| -> Result<crate::viewer::Model> {
         match input {
             Input::File(path) => progress
@@ -210,7 +217,8 @@ fn run_view(args: ViewArgs) -> Result<ExitCode> {
             Some(input) => crate::viewer::Start::Model(model(input)?),
             None => crate::viewer::Start::Nothing,
         };
-        crate::viewer::run_window(start, args.ratio.unwrap_or(0.1)).map_err(lib)?;
+        let size = args.size.unwrap_or((1280, 800));
+        crate::viewer::run_window(start, args.ratio.unwrap_or(0.1), style, size).map_err(lib)?;
         return Ok(ExitCode::SUCCESS);
     };
     let Some(input) = &args.input else {
@@ -227,15 +235,10 @@ fn run_view(args: ViewArgs) -> Result<ExitCode> {
         .into());
     }
     let model = model(input)?;
-    let style = crate::viewer::Style {
-        mode: args.mode,
-        smooth: args.smooth,
-        wireframe: args.wireframe,
-        error_scale: 0.0,
-    };
+    let size = args.size.unwrap_or((1024, 768));
     let frame = progress
         .spinner("simplifying and rendering on the GPU".to_string(), || {
-            crate::viewer::screenshot(&model, args.ratio.unwrap_or(1.0), style, args.size)
+            crate::viewer::screenshot(&model, args.ratio.unwrap_or(1.0), style, size)
         })
         .map_err(lib)?;
     crate::io::write_atomic(&png, |w| w.write_all(&frame.png))
@@ -251,8 +254,8 @@ fn run_view(args: ViewArgs) -> Result<ExitCode> {
         png.display(),
         frame.faces,
         frame.adapter,
-        args.size.0,
-        args.size.1
+        size.0,
+        size.1
     );
     Ok(ExitCode::SUCCESS)
 }

@@ -77,6 +77,12 @@ impl GpuSimplifier {
     pub fn has_timestamps(&self) -> bool {
         self.timestamps
     }
+
+    /// An error the device reported since the last check (it holds the device's one error
+    /// handler, so a renderer on the same device checks its own work here too).
+    pub fn check_errors(&self, doing: &str) -> Result<()> {
+        self.errors.check(doing)
+    }
 }
 
 /// The mesh on the GPU as a renderer draws it: positions (vec4, normalized frame) and u32

@@ -151,8 +151,8 @@ pub struct ViewerApp {
     pub status: String,
     pub show_help: bool,
     browser: Option<Browser>,
-    save_path: String,
-    shot_path: String,
+    pub save_path: String,
+    pub shot_path: String,
     pub texture_note: Option<String>,
     ctx: egui::Context,
 }
@@ -249,9 +249,33 @@ impl ViewerApp {
         }
     }
 
+    /// How the view draws (the command line's --mode, --smooth, --wireframe).
+    pub fn set_style(&mut self, style: Style) {
+        self.style = style;
+        if !self.mode_available(style.mode) {
+            self.style.mode = Mode::Shaded;
+        }
+        if !self.renderer.has_wireframe() {
+            self.style.wireframe = false;
+        }
+    }
+
     /// The target in faces, as the face-count field holds it.
     pub fn set_target_faces(&mut self, faces: usize) {
         self.faces_text = faces.to_string();
+    }
+
+    /// The pixels of pane `k` of the 3D view as last drawn (RGBA8 rows) and its size: what the
+    /// screenshot writes.
+    pub fn pane_rgba(&self, k: usize) -> Result<(Vec<u8>, (u32, u32))> {
+        let v = self
+            .views
+            .get(k)
+            .ok_or_else(|| Error::InvalidOption(format!("no pane {k} drawn")))?;
+        Ok((
+            v.target.read_rgba(&self.gpu.device, &self.gpu.queue)?,
+            v.target.size,
+        ))
     }
 
     /// The device the window draws with — eframe's — on which the simplifier also runs.
@@ -460,6 +484,11 @@ impl ViewerApp {
         };
         let job = self.job.take().expect("checked above");
         let secs = job.started.elapsed().as_secs_f64();
+        if job.cancel.is_cancelled() {
+            // Cancelled after its last check (measuring, uploading): dropped all the same.
+            self.status = format!("{}: cancelled", job.label);
+            return;
+        }
         let failed = |e: Error| match e {
             Error::Cancelled => format!("{}: cancelled", job.label),
             e => format!("{} failed: {e}", job.label),
@@ -471,13 +500,12 @@ impl ViewerApp {
             }
             Done::Simplified(Ok(s)) => {
                 self.status = format!(
-                    "{} -> {} faces in {:.2} s ({}), mean error {:.2e}, max {:.2e} of the diagonal",
+                    "{} -> {} faces in {:.2} s ({}), {}",
                     s.report.input_faces,
                     s.report.output_faces,
                     s.seconds,
                     backend_name(s.report.backend),
-                    s.mean_error,
-                    s.max_error
+                    error_text(s.error)
                 );
                 self.style.error_scale = s.scene.max_error;
                 self.simplified = Some(*s);
@@ -536,31 +564,48 @@ impl ViewerApp {
     }
 
     fn write_screenshot(&self, path: &Path) -> Result<()> {
-        let v = self
-            .views
-            .first()
-            .ok_or_else(|| Error::InvalidOption("no frame drawn yet".into()))?;
-        let rgba = v.target.read_rgba(&self.gpu.device, &self.gpu.queue)?;
-        let png = super::encode_png(&rgba, v.target.size)?;
+        let (rgba, size) = self.pane_rgba(0)?;
+        let png = super::encode_png(&rgba, size)?;
         crate::io::write_atomic(path, |w| std::io::Write::write_all(w, &png))
     }
 
     /// The camera that frames the LOD grid from above one corner.
+    /// The LOD scene's first view: low over one side of the grid, so that the nearest
+    /// instances are large on screen and the farthest small — every level has its turn.
     fn lod_home(&self) -> Camera {
         let half = LOD_GRID as f32 * LOD_SPACING * 0.5;
         let mut c = Camera {
             yaw: 0.6,
-            pitch: 0.45,
+            pitch: 0.3,
             ..self.camera
         };
-        c.fit(Vec3::ZERO, half * 1.2, self.aspect());
+        c.fit(Vec3::ZERO, half * 0.6, self.aspect());
         c
     }
 
-    /// The scene's instances: (mesh, placement), each choosing its level by distance to the eye
+    /// How many instances of the LOD scene draw each level (with the current camera).
+    pub fn lod_histogram(&self) -> Vec<usize> {
+        let Some(levels) = &self.lod else {
+            return Vec::new();
+        };
+        let mut h = vec![0; levels.len()];
+        for (mesh, _) in self.lod_items(levels) {
+            let k = levels
+                .iter()
+                .position(|l| std::ptr::eq(l, mesh))
+                .expect("an item draws one of the levels");
+            h[k] += 1;
+        }
+        h
+    }
+
+    /// The scene's instances: (mesh, placement), each choosing its level by its size on screen
     /// when LOD is on.
     fn lod_items<'a>(&self, levels: &'a [SceneMesh]) -> Vec<(&'a SceneMesh, Mat4)> {
         let eye = self.camera.eye();
+        let view_px = self.views.first().map_or(600.0, |v| v.target.size.1 as f32);
+        // Pixels per unit of length at distance 1.
+        let px_per_unit = view_px / (2.0 * (0.5 * self.camera.fov_y).tan());
         let n = LOD_GRID as f32;
         let mut items = Vec::with_capacity(LOD_GRID * LOD_GRID);
         for i in 0..LOD_GRID {
@@ -572,7 +617,9 @@ impl ViewerApp {
                 );
                 let place = Mat4::from_translation(at) * self.camera.model;
                 let level = if self.lod_on {
-                    lod_level(eye.distance(at), levels.len())
+                    // An instance's diagonal is 1: its height on screen in pixels.
+                    let px = px_per_unit / eye.distance(at).max(1e-3);
+                    lod_level(px, levels.len())
                 } else {
                     0
                 };
@@ -630,7 +677,6 @@ impl ViewerApp {
     /// Renders the pane textures.
     fn draw_views(&mut self, split: bool, lod: bool) {
         self.renders += 1;
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         let original = self.original.clone();
         let shown: Vec<Option<&SceneMesh>> = if split {
             vec![
@@ -659,6 +705,9 @@ impl ViewerApp {
             if style.mode == Mode::Texture && !mesh.is_some_and(|m| m.has_uvs) {
                 style.mode = Mode::Shaded;
             }
+            // One submission per pane: the renderer's uniforms are written through the queue,
+            // and a second pane's writes would land before the first pane's draw otherwise.
+            let mut enc = self.gpu.device.create_command_encoder(&Default::default());
             self.renderer.draw(
                 &self.gpu.device,
                 &self.gpu.queue,
@@ -668,9 +717,14 @@ impl ViewerApp {
                 &style,
                 &items,
             );
+            self.gpu.queue.submit([enc.finish()]);
         }
         self.lod = lod_levels;
-        self.gpu.queue.submit([enc.finish()]);
+        if let Some(sim) = &self.gpu.sim
+            && let Err(e) = sim.check_errors("drawing the view")
+        {
+            self.status = e.to_string();
+        }
     }
 
     /// Shows the pane textures and the overlays (labels, legend).
@@ -743,7 +797,9 @@ impl ViewerApp {
 
     /// One texture per pane, of the pane's size in pixels, registered with egui.
     fn ensure_views(&mut self, panes: &[egui::Rect], ppp: f32) -> Result<()> {
-        self.views.truncate(panes.len());
+        for v in self.views.drain(panes.len().min(self.views.len())..) {
+            self.gpu.egui_renderer.write().free_texture(&v.id);
+        }
         for (k, pane) in panes.iter().enumerate() {
             let size = (
                 ((pane.width() * ppp).round() as u32).max(1),
@@ -1146,10 +1202,7 @@ impl ViewerApp {
             s.seconds,
             s.report.stop_reason
         ));
-        ui.label(format!(
-            "mean error {:.3e}, max {:.3e} (of the diagonal)",
-            s.mean_error, s.max_error
-        ));
+        ui.label(error_text(s.error));
         if let Some(r) = &s.report.rounds {
             ui.label(format!("{} rounds; time per stage:", r.rounds));
             egui::Grid::new("stages").striped(true).show(ui, |ui| {
@@ -1269,17 +1322,28 @@ fn home_camera(m: &Model, aspect: f32) -> Camera {
     cam
 }
 
-/// The level an instance at `distance` from the eye draws: the original near, coarser farther,
-/// each level from twice the distance of the one before.
-pub fn lod_level(distance: f32, levels: usize) -> usize {
-    let near = 3.0 * LOD_SPACING;
+/// The level an instance `pixels` tall on screen draws: the original from
+/// [`LOD_FULL_PIXELS`] up, each coarser level below half the size of the one before (the levels'
+/// face counts fall about 4× apart, so the faces per pixel stay about even).
+pub fn lod_level(pixels: f32, levels: usize) -> usize {
     let mut level = 0;
-    let mut d = near;
-    while distance > d && level + 1 < levels {
+    let mut size = LOD_FULL_PIXELS;
+    while pixels < size && level + 1 < levels {
         level += 1;
-        d *= 2.0;
+        size *= 0.5;
     }
     level
+}
+
+/// On-screen height from which the LOD scene draws the original.
+pub const LOD_FULL_PIXELS: f32 = 240.0;
+
+/// The two-sided error as the window shows it.
+fn error_text(error: Option<(f64, f64)>) -> String {
+    match error {
+        Some((mean, max)) => format!("mean error {mean:.2e}, max {max:.2e} of the diagonal"),
+        None => "no faces left to measure".into(),
+    }
 }
 
 pub fn backend_name(b: Backend) -> &'static str {
@@ -1474,17 +1538,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn nearer_instances_draw_finer_levels() {
+    fn larger_instances_draw_finer_levels() {
         let levels = 4;
-        assert_eq!(lod_level(0.0, levels), 0);
+        assert_eq!(lod_level(1e4, levels), 0, "large on screen: the original");
         let mut last = 0;
-        for d in [1.0, 4.0, 8.0, 16.0, 32.0, 64.0, 1e6] {
-            let l = lod_level(d, levels);
-            assert!(l >= last && l < levels, "{d}: level {l}");
+        for px in [500.0, 240.0, 200.0, 100.0, 50.0, 20.0, 1.0, 0.0] {
+            let l = lod_level(px, levels);
+            assert!(l >= last && l < levels, "{px} px: level {l}");
             last = l;
         }
-        assert_eq!(last, levels - 1, "far away is the coarsest");
-        assert_eq!(lod_level(1e6, 1), 0, "one level only");
+        assert_eq!(last, levels - 1, "tiny is the coarsest");
+        assert_eq!(lod_level(0.0, 1), 0, "one level only");
     }
 
     #[test]

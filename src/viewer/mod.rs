@@ -59,7 +59,23 @@ pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> 
     }
     style.error_scale = scene.max_error;
     let mut renderer = Renderer::new(&ctx.device, &ctx.queue);
-    if let Some(t) = &model.texture {
+    let max = ctx.device.limits().max_texture_dimension_2d;
+    if let Some(t) = model
+        .texture
+        .as_ref()
+        .filter(|_| style.mode == Mode::Texture)
+        && (t.size.0 > max || t.size.1 > max)
+    {
+        return Err(Error::InvalidOption(format!(
+            "the texture is {}x{}, larger than this device's {max} pixels a side",
+            t.size.0, t.size.1
+        )));
+    }
+    if let Some(t) = model
+        .texture
+        .as_ref()
+        .filter(|_| style.mode == Mode::Texture)
+    {
         renderer.set_texture(&ctx.device, &ctx.queue, Some((&t.rgba, t.size)));
     }
     let mut cam = Camera {
@@ -80,6 +96,8 @@ pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> 
         &style,
         size,
     )?;
+    // The device's one error handler is the simplifier's: a refused draw shows up there.
+    sim.check_errors("rendering the frame")?;
     Ok(Frame {
         adapter: ctx.adapter_name.clone(),
         faces,
@@ -88,13 +106,13 @@ pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> 
     })
 }
 
-/// Opens the interactive window with `ratio` as the starting target (blocks until it is
-/// closed).
-pub fn run_window(start: Start, ratio: f64) -> Result<()> {
+/// Opens the interactive window with `ratio` as the starting target, drawn in `style`, of
+/// `size` points (blocks until it is closed).
+pub fn run_window(start: Start, ratio: f64, style: Style, size: (u32, u32)) -> Result<()> {
     let options = eframe::NativeOptions {
         viewport: eframe::egui::ViewportBuilder::default()
             .with_title("meshslim")
-            .with_inner_size([1280.0, 800.0])
+            .with_inner_size([size.0 as f32, size.1 as f32])
             .with_drag_and_drop(true),
         wgpu_options: eframe::egui_wgpu::WgpuConfiguration {
             wgpu_setup: app::wgpu_setup(),
@@ -114,6 +132,7 @@ pub fn run_window(start: Start, ratio: f64) -> Result<()> {
                 .unwrap_or(Start::Nothing);
             let mut app = ViewerApp::new(cc, start)?;
             app.set_ratio(ratio);
+            app.set_style(style);
             Ok(Box::new(app))
         }),
     )

@@ -147,7 +147,11 @@ impl Model {
 /// The first material library's first `map_Kd`, read as PNG; a note when one is named but
 /// unusable (the texture mode says why it is off).
 fn find_texture(path: &Path, mesh: &Mesh) -> (Option<Image>, Option<String>) {
-    let dir = path.parent().unwrap_or(Path::new("."));
+    // A bare file name has the empty path as its parent: the current folder.
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
     for lib in &mesh.material_libs {
         let mtl = dir.join(lib);
         let Ok(text) = std::fs::read_to_string(&mtl) else {
@@ -176,6 +180,11 @@ fn find_texture(path: &Path, mesh: &Mesh) -> (Option<Image>, Option<String>) {
             .flatten()
             .map(|e| e.path())
             .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")))
+            // The viewer's own screenshots are not textures.
+            .filter(|p| {
+                !p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with("meshslim-"))
+            })
             .collect();
         if let [only] = &pngs[..] {
             return match read_png(only) {
@@ -233,9 +242,9 @@ pub struct Simplified {
     pub mesh: Mesh,
     pub report: SimplifyReport,
     pub seconds: f64,
-    /// Two-sided distance to the original, relative to its diagonal.
-    pub mean_error: f64,
-    pub max_error: f64,
+    /// Two-sided distance to the original, relative to its diagonal: mean and max; `None` when
+    /// the result has no faces to measure.
+    pub error: Option<(f64, f64)>,
 }
 
 /// Simplifies `model` with `opts.backend`. The `gpu` backend runs on `sim` (the window's own
@@ -319,14 +328,19 @@ pub fn simplify(
         samples: Some(VIEWER_SAMPLES),
         ..CompareOptions::default()
     };
-    let d = compare(&model.mesh, &mesh, &sampling)?.distance.two_sided;
+    let error = if mesh.triangles.is_empty() {
+        None
+    } else {
+        let d = compare(&model.mesh, &mesh, &sampling)?.distance.two_sided;
+        Some((d.mean_rel, d.max_rel))
+    };
+    opts.cancel.check()?;
     Ok(Simplified {
         scene,
         mesh,
         report,
         seconds,
-        mean_error: d.mean_rel,
-        max_error: d.max_rel,
+        error,
     })
 }
 
