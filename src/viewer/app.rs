@@ -745,52 +745,40 @@ impl ViewerApp {
                 egui::Color32::WHITE,
             );
         }
-        let text = egui::Color32::from_gray(220);
-        let font = egui::FontId::proportional(13.0);
+        let label = |at: egui::Pos2, align: egui::Align2, text: &str| {
+            overlay_text(&painter, at, align, text, 13.0);
+        };
+        let top_left = egui::Align2::LEFT_TOP;
         if split {
-            painter.text(
+            label(
                 panes[0].left_top() + egui::vec2(8.0, 6.0),
-                egui::Align2::LEFT_TOP,
+                top_left,
                 "original",
-                font.clone(),
-                text,
             );
-            painter.text(
-                panes[1].left_top() + egui::vec2(8.0, 6.0),
-                egui::Align2::LEFT_TOP,
-                if self.simplified.is_some() {
-                    "simplified"
-                } else {
-                    "original (not simplified yet)"
-                },
-                font.clone(),
-                text,
-            );
+            let right = if self.simplified.is_some() {
+                "simplified"
+            } else {
+                "original (not simplified yet)"
+            };
+            label(panes[1].left_top() + egui::vec2(8.0, 6.0), top_left, right);
         }
         if lod {
-            painter.text(
-                rect.left_top() + egui::vec2(8.0, 6.0),
-                egui::Align2::LEFT_TOP,
-                format!(
-                    "LOD scene {0}x{0}: LOD {1}, {2:.1} ms / frame",
-                    LOD_GRID,
-                    if self.lod_on { "on" } else { "off" },
-                    self.clock.smoothed * 1e3
-                ),
-                font.clone(),
-                text,
+            let text = format!(
+                "LOD scene {0}x{0}: LOD {1}, {2:.1} ms / frame",
+                LOD_GRID,
+                if self.lod_on { "on" } else { "off" },
+                self.clock.smoothed * 1e3
             );
+            label(rect.left_top() + egui::vec2(8.0, 6.0), top_left, &text);
         }
         if self.style.mode == Mode::Heatmap {
             heatmap_legend(&painter, rect, self.style.error_scale);
         }
         if self.fly {
-            painter.text(
+            label(
                 rect.left_bottom() + egui::vec2(8.0, -8.0),
                 egui::Align2::LEFT_BOTTOM,
                 "fly: W A S D move, Q E down/up, drag to look, G to leave",
-                font,
-                text,
             );
         }
     }
@@ -1373,29 +1361,36 @@ fn heatmap_legend(painter: &egui::Painter, rect: egui::Rect, top: f32) {
         );
         painter.rect_filled(r, 0.0, ramp_color((t0 + t1) * 0.5));
     }
-    let text = egui::Color32::from_gray(220);
-    let font = egui::FontId::proportional(12.0);
-    painter.text(
+    let top = format!("{top:.2e}");
+    let at = |p: egui::Pos2, align, text: &str| overlay_text(painter, p, align, text, 12.0);
+    at(
         bar.right_top() + egui::vec2(4.0, 0.0),
         egui::Align2::LEFT_TOP,
-        format!("{top:.2e}"),
-        font.clone(),
-        text,
+        &top,
     );
-    painter.text(
+    at(
         bar.right_bottom() + egui::vec2(4.0, 0.0),
         egui::Align2::LEFT_BOTTOM,
         "0",
-        font.clone(),
-        text,
     );
-    painter.text(
+    let caption = "vertex distance / diagonal";
+    at(
         bar.center_bottom() + egui::vec2(0.0, 4.0),
         egui::Align2::CENTER_TOP,
-        "vertex distance / diagonal",
-        font,
-        text,
+        caption,
     );
+}
+
+/// Light text over the 3D view.
+fn overlay_text(
+    painter: &egui::Painter,
+    at: egui::Pos2,
+    align: egui::Align2,
+    text: &str,
+    size: f32,
+) {
+    let color = egui::Color32::from_gray(220);
+    painter.text(at, align, text, egui::FontId::proportional(size), color);
 }
 
 /// `ramp` in shaders/viewer/mesh.wgsl.
