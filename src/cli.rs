@@ -148,7 +148,8 @@ pub struct ViewArgs {
     #[arg(long, value_name = "FILE.png")]
     pub screenshot: Option<PathBuf>,
 
-    /// A PNG texture for the texture mode (default: the OBJ material's map_Kd)
+    /// A PNG texture for the texture mode (default: the OBJ material's map_Kd, else the only PNG
+    /// beside a mesh that has UVs)
     #[arg(long, value_name = "FILE.png")]
     pub texture: Option<PathBuf>,
 
@@ -212,6 +213,17 @@ fn run_view(args: ViewArgs) -> Result<ExitCode> {
         }
     };
     let Some(png) = args.screenshot.clone() else {
+        // A file that cannot be opened fails here, not in a window that opens to say so.
+        if let Some(Input::File(p)) = &args.input {
+            std::fs::File::open(p)
+                .map_err(|e| {
+                    lib(crate::Error::Io {
+                        path: p.clone(),
+                        source: e,
+                    })
+                })
+                .context("cannot read the input")?;
+        }
         let start = match &args.input {
             Some(Input::File(p)) if args.texture.is_none() => crate::viewer::Start::Open(p.clone()),
             Some(input) => crate::viewer::Start::Model(model(input)?),

@@ -167,6 +167,10 @@ fn screenshot_command_writes_a_png() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+    // A missing file fails before any window opens.
+    let o = meshslim(&["view", "missing.ply"], dir.path());
+    expect_code(&o, 1);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("missing.ply"));
     // --mode texture on a mesh without UVs says why; a bad size is a usage error.
     let o = meshslim(
         &[
