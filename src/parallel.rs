@@ -30,7 +30,7 @@ pub trait RoundRunner {
     /// Runs one round with `params` (the first also computes face planes, flags and quadrics)
     /// and returns its counters.
     fn round(&mut self, params: &Params, first: bool) -> Result<Counters>;
-    /// The current mesh, read back.
+    /// The current mesh, read back; the rounds can go on afterwards.
     fn download(&mut self) -> Result<Download>;
     fn stage_times(&self) -> &StageTimes;
 }

@@ -517,12 +517,14 @@ impl RoundRunner for CpuRounds {
     }
 
     fn download(&mut self) -> Result<Download> {
+        // A copy, as the GPU's read-back is: the rounds can go on afterwards (a resumed run
+        // reads each level). The mesh is compacted by then, so this is a small part of a run.
         Ok(Download {
-            positions: std::mem::take(&mut self.positions),
-            flags: std::mem::take(&mut self.flags),
-            vertex_attr: std::mem::take(&mut self.vertex_attr),
-            indices: std::mem::take(&mut self.indices),
-            face_extra: std::mem::take(&mut self.face_extra),
+            positions: self.positions.clone(),
+            flags: self.flags.clone(),
+            vertex_attr: self.vertex_attr.clone(),
+            indices: self.indices.clone(),
+            face_extra: self.face_extra.clone(),
         })
     }
 
