@@ -2,6 +2,8 @@
 // buffer and its u32 indices, plus per-vertex extras the viewer keeps beside them (distance to
 // the original surface for the heatmap, a smooth normal, a texture coordinate). Flat normals come
 // from screen-space derivatives, so the flat modes need none of the extras.
+// Relies on: every extra buffer holds one entry per vertex of the GpuMesh drawn with it
+// (SceneMesh sizes them so), as the indirect draw may index any vertex the rounds kept.
 
 // One per drawn instance (dynamic uniform offset). Keep in sync with `ViewUniform` in
 // src/viewer/render.rs.
