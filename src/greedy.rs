@@ -667,12 +667,18 @@ fn key(priority: f64) -> u32 {
 
 impl<'a> State<'a> {
     fn next_mark(&mut self) -> u32 {
-        self.mark_gen = self.mark_gen.wrapping_add(1);
-        if self.mark_gen == 0 {
+        self.next_marks(1)
+    }
+
+    /// `n` fresh mark values `m..m + n`; returns `m`.
+    fn next_marks(&mut self, n: u32) -> u32 {
+        if self.mark_gen > u32::MAX - n {
             self.mark.iter_mut().for_each(|m| *m = 0);
-            self.mark_gen = 1;
+            self.mark_gen = 0;
         }
-        self.mark_gen
+        let m = self.mark_gen + 1;
+        self.mark_gen += n;
+        m
     }
 
     fn stamp(&self, a: u32, b: u32) -> u32 {
@@ -824,7 +830,8 @@ impl<'a> State<'a> {
 
         // Link condition: the common neighbours of the endpoints are exactly the vertices
         // opposite the edge in its faces (Dey et al. 1999), which keeps a manifold manifold.
-        let m = self.next_mark();
+        // m marks keep's neighbours, m + 1 those of them already counted as common.
+        let m = self.next_marks(2);
         for &f in self.vert_faces.get(k) {
             if self.topo_faces[f as usize][0] != DEAD {
                 for &u in &self.topo_faces[f as usize] {
@@ -834,7 +841,7 @@ impl<'a> State<'a> {
         }
         let mut edge_faces = 0u32;
         let mut opposite = [u32::MAX; 2];
-        self.scratch.clear();
+        let mut common = 0u32;
         for &f in self.vert_faces.get(r) {
             if self.topo_faces[f as usize][0] == DEAD {
                 continue;
@@ -850,16 +857,17 @@ impl<'a> State<'a> {
             }
             for u in t {
                 if u != keep && u != remove && self.mark[u as usize] == m {
-                    self.scratch.push(u);
+                    // Counted once however many of remove's faces it is on: re-marking
+                    // replaced collecting them all and sorting out the duplicates.
+                    self.mark[u as usize] = m + 1;
+                    common += 1;
                 }
             }
         }
         if edge_faces == 0 {
             return None;
         }
-        self.scratch.sort_unstable();
-        self.scratch.dedup();
-        if self.scratch.len() != edge_faces as usize {
+        if common != edge_faces {
             return None;
         }
         // Joining two border vertices through the interior would pinch the surface.
