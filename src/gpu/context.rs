@@ -42,6 +42,46 @@ impl GpuContext {
     }
 }
 
+/// A buffer of `size` bytes (at least 16 and a multiple of 4: wgpu refuses empty buffers),
+/// checked against the device's limits before it is allocated.
+pub fn checked_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    size: u64,
+    usage: wgpu::BufferUsages,
+) -> Result<wgpu::Buffer> {
+    check_buffer(&device.limits(), label, size)?;
+    Ok(device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(16).next_multiple_of(4),
+        usage,
+        mapped_at_creation: false,
+    }))
+}
+
+/// A buffer holding `data` zero-padded to `len` bytes (at least 16), checked against the
+/// device's limits before it is allocated.
+pub fn checked_buffer_init(
+    device: &wgpu::Device,
+    label: &str,
+    data: &[u8],
+    len: usize,
+    usage: wgpu::BufferUsages,
+) -> Result<wgpu::Buffer> {
+    use wgpu::util::DeviceExt;
+    let len = len.max(data.len());
+    check_buffer(&device.limits(), label, len as u64)?;
+    let mut bytes = data.to_vec();
+    bytes.resize(len.max(16), 0);
+    Ok(
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: &bytes,
+            usage,
+        }),
+    )
+}
+
 /// What meshslim asks of a device, whoever creates it (the simplifier here, eframe for the
 /// viewer's window, the viewer's tests): the adapter's own limits, so that million-triangle
 /// meshes fit; timestamp queries for the per-stage table and line polygons for the viewer's

@@ -2,14 +2,13 @@
 //! per mesh ([`GpuMesh`] plus the working buffers), and one command buffer per round whose only
 //! read-back is the 64-byte counters block (and the stage timestamps when the device has them).
 
-use super::context::{ErrorSink, check_buffer};
+use super::context::{ErrorSink, checked_buffer, checked_buffer_init};
 use super::shaders::{STAGES, source};
 use super::types::*;
 use crate::error::{Error, Result};
 use crate::parallel::{Download, RoundRunner, StageTimes, Upload};
 use std::collections::HashMap;
 use std::time::Instant;
-use wgpu::util::DeviceExt;
 
 const SU: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
     .union(wgpu::BufferUsages::COPY_DST)
@@ -114,18 +113,8 @@ impl GpuMesh {
         center: [f64; 3],
         scale: f64,
     ) -> Result<GpuMesh> {
-        let limits = device.limits();
-        let init = |label: &str, data: &[u8], usage| -> Result<wgpu::Buffer> {
-            check_buffer(&limits, label, data.len() as u64)?;
-            let mut bytes = data.to_vec();
-            bytes.resize(bytes.len().max(16), 0);
-            Ok(
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents: &bytes,
-                    usage,
-                }),
-            )
+        let init = |label: &str, data: &[u8], usage| {
+            checked_buffer_init(device, label, data, data.len(), usage)
         };
         let args = DrawArgs {
             index_count: indices.len() as u32,
@@ -236,30 +225,14 @@ impl<'a> GpuRounds<'a> {
     ) -> Result<GpuRounds<'a>> {
         let t = Instant::now();
         let dev = &sim.device;
-        let limits = dev.limits();
         let nv = up.positions.len().max(1) as u64;
         let nf = up.face_count().max(1) as u64;
         let cap = 3 * nf;
-        let mk = |label: &str, size: u64, usage: wgpu::BufferUsages| -> Result<wgpu::Buffer> {
-            let label = format!("meshslim.{label}");
-            check_buffer(&limits, &label, size)?;
-            Ok(dev.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(&label),
-                size: size.max(16).next_multiple_of(4),
-                usage,
-                mapped_at_creation: false,
-            }))
+        let mk = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+            checked_buffer(dev, &format!("meshslim.{label}"), size, usage)
         };
-        let init = |label: &str, data: &[u8], usage: wgpu::BufferUsages| -> Result<wgpu::Buffer> {
-            let label = format!("meshslim.{label}");
-            check_buffer(&limits, &label, data.len() as u64)?;
-            let mut bytes = data.to_vec();
-            bytes.resize(bytes.len().max(16), 0);
-            Ok(dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(&label),
-                contents: &bytes,
-                usage,
-            }))
+        let init = |label: &str, data: &[u8], usage: wgpu::BufferUsages| {
+            checked_buffer_init(dev, &format!("meshslim.{label}"), data, data.len(), usage)
         };
         let mesh_usage = MESH_USAGE;
         let qsize = std::mem::size_of::<Quadric>() as u64;
@@ -512,17 +485,8 @@ impl<'a> GpuRounds<'a> {
     /// round ([`crate::parallel::Driver`] knows them).
     pub fn snapshot(&self, up: &Upload, vertices: usize, faces: usize) -> Result<GpuMesh> {
         let dev = &self.sim.device;
-        let limits = dev.limits();
         let h = &self.half[self.cur];
-        let mk = |label: &str, size: u64, usage| -> Result<wgpu::Buffer> {
-            check_buffer(&limits, label, size)?;
-            Ok(dev.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: size.max(16).next_multiple_of(4),
-                usage,
-                mapped_at_creation: false,
-            }))
-        };
+        let mk = |label: &str, size: u64, usage| checked_buffer(dev, label, size, usage);
         let (pb, ib) = (vertices as u64 * 16, faces as u64 * 12);
         let mesh = GpuMesh {
             positions: mk("meshslim.lod.positions", pb, MESH_USAGE)?,

@@ -91,18 +91,14 @@ impl SceneMesh {
         faces: usize,
         extras: &Extras,
     ) -> Result<SceneMesh> {
-        let limits = device.limits();
-        let buf = |label: &str, data: &[u8], len: usize| -> Result<wgpu::Buffer> {
-            crate::gpu::context::check_buffer(&limits, label, len as u64)?;
-            let mut bytes = data.to_vec();
-            // Zeros where the extra is missing; at least 16 bytes, wgpu refuses empty buffers.
-            bytes.resize(len.max(16), 0);
-            Ok(
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents: &bytes,
-                    usage: wgpu::BufferUsages::VERTEX,
-                }),
+        // Zeros where the extra is missing.
+        let buf = |label: &str, data: &[u8], len: usize| {
+            crate::gpu::context::checked_buffer_init(
+                device,
+                label,
+                data,
+                len,
+                wgpu::BufferUsages::VERTEX,
             )
         };
         let max_error = extras.error.iter().fold(0f32, |m, &e| m.max(e));

@@ -102,12 +102,7 @@ impl Model {
     pub fn original(&self, device: &wgpu::Device) -> Result<SceneMesh> {
         let up = &self.up;
         let gpu = GpuMesh::from_arrays(device, &up.positions, &up.indices, up.center, up.scale)?;
-        let uvs = up.welded.uvs.as_ref().map(|uv| {
-            up.vertex_attr
-                .iter()
-                .map(|&a| uv[a as usize])
-                .collect::<Vec<_>>()
-        });
+        let uvs = class_uvs(up, &up.vertex_attr);
         let extras = Extras {
             error: Vec::new(),
             normals: vertex_normals(&up.positions, &up.indices),
@@ -142,6 +137,12 @@ impl Model {
             })
             .collect()
     }
+}
+
+/// Each position class's UV: that of the attribute vertex the rounds keep for it (`vertex_attr`).
+fn class_uvs(up: &Upload, vertex_attr: &[u32]) -> Option<Vec<[f32; 2]>> {
+    let uv = up.welded.uvs.as_ref()?;
+    Some(vertex_attr.iter().map(|&a| uv[a as usize]).collect())
 }
 
 /// The first material library's first `map_Kd`, read as PNG; a note when one is named but
@@ -288,12 +289,7 @@ pub fn simplify(
             // back; what is drawn is the rounds' own buffers.
             let d = rounds.download()?;
             let indices = d.indices.clone();
-            let uvs = up.welded.uvs.as_ref().map(|uv| {
-                d.vertex_attr
-                    .iter()
-                    .map(|&a| uv[a as usize])
-                    .collect::<Vec<_>>()
-            });
+            let uvs = class_uvs(up, &d.vertex_attr);
             let gpu = rounds.into_mesh(up)?;
             (gpu, d.positions, indices, mesh, report, uvs)
         }
