@@ -51,8 +51,9 @@ pub struct SimplifyOptions {
     pub quality_threshold: f64,
     pub backend: Backend,
     /// `cpu` backend: how many regions large meshes are split into for the parallel first
-    /// phase; `None` picks 8 for meshes of 100,000 faces or more and 1 (purely sequential)
-    /// below. The result depends on this number, never on the number of threads.
+    /// level (a second level then uses at most 4); `None` picks one per 32,768 faces, 8 to 32,
+    /// for meshes of 100,000 faces or more and 1 (purely sequential) below. The result depends
+    /// on this number, never on the number of threads.
     pub partitions: Option<usize>,
     /// Set from another thread to stop a running simplification (the viewer's Cancel button):
     /// it then returns [`Error::Cancelled`] within one round or a few thousand collapses.
