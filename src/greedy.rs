@@ -1616,4 +1616,52 @@ mod tests {
         let (mut s, _) = State::new(Prepared::new(&m, &lax), &lax);
         assert!(s.evaluate(centre, folding).is_some());
     }
+
+    /// The queue gives entries back in (key, a, b, stamp) order across buckets and within one,
+    /// takes an entry pushed below the bucket being taken next, and drops the entries of a
+    /// bucket that are no longer current when that bucket comes up.
+    #[test]
+    fn queue_pops_in_key_order_and_drops_stale_entries() {
+        // A deterministic spread of keys over many buckets and exponents, with ties.
+        let keys: Vec<u32> = (0..5000u32)
+            .map(|i| {
+                (0.5 + (i.wrapping_mul(2_654_435_761) % 977) as f32 * 1e-3).to_bits() >> (i % 3)
+            })
+            .collect();
+        let mut q = Queue::new();
+        for (i, &k) in keys.iter().enumerate() {
+            q.push(k, i as u32 % 7, i as u32, 0);
+        }
+        let mut expected: Vec<(u32, u32, u32, u32)> = keys
+            .iter()
+            .enumerate()
+            .map(|(i, &k)| (k, i as u32 % 7, i as u32, 0))
+            .collect();
+        expected.sort_unstable();
+        let mut got = Vec::new();
+        while let Some(e) = q.pop(|_, _, _| true) {
+            got.push(e);
+            if got.len() == 100 {
+                // Below everything still queued (and below the last key taken): it must come
+                // out next.
+                let below = got[99].0 - 1;
+                q.push(below, 0, u32::MAX, 9);
+                assert_eq!(q.pop(|_, _, _| true), Some((below, 0, u32::MAX, 9)));
+            }
+        }
+        assert_eq!(got, expected);
+        assert!(q.is_empty());
+
+        // Odd stamps are stale: none of them comes out, every even one does.
+        let mut q = Queue::new();
+        for (i, &k) in keys.iter().enumerate() {
+            q.push(k, 1, i as u32, i as u32 % 2);
+        }
+        let mut n = 0;
+        while let Some((_, _, _, stamp)) = q.pop(|_, _, stamp| stamp == 0) {
+            assert_eq!(stamp, 0);
+            n += 1;
+        }
+        assert_eq!(n, keys.len().div_ceil(2));
+    }
 }
