@@ -337,9 +337,9 @@ impl Prepared {
     /// back. Returns the sub-problem and its local → whole topological vertex map.
     pub(crate) fn subset(&self, faces: &[u32], pin: &[bool]) -> (Prepared, Vec<u32>) {
         // The vertices used, in ascending order, through a table over the span of their ids
-        // (a region is mostly one run of the Morton order): measured on the 1M scan, sorting
-        // the 400k corners of each of the 8 regions and binary-searching them took 0.05 s
-        // per region, twice the region's whole queue set-up.
+        // (a region is one or two runs of the Morton order): measured on the 1M scan, sorting
+        // the 400k corners of each of 8 regions and binary-searching them took 0.05 s per
+        // region, twice the region's whole queue set-up.
         let corner_topo = |f: u32| self.faces[f as usize].map(|v| self.topo[v as usize]);
         let (lo, hi) = faces
             .iter()
@@ -620,7 +620,7 @@ struct State<'a> {
 }
 
 /// The queue of (key, a, b, stamp) entries: a bucket queue on the key's top bits (f32
-/// exponent and three mantissa bits, so a bucket spans 12.5% of cost) in front of a binary heap
+/// exponent and three mantissa bits, so a bucket spans 6-12.5% of cost) in front of a binary heap
 /// that orders the one bucket being taken. An entry is appended to its bucket, moved once into
 /// the heap when its bucket comes up, and popped; an edge re-keyed below the bucket being taken
 /// (a collapse can make a neighbouring edge cheaper than the edge just taken) goes straight into
@@ -677,15 +677,22 @@ impl Queue {
                 return Some(e);
             }
             let from = (self.active_end >> BUCKET_SHIFT) as usize;
-            let i = (from / 64..self.occupied.len()).find_map(|w| {
+            let Some(i) = (from / 64..self.occupied.len()).find_map(|w| {
                 let bits = self.occupied[w] & (!0u64 << (from.max(w * 64) - w * 64));
                 (bits != 0).then(|| w * 64 + bits.trailing_zeros() as usize)
-            })?;
+            }) else {
+                // Empty: start again from the bottom, so a queue filled anew (the run re-queues
+                // every edge before giving up) fills buckets rather than all go to the heap.
+                self.active_end = 0;
+                return None;
+            };
             self.occupied[i / 64] &= !(1 << (i % 64));
             let list = std::mem::take(&mut self.buckets[i]);
             self.waiting -= list.len();
             self.active_end = ((i as u64) + 1) << BUCKET_SHIFT;
-            let mut live: Vec<Reverse<(u32, u32, u32, u32)>> = Vec::with_capacity(list.len());
+            // The heap is empty here: its allocation takes the bucket's live entries.
+            let mut live = std::mem::take(&mut self.active).into_vec();
+            live.clear();
             live.extend(
                 list.into_iter()
                     .filter(|&(_, a, b, stamp)| current(a, b, stamp))
@@ -1305,17 +1312,17 @@ pub fn simplify_greedy(
     } else {
         1
     });
-    let mut phase1 = PhaseStats::default();
+    let mut levels = PhaseStats::default();
     let p = if regions > 1 && target < nf {
         let mut report = |faces: usize| progress((nf - faces) as f32 / need);
-        let p = partitioned_phase(p, opts, regions, 0, &mut phase1, &mut report);
+        let first = Cuts::first(p.pos.len(), regions);
+        let p = partitioned_phase(p, opts, first, &mut levels, &mut report);
         if p.faces.len() > partitioned_stop(target) && !opts.cancel.is_cancelled() {
-            // The second level: fewer, larger regions, their cuts half a first-level region
-            // along the Morton order from any first-level cut, so the vertices the first
-            // level had to pin are interior now and thin out with the rest.
-            let shift = p.pos.len() / (2 * regions);
-            let regions = SECOND_LEVEL_REGIONS.min(regions);
-            partitioned_phase(p, opts, regions, shift, &mut phase1, &mut report)
+            // The second level: fewer, larger regions, each cut half a first-level region
+            // along the Morton order from a first-level cut, so the vertices the first level
+            // had to pin are interior now and thin out with the rest.
+            let second = first.second(SECOND_LEVEL_REGIONS);
+            partitioned_phase(p, opts, second, &mut levels, &mut report)
         } else {
             p
         }
@@ -1332,7 +1339,7 @@ pub fn simplify_greedy(
 
     let stop_reason = if s.faces <= target {
         StopReason::TargetReached
-    } else if s.hit_max_error || phase1.hit_max_error {
+    } else if s.hit_max_error || levels.hit_max_error {
         StopReason::MaxError
     } else {
         StopReason::NoValidCollapse
@@ -1345,8 +1352,8 @@ pub fn simplify_greedy(
         output_faces: out.triangles.len(),
         input_vertices: input.positions.len(),
         output_vertices: out.positions.len(),
-        collapses: s.collapses + phase1.collapses,
-        max_collapse_error: s.max_collapse_err2.max(phase1.max_collapse_err2).sqrt(),
+        collapses: s.collapses + levels.collapses,
+        max_collapse_error: s.max_collapse_err2.max(levels.max_collapse_err2).sqrt(),
         stop_reason,
         dropped_degenerate_faces: s.p.dropped_degenerate,
         pinned_vertices,
@@ -1362,21 +1369,63 @@ struct PhaseStats {
     hit_max_error: bool,
 }
 
-/// One partitioned level of [`simplify_greedy`], its regions the Morton order cut into
-/// `regions` runs starting `shift` vertices along (the last wraps around to the first):
-/// returns the whole mesh, reduced, prepared for the next level; adds to `stats`.
+/// Where a partitioned level cuts the topological vertices (Morton ranks `0..nt`): into `base`
+/// equal runs of the Morton order, the first starting `shift` ranks along (so run 0 wraps
+/// around the end of the order), grouped `base / regions` at a time into `regions` regions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Cuts {
+    nt: usize,
+    base: usize,
+    regions: usize,
+    shift: usize,
+}
+
+impl Cuts {
+    /// The first level: `regions` runs from rank 0.
+    fn first(nt: usize, regions: usize) -> Cuts {
+        Cuts {
+            nt,
+            base: regions,
+            regions,
+            shift: 0,
+        }
+    }
+
+    /// A second level of at most `regions` regions made of this level's runs moved half a run
+    /// along, so each of its cuts is half a run from every cut of this level. (Cutting the
+    /// shifted order into `regions` equal parts instead put cuts right on first-level cuts
+    /// whenever the first level's count was not a multiple of it.)
+    fn second(self, regions: usize) -> Cuts {
+        Cuts {
+            nt: self.nt,
+            base: self.base,
+            regions: regions.min(self.base),
+            shift: self.nt / (2 * self.base),
+        }
+    }
+
+    fn region_of(&self, t: u32) -> u32 {
+        let nt = self.nt.max(1);
+        let run = (t as usize + self.shift) % nt * self.base / nt;
+        (run * self.regions / self.base) as u32
+    }
+}
+
+/// One partitioned level of [`simplify_greedy`], its regions as `cuts` says: returns the whole
+/// mesh, reduced, prepared for the next level or the final queue; adds to `stats`.
 fn partitioned_phase(
     mut p: Prepared,
     opts: &SimplifyOptions,
-    regions: usize,
-    shift: usize,
+    cuts: Cuts,
     stats: &mut PhaseStats,
     progress: &mut dyn FnMut(usize),
 ) -> Prepared {
     use rayon::prelude::*;
     let nt = p.pos.len();
+    assert_eq!(cuts.nt, nt, "cuts made for another mesh");
+    let regions = cuts.regions;
     let nf = p.faces.len();
-    let region_of = |t: u32| ((t as usize + shift) % nt.max(1) * regions / nt.max(1)) as u32;
+    let region_of = |t: u32| cuts.region_of(t);
     let face_topo = |f: usize| p.faces[f].map(|v| p.topo[v as usize]);
     let face_region: Vec<u32> = (0..nf)
         .map(|f| {
@@ -1388,7 +1437,7 @@ fn partitioned_phase(
             }
         })
         .collect();
-    // Vertices of faces that cross regions stay put in phase 1.
+    // Vertices of faces that cross regions stay put in this level.
     let mut frontier = vec![false; nt];
     for (f, &r) in face_region.iter().enumerate() {
         if r == u32::MAX {
@@ -1440,13 +1489,17 @@ fn partitioned_phase(
             // Pinned frontier vertices cannot thin out; if the interior were simplified far
             // below their density, its faces would fan out from them into long slivers. So a
             // region stops where its frontier would be a quarter of its vertices (a closed
-            // triangle mesh has about two faces per vertex) and phase 2 takes it from there.
+            // triangle mesh has about two faces per vertex) and the next level or the final
+            // queue takes it from there.
             let own_frontier = topo_global
                 .iter()
                 .filter(|&&t| frontier[t as usize] && region_of(t) == r)
                 .count();
             let floor = own_cut + ((own as f64 * ratio).ceil() as usize).max(8 * own_frontier);
-            let (state, heap) = State::new(sub, opts);
+            let (mut state, heap) = State::new(sub, opts);
+            // Sized for every attribute vertex of the whole mesh and read only by
+            // `State::new`: not kept for each of up to 32 regions through the level.
+            state.p.topo = Vec::new();
             Region {
                 state,
                 heap,
@@ -1618,8 +1671,9 @@ mod tests {
     }
 
     /// The queue gives entries back in (key, a, b, stamp) order across buckets and within one,
-    /// takes an entry pushed below the bucket being taken next, and drops the entries of a
-    /// bucket that are no longer current when that bucket comes up.
+    /// gives an entry pushed below the last key taken next, sorts entries pushed while it is
+    /// being drained among the rest, and drops the entries of a bucket that are no longer
+    /// current when that bucket comes up.
     #[test]
     fn queue_pops_in_key_order_and_drops_stale_entries() {
         // A deterministic spread of keys over many buckets and exponents, with ties.
@@ -1638,6 +1692,15 @@ mod tests {
             .map(|(i, &k)| (k, i as u32 % 7, i as u32, 0))
             .collect();
         expected.sort_unstable();
+        // Pushed while draining, as a run re-keys edges: above everything (the top bucket,
+        // whose end is 2^32) and in the middle.
+        let late = [
+            (u32::MAX, 3, 4, 0),
+            (0x8000_0000, 1, 2, 0),
+            (keys[17], 8, 9, 0),
+        ];
+        expected.extend(late);
+        expected.sort_unstable();
         let mut got = Vec::new();
         while let Some(e) = q.pop(|_, _, _| true) {
             got.push(e);
@@ -1647,9 +1710,18 @@ mod tests {
                 let below = got[99].0 - 1;
                 q.push(below, 0, u32::MAX, 9);
                 assert_eq!(q.pop(|_, _, _| true), Some((below, 0, u32::MAX, 9)));
+                for (k, a, b, stamp) in late {
+                    q.push(k, a, b, stamp);
+                }
             }
         }
         assert_eq!(got, expected);
+        assert!(q.is_empty());
+        // Filled again after running dry, it starts from the bottom.
+        q.push(5, 0, 1, 0);
+        q.push(3, 0, 2, 0);
+        assert_eq!(q.pop(|_, _, _| true), Some((3, 0, 2, 0)));
+        assert_eq!(q.pop(|_, _, _| true), Some((5, 0, 1, 0)));
         assert!(q.is_empty());
 
         // Odd stamps are stale: none of them comes out, every even one does.
@@ -1663,5 +1735,35 @@ mod tests {
             n += 1;
         }
         assert_eq!(n, keys.len().div_ceil(2));
+        assert!(q.is_empty());
+    }
+
+    /// Every cut of the second level is half a first-level run from the nearest first-level
+    /// cut, whatever the first level's region count, and the second level has all its regions.
+    #[test]
+    fn second_level_cuts_fall_between_first_level_cuts() {
+        let nt = 100_003;
+        let cut_ranks = |c: Cuts| -> Vec<usize> {
+            (1..nt)
+                .filter(|&t| c.region_of(t as u32) != c.region_of(t as u32 - 1))
+                .collect()
+        };
+        for base in 2..=40 {
+            let first = Cuts::first(nt, base);
+            let second = first.second(SECOND_LEVEL_REGIONS);
+            let (a, b) = (cut_ranks(first), cut_ranks(second));
+            assert_eq!(a.len(), base - 1);
+            let regions: std::collections::BTreeSet<u32> =
+                (0..nt as u32).map(|t| second.region_of(t)).collect();
+            assert_eq!(regions.len(), SECOND_LEVEL_REGIONS.min(base), "{base} runs");
+            let run = nt / base;
+            for &c in &b {
+                let nearest = a.iter().map(|&x| x.abs_diff(c)).min().unwrap_or(nt);
+                assert!(
+                    nearest + 2 >= run / 2,
+                    "{base} runs: a second-level cut at {c} is {nearest} from a first-level cut"
+                );
+            }
+        }
     }
 }
