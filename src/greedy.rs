@@ -1200,10 +1200,7 @@ impl<'a> State<'a> {
         let mut next_report = self.collapses;
         let mut seeded_at = self.collapses;
         while self.faces > target {
-            let version = &self.version;
-            let Some((k, a, b, stamp)) = heap
-                .pop(|a, b, stamp| version[a as usize].wrapping_add(version[b as usize]) == stamp)
-            else {
+            let Some((k, a, b, stamp)) = heap.pop(|a, b, stamp| self.stamp(a, b) == stamp) else {
                 // An edge refused earlier (a flip, the link condition) can have become valid
                 // through collapses around it that did not touch its endpoints: before giving
                 // up, queue every live edge once more if anything changed since the last time.
@@ -1312,17 +1309,17 @@ pub fn simplify_greedy(
     } else {
         1
     });
-    let mut levels = PhaseStats::default();
+    let mut levels = LevelStats::default();
     let p = if regions > 1 && target < nf {
         let mut report = |faces: usize| progress((nf - faces) as f32 / need);
         let first = Cuts::first(p.pos.len(), regions);
-        let p = partitioned_phase(p, opts, first, &mut levels, &mut report);
+        let p = partitioned_level(p, opts, first, &mut levels, &mut report);
         if p.faces.len() > partitioned_stop(target) && !opts.cancel.is_cancelled() {
             // The second level: fewer, larger regions, each cut half a first-level region
             // along the Morton order from a first-level cut, so the vertices the first level
             // had to pin are interior now and thin out with the rest.
             let second = first.second(SECOND_LEVEL_REGIONS);
-            partitioned_phase(p, opts, second, &mut levels, &mut report)
+            partitioned_level(p, opts, second, &mut levels, &mut report)
         } else {
             p
         }
@@ -1363,7 +1360,7 @@ pub fn simplify_greedy(
 }
 
 #[derive(Default)]
-struct PhaseStats {
+struct LevelStats {
     collapses: usize,
     max_collapse_err2: f64,
     hit_max_error: bool,
@@ -1413,11 +1410,11 @@ impl Cuts {
 
 /// One partitioned level of [`simplify_greedy`], its regions as `cuts` says: returns the whole
 /// mesh, reduced, prepared for the next level or the final queue; adds to `stats`.
-fn partitioned_phase(
+fn partitioned_level(
     mut p: Prepared,
     opts: &SimplifyOptions,
     cuts: Cuts,
-    stats: &mut PhaseStats,
+    stats: &mut LevelStats,
     progress: &mut dyn FnMut(usize),
 ) -> Prepared {
     use rayon::prelude::*;
