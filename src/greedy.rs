@@ -334,8 +334,16 @@ impl Prepared {
     /// ids in the same (Morton) order, everything else copied, `pin` (per topological vertex of
     /// the whole) added to the pinned vertices. Attribute vertex ids stay those of the whole
     /// mesh, and `face_origin` holds each face's index in `self.faces`, so results map straight
-    /// back. Returns the sub-problem and its local → whole topological vertex map.
-    pub(crate) fn subset(&self, faces: &[u32], pin: &[bool]) -> (Prepared, Vec<u32>) {
+    /// back. The sub-problem's `topo` is left empty: it would have to cover every attribute
+    /// vertex of the whole mesh (measured on the 1M scan, zeroing that for each of 32 regions
+    /// was 68 MB of fresh pages); its faces come as topological faces instead.
+    /// Returns the sub-problem, its topological faces and its local → whole topological vertex
+    /// map.
+    pub(crate) fn subset(
+        &self,
+        faces: &[u32],
+        pin: &[bool],
+    ) -> (Prepared, Vec<[u32; 3]>, Vec<u32>) {
         // The vertices used, in ascending order, through a table over the span of their ids
         // (a region is one or two runs of the Morton order): measured on the 1M scan, sorting
         // the 400k corners of each of 8 regions and binary-searching them took 0.05 s per
@@ -359,14 +367,10 @@ impl Prepared {
             }
         }
         let local = |t: u32| local_of[(t - lo) as usize];
-        // Attribute vertices keep their global ids; `topo` must cover them all, so it is sized
-        // for the whole mesh with unused entries left at 0.
-        let mut topo = vec![0u32; self.topo.len()];
+        let topo_faces: Vec<[u32; 3]> = faces.iter().map(|&f| corner_topo(f).map(local)).collect();
         let mut first_attr = vec![u32::MAX; topo_global.len()];
-        for &f in faces {
-            for v in self.faces[f as usize] {
-                let lt = local(self.topo[v as usize]);
-                topo[v as usize] = lt;
+        for (&f, t) in faces.iter().zip(&topo_faces) {
+            for (&v, &lt) in self.faces[f as usize].iter().zip(t) {
                 if first_attr[lt as usize] == u32::MAX
                     || v == self.first_attr[topo_global[lt as usize] as usize]
                 {
@@ -378,7 +382,7 @@ impl Prepared {
         let n = topo_global.len();
         let sub = Prepared {
             mesh: Mesh::default(),
-            topo,
+            topo: Vec::new(),
             first_attr,
             faces: faces.iter().map(|&f| self.faces[f as usize]).collect(),
             face_origin: faces.to_vec(),
@@ -400,7 +404,7 @@ impl Prepared {
             scale: self.scale,
             dropped_degenerate: 0,
         };
-        (sub, topo_global)
+        (sub, topo_faces, topo_global)
     }
 
     /// Into the normalized frame; the same arithmetic as the set-up, so a vertex that never
@@ -1132,13 +1136,23 @@ impl<'a> State<'a> {
 impl<'a> State<'a> {
     /// Sets up the collapse state and queues every unique edge once, keyed by its quadric error.
     fn new(p: Prepared, opts: &'a SimplifyOptions) -> (State<'a>, Queue) {
-        let nt = p.pos.len();
-        let nf = p.faces.len();
         let topo_faces: Vec<[u32; 3]> = p
             .faces
             .iter()
             .map(|f| f.map(|v| p.topo[v as usize]))
             .collect();
+        State::with_topo_faces(p, topo_faces, opts)
+    }
+
+    /// [`State::new`] with the faces' topological vertices given (`p.topo` is not read).
+    fn with_topo_faces(
+        p: Prepared,
+        topo_faces: Vec<[u32; 3]>,
+        opts: &'a SimplifyOptions,
+    ) -> (State<'a>, Queue) {
+        let nt = p.pos.len();
+        let nf = p.faces.len();
+        assert_eq!(topo_faces.len(), nf, "one topological face per face");
         let vert_faces = VertFaces::new(nt, &topo_faces);
         let s = State {
             opts,
@@ -1482,7 +1496,7 @@ fn partitioned_level(
                 .filter(|&&f| face_region[f as usize] == r)
                 .count();
             let own_cut = faces.len() - own;
-            let (sub, topo_global) = p_ref.subset(&faces, &frontier);
+            let (sub, topo_faces, topo_global) = p_ref.subset(&faces, &frontier);
             // Pinned frontier vertices cannot thin out; if the interior were simplified far
             // below their density, its faces would fan out from them into long slivers. So a
             // region stops where its frontier would be a quarter of its vertices (a closed
@@ -1493,10 +1507,7 @@ fn partitioned_level(
                 .filter(|&&t| frontier[t as usize] && region_of(t) == r)
                 .count();
             let floor = own_cut + ((own as f64 * ratio).ceil() as usize).max(8 * own_frontier);
-            let (mut state, heap) = State::new(sub, opts);
-            // Sized for every attribute vertex of the whole mesh and read only by
-            // `State::new`: not kept for each of up to 32 regions through the level.
-            state.p.topo = Vec::new();
+            let (state, heap) = State::with_topo_faces(sub, topo_faces, opts);
             Region {
                 state,
                 heap,
