@@ -788,15 +788,7 @@ pub fn plot_svg(report: &Report) -> String {
 /// counts exactly the bytes the call asked for. Its cost is two relaxed atomic operations per
 /// allocation.
 pub mod alloc {
-    use std::alloc::{GlobalAlloc, Layout};
-
-    /// The allocator underneath: mimalloc rather than the system's. The greedy backend's levels
-    /// allocate and free hundreds of megabytes of per-region tables; glibc hands large blocks
-    /// back to the kernel and takes them again as fresh pages (99k page faults simplifying the
-    /// 1M scan to 1%, against 1.8k with mimalloc). Measured with `meshslim simplify` on that
-    /// scan, min of 5 runs: 1.343 → 1.277 s at 1%, 1.262 → 1.262 s at 10% (median 1.303 →
-    /// 1.276 s).
-    use mimalloc::MiMalloc as Inner;
+    use std::alloc::{GlobalAlloc, Layout, System};
     use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 
     static LIVE: AtomicUsize = AtomicUsize::new(0);
@@ -812,29 +804,29 @@ pub mod alloc {
         }
     }
 
-    // SAFETY: every call forwards to `Inner` with the caller's own layout and pointer, so the
-    // allocator contract is Inner's; the bookkeeping only touches atomics and never allocates.
+    // SAFETY: every call forwards to `System` with the caller's own layout and pointer, so the
+    // allocator contract is System's; the bookkeeping only touches atomics and never allocates.
     unsafe impl GlobalAlloc for CountingAlloc {
         unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-            let p = unsafe { Inner.alloc(layout) };
+            let p = unsafe { System.alloc(layout) };
             if !p.is_null() {
                 grew(layout.size());
             }
             p
         }
         unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-            let p = unsafe { Inner.alloc_zeroed(layout) };
+            let p = unsafe { System.alloc_zeroed(layout) };
             if !p.is_null() {
                 grew(layout.size());
             }
             p
         }
         unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-            unsafe { Inner.dealloc(ptr, layout) };
+            unsafe { System.dealloc(ptr, layout) };
             LIVE.fetch_sub(layout.size(), Relaxed);
         }
         unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-            let p = unsafe { Inner.realloc(ptr, layout, new_size) };
+            let p = unsafe { System.realloc(ptr, layout, new_size) };
             if !p.is_null() {
                 if new_size >= layout.size() {
                     grew(new_size - layout.size());

@@ -6,8 +6,7 @@ use std::process::ExitCode;
 use clap::Parser;
 use meshslim::cli::{self, Cli};
 
-/// Counts heap bytes so that `meshslim bench` can report each simplify call's peak memory;
-/// allocates through mimalloc (see `meshslim::bench::alloc` for why).
+/// Counts heap bytes so that `meshslim bench` can report each simplify call's peak memory.
 #[global_allocator]
 static ALLOC: meshslim::bench::alloc::CountingAlloc = meshslim::bench::alloc::CountingAlloc;
 
