@@ -483,8 +483,9 @@ pub enum BackendArg {
     CpuParallel,
     /// Rounds of parallel collapses as WGSL compute passes (wgpu: Vulkan, Metal, DX12)
     Gpu,
-    /// gpu when an adapter is found, else cpu-parallel (says which on stderr); falls back to
-    /// cpu-parallel when the GPU fails (a lost device, a mesh too big for it)
+    /// gpu when a GPU adapter is found, else cpu-parallel (says which on stderr); a software
+    /// rasterizer (llvmpipe, WARP) counts as none, being slower than the CPU's cores; falls back
+    /// to cpu-parallel when the GPU fails (a lost device, a mesh too big for it)
     Auto,
 }
 
@@ -842,11 +843,25 @@ fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     opts.backend = match args.backend.fixed() {
         Some(b) => b,
         // The process's shared device: the adapter found here is the one that simplifies.
-        None => match crate::gpu::shared() {
-            Ok((ctx, _)) => {
-                say(format!("backend auto: gpu on {}", ctx.adapter_name));
-                Backend::Gpu
+        None => match crate::gpu::shared_context() {
+            Ok(ctx) if ctx.software => {
+                say(format!(
+                    "backend auto: cpu-parallel (the only GPU adapter, {}, is a software \
+                     rasterizer, slower than the CPU's cores; --backend gpu runs on it anyway)",
+                    ctx.adapter_name
+                ));
+                Backend::CpuParallel
             }
+            Ok(_) => match crate::gpu::shared() {
+                Ok((ctx, _)) => {
+                    say(format!("backend auto: gpu on {}", ctx.adapter_name));
+                    Backend::Gpu
+                }
+                Err(e) => {
+                    say(format!("backend auto: cpu-parallel ({e})"));
+                    Backend::CpuParallel
+                }
+            },
             Err(e) => {
                 say(format!("backend auto: cpu-parallel ({e})"));
                 Backend::CpuParallel

@@ -483,4 +483,19 @@ fn round_backends_report_rounds_and_stages() {
     expect_code(&o, 0);
     assert!(stderr(&o).contains("backend auto:"), "{}", stderr(&o));
     assert!(stdout(&o).contains("rounds"), "{}", stdout(&o));
+    // A software rasterizer (lavapipe here and in CI) is passed over for the CPU's cores; a
+    // hardware adapter is taken.
+    let took = if stderr(&o).contains("is a software rasterizer") {
+        "cpu-parallel"
+    } else if stderr(&o).contains("backend auto: gpu on") {
+        "gpu"
+    } else {
+        "cpu-parallel"
+    };
+    assert!(
+        stdout(&o).contains(&format!("(backend {took})")),
+        "auto said {:?} but ran {}",
+        stderr(&o),
+        stdout(&o)
+    );
 }

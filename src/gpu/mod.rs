@@ -26,15 +26,24 @@ pub fn simplify_gpu(
 
 /// The process's device and compiled pipelines, made on first use: later calls (the benchmark's
 /// repeats) do not pay for adapter discovery and shader compilation again.
-pub fn shared() -> Result<&'static (GpuContext, GpuSimplifier)> {
-    static SHARED: std::sync::OnceLock<std::result::Result<(GpuContext, GpuSimplifier), String>> =
+pub fn shared() -> Result<(&'static GpuContext, &'static GpuSimplifier)> {
+    static SIMPLIFIER: std::sync::OnceLock<std::result::Result<GpuSimplifier, String>> =
         std::sync::OnceLock::new();
-    SHARED
-        .get_or_init(|| {
-            let ctx = GpuContext::new().map_err(|e| e.to_string())?;
-            let sim = GpuSimplifier::new(&ctx.device, &ctx.queue).map_err(|e| e.to_string())?;
-            Ok((ctx, sim))
-        })
+    let ctx = shared_context()?;
+    let sim = SIMPLIFIER
+        .get_or_init(|| GpuSimplifier::new(&ctx.device, &ctx.queue).map_err(|e| e.to_string()))
+        .as_ref()
+        .map_err(|e| crate::Error::Gpu(e.trim_start_matches("GPU: ").to_string()))?;
+    Ok((ctx, sim))
+}
+
+/// The process's device alone, without compiling the pipelines: enough to see which adapter
+/// there is (`auto` looks before it pays for the shaders).
+pub fn shared_context() -> Result<&'static GpuContext> {
+    static CONTEXT: std::sync::OnceLock<std::result::Result<GpuContext, String>> =
+        std::sync::OnceLock::new();
+    CONTEXT
+        .get_or_init(|| GpuContext::new().map_err(|e| e.to_string()))
         .as_ref()
         .map_err(|e| crate::Error::Gpu(e.trim_start_matches("GPU: ").to_string()))
 }
