@@ -1,6 +1,7 @@
 // Each winner moves its survivor to the new position with both quadrics re-centred there and
-// summed, carries the border bit, and points the removed vertex at the survivor. Winners share
-// no face, hence no vertex, so these writes never meet.
+// summed, carries the border bit, and points the removed vertex at the survivor; when the
+// survivor is a seam vertex, the removed vertex's corners take their attribute vertices from
+// the candidate's map. Winners share no face, hence no vertex, so these writes never meet.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> candidates: array<EdgeCandidate>; // per edge
@@ -10,6 +11,17 @@
 @group(0) @binding(5) var<storage, read_write> quadrics: array<Quadric>;   // per vertex
 @group(0) @binding(6) var<storage, read_write> flags: array<u32>;          // per vertex
 @group(0) @binding(7) var<storage, read_write> remap: array<u32>;          // per vertex
+@group(0) @binding(8) var<storage, read> indices: array<u32>;             // per face × 3
+@group(0) @binding(9) var<storage, read> offsets: array<u32>;             // per vertex + 1
+@group(0) @binding(10) var<storage, read> vertex_faces: array<u32>;       // per corner
+@group(0) @binding(11) var<storage, read_write> face_extra: array<FaceExtra>; // per face
+
+// The attribute vertex a corner of the removed vertex takes under map m.
+fn mapped(m: vec4<u32>, a: u32) -> u32 {
+    if (m.x == NO_ATTR || a == m.x) { return m.y; }
+    if (a == m.z) { return m.w; }
+    return a;
+}
 
 @compute @workgroup_size(256)
 fn collapse(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -29,4 +41,17 @@ fn collapse(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     flags[k] = flags[k] | (flags[r] & FLAG_BORDER) | moved;
     positions[k] = vec4<f32>(p, 1.0);
     remap[r] = k;
+    if (c.attr_map.y != NO_ATTR) {
+        // The faces that stay (those on the edge go); they are locked by this winner alone.
+        for (var i = offsets[r]; i < offsets[r + 1u]; i = i + 1u) {
+            let f = vertex_faces[i];
+            let t = face_of(f);
+            if (has(t, k)) { continue; }
+            var x = face_extra[f];
+            if (t.x == r) { x.attr0 = mapped(c.attr_map, x.attr0); }
+            if (t.y == r) { x.attr1 = mapped(c.attr_map, x.attr1); }
+            if (t.z == r) { x.attr2 = mapped(c.attr_map, x.attr2); }
+            face_extra[f] = x;
+        }
+    }
 }

@@ -6,10 +6,11 @@ const SCAN_BLOCK: u32 = 1024u;
 const HIST_BINS: u32 = 4096u;
 const HIST_SHIFT: u32 = 20u;
 const INVALID_COST: u32 = 0xffffffffu;
+const NO_ATTR: u32 = 0xffffffffu;
 
 const FLAG_BORDER: u32 = 1u;
 const FLAG_PINNED: u32 = 2u;
-const FLAG_FROZEN: u32 = 4u;
+const FLAG_SEAM: u32 = 4u;
 const FLAG_MOVED: u32 = 8u;
 
 const STATE_OUT: u32 = 0u;
@@ -85,6 +86,11 @@ struct EdgeCandidate {
     remove: u32,
     cost_bits: u32,
     faces: u32,
+    attr_map: vec4<u32>,
+}
+
+fn invalid_candidate() -> EdgeCandidate {
+    return EdgeCandidate(vec4<f32>(0.0), 0u, 0u, INVALID_COST, 0u, vec4<u32>(NO_ATTR));
 }
 
 struct FaceExtra {

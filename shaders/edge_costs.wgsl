@@ -1,6 +1,8 @@
 // Per edge: the collapse position, quadric error, flip and needle checks of the faces that move,
 // the quality-scaled priority, and the cost histogram; the topological checks wait for validate.
-// Relies on the current CSR face lists.
+// Seam vertices follow the greedy reference's rules (onto_seam, seam_slide), the candidate
+// carrying the attribute map collapse applies. Relies on the current CSR face lists and on the
+// seam corners' attribute vertices in face_extra.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;        // per vertex
@@ -16,6 +18,7 @@
 @group(0) @binding(11) var<storage, read_write> edge_state: array<u32>;      // per edge
 @group(0) @binding(12) var<storage, read_write> histogram: array<atomic<u32>>; // HIST_BINS
 @group(0) @binding(13) var<storage, read_write> counters: array<atomic<u32>, 16>;
+@group(0) @binding(14) var<storage, read> face_extra: array<FaceExtra>;      // per face
 
 const VERDICT_INVALID: u32 = 0u;
 const VERDICT_OVER: u32 = 1u;
@@ -27,16 +30,74 @@ struct Verdict {
 }
 
 fn invalid() -> Verdict {
-    return Verdict(VERDICT_INVALID, EdgeCandidate(vec4<f32>(0.0), 0u, 0u, INVALID_COST, 0u));
+    return Verdict(VERDICT_INVALID, invalid_candidate());
+}
+
+// The attribute vertex face f uses at its corner on vertex v.
+fn corner_attr(f: u32, v: u32) -> u32 {
+    let t = face_of(f);
+    let x = face_extra[f];
+    if (t.x == v) { return x.attr0; }
+    if (t.y == v) { return x.attr1; }
+    return x.attr2;
+}
+
+// Free vertex r moving onto seam vertex k: its corners take the attribute vertex k has in the
+// faces on the edge, which must agree (else the edge runs along the seam). .y = NO_ATTR if not.
+fn onto_seam(k: u32, r: u32) -> vec4<u32> {
+    var to = NO_ATTR;
+    for (var i = offsets[r]; i < offsets[r + 1u]; i = i + 1u) {
+        let f = vertex_faces[i];
+        if (has(face_of(f), k)) {
+            let a = corner_attr(f, k);
+            if (to != NO_ATTR && to != a) { return vec4<u32>(NO_ATTR); }
+            to = a;
+        }
+    }
+    return vec4<u32>(NO_ATTR, to, NO_ATTR, NO_ATTR);
+}
+
+// Seam vertex r sliding along edge (r, k) onto seam vertex k (the greedy's seam_slide): r is
+// free to go (not pinned, not on a border), has two attribute vertices, and the two faces on
+// the edge use different ones at both ends. (from1, to1, from2, to2), or all NO_ATTR.
+fn seam_slide(r: u32, k: u32) -> vec4<u32> {
+    let none = vec4<u32>(NO_ATTR);
+    if ((flags[r] & (FLAG_PINNED | FLAG_BORDER)) != 0u) { return none; }
+    var attrs = vec2<u32>(NO_ATTR, NO_ATTR);
+    var sides = none;
+    var n = 0u;
+    for (var i = offsets[r]; i < offsets[r + 1u]; i = i + 1u) {
+        let f = vertex_faces[i];
+        let a = corner_attr(f, r);
+        if (attrs.x == NO_ATTR || attrs.x == a) {
+            attrs.x = a;
+        } else if (attrs.y == NO_ATTR || attrs.y == a) {
+            attrs.y = a;
+        } else {
+            return none; // a seam junction stays
+        }
+        if (has(face_of(f), k)) {
+            if (n == 2u) { return none; }
+            if (n == 0u) {
+                sides.x = a;
+                sides.y = corner_attr(f, k);
+            } else {
+                sides.z = a;
+                sides.w = corner_attr(f, k);
+            }
+            n = n + 1u;
+        }
+    }
+    if (n == 2u && sides.x != sides.z && sides.y != sides.w) { return sides; }
+    return none;
 }
 
 fn evaluate(a: u32, b: u32) -> Verdict {
     let fla = flags[a];
     let flb = flags[b];
-    if (((fla | flb) & FLAG_FROZEN) != 0u) { return invalid(); }
-    let pin_a = (fla & FLAG_PINNED) != 0u;
-    let pin_b = (flb & FLAG_PINNED) != 0u;
-    if (pin_a && pin_b) { return invalid(); }
+    // Seam vertices keep their position like pinned ones.
+    let fixed_a = (fla & (FLAG_PINNED | FLAG_SEAM)) != 0u;
+    let fixed_b = (flb & (FLAG_PINNED | FLAG_SEAM)) != 0u;
     let pa = positions[a].xyz;
     let pb = positions[b].xyz;
     let dab = pb - pa;
@@ -44,9 +105,22 @@ fn evaluate(a: u32, b: u32) -> Verdict {
     var keep = a;
     var remove = b;
     var y = vec3<f32>(0.0);
-    if (pin_a) {
+    var attr_map = vec4<u32>(NO_ATTR);
+    if (fixed_a && fixed_b) {
+        // Only a seam vertex sliding along its seam onto a seam neighbour; b first, as the
+        // greedy tries.
+        if ((fla & flb & FLAG_SEAM) == 0u) { return invalid(); }
+        attr_map = seam_slide(b, a);
+        if (attr_map.y == NO_ATTR) {
+            attr_map = seam_slide(a, b);
+            keep = b;
+            remove = a;
+            y = dab;
+        }
+        if (attr_map.y == NO_ATTR) { return invalid(); }
+    } else if (fixed_a) {
         y = vec3<f32>(0.0);
-    } else if (pin_b) {
+    } else if (fixed_b) {
         keep = b;
         remove = a;
         y = dab;
@@ -69,6 +143,10 @@ fn evaluate(a: u32, b: u32) -> Verdict {
             keep = b;
             remove = a;
         }
+    }
+    if ((flags[keep] & FLAG_SEAM) != 0u && attr_map.y == NO_ATTR) {
+        attr_map = onto_seam(keep, remove);
+        if (attr_map.y == NO_ATTR) { return invalid(); }
     }
     let error = quadric_eval(q, y);
     let pos = pa + y;
@@ -114,9 +192,9 @@ fn evaluate(a: u32, b: u32) -> Verdict {
         return invalid();
     }
     if (err2 > params.max_error2) {
-        return Verdict(VERDICT_OVER, EdgeCandidate(vec4<f32>(0.0), 0u, 0u, INVALID_COST, 0u));
+        return Verdict(VERDICT_OVER, invalid_candidate());
     }
-    return Verdict(VERDICT_OK, EdgeCandidate(vec4<f32>(pos, err2), keep, remove, bitcast<u32>(priority), 0u));
+    return Verdict(VERDICT_OK, EdgeCandidate(vec4<f32>(pos, err2), keep, remove, bitcast<u32>(priority), 0u, attr_map));
 }
 
 @compute @workgroup_size(256)
@@ -134,7 +212,7 @@ fn edge_costs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         atomicAdd(&histogram[v.c.cost_bits >> HIST_SHIFT], 1u);
         atomicAdd(&counters[C_CANDIDATES], 1u);
     } else {
-        candidates[e] = EdgeCandidate(vec4<f32>(0.0), 0u, 0u, INVALID_COST, 0u);
+        candidates[e] = invalid_candidate();
         if (v.kind == VERDICT_OVER) {
             atomicAdd(&counters[C_OVER_MAX_ERROR], 1u);
         }

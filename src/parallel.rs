@@ -86,7 +86,7 @@ pub struct Upload {
     pub positions: Vec<[f32; 4]>,
     /// Per face × 3: class ids.
     pub indices: Vec<u32>,
-    /// Per class: FROZEN for seams (more than one attribute vertex used).
+    /// Per class: SEAM for seams (more than one attribute vertex used).
     pub flags: Vec<u32>,
     /// Per class: one attribute vertex the faces use.
     pub vertex_attr: Vec<u32>,
@@ -94,7 +94,8 @@ pub struct Upload {
     pub center: [f64; 3],
     pub scale: f64,
     pub dropped_degenerate: usize,
-    pub frozen: usize,
+    /// Seam vertices.
+    pub seams: usize,
 }
 
 /// The rounds' buffers read back at the end.
@@ -176,7 +177,7 @@ impl Upload {
                 positions[d] = [q[0], q[1], q[2], 1.0];
                 vertex_attr[d] = class_attr[c];
                 if attr_count[c] > 1 {
-                    flags[d] = flag::FROZEN;
+                    flags[d] = flag::SEAM;
                 }
             }
         }
@@ -184,7 +185,7 @@ impl Upload {
             .iter()
             .flat_map(|(_, c, _)| c.map(|x| dense[x as usize]))
             .collect();
-        let frozen = flags.iter().filter(|&&f| f != 0).count();
+        let seams = flags.iter().filter(|&&f| f != 0).count();
         Upload {
             positions,
             indices,
@@ -195,7 +196,7 @@ impl Upload {
             center,
             scale,
             dropped_degenerate,
-            frozen,
+            seams,
         }
     }
 
@@ -240,7 +241,7 @@ impl Upload {
                 let x = &d.face_extra[f];
                 [0, 1, 2].map(|k| {
                     let v = d.indices[3 * f + k] as usize;
-                    if d.flags[v] & flag::FROZEN != 0 {
+                    if d.flags[v] & flag::SEAM != 0 {
                         x.attr[k]
                     } else {
                         d.vertex_attr[v]
@@ -413,7 +414,7 @@ pub fn simplify_rounds(
     let pinned = down
         .flags
         .iter()
-        .filter(|&&f| f & (flag::PINNED | flag::FROZEN) != 0)
+        .filter(|&&f| f & flag::PINNED != 0)
         .count();
     let report = SimplifyReport {
         backend: opts.backend,

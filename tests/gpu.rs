@@ -27,7 +27,11 @@ fn close(a: f32, b: f32, tol: f32) -> bool {
 fn each_stage_matches_its_cpu_twin() {
     let Some(ctx) = gpu_context() else { return };
     let sim = GpuSimplifier::new(&ctx.device, &ctx.queue).unwrap();
-    for (name, m) in generated_meshes() {
+    // The seamed torus takes the seam rules' paths (slides, collapses onto the seam).
+    for (name, m) in generated_meshes()
+        .into_iter()
+        .chain([("seamed_torus", seamed_torus())])
+    {
         let up = Upload::new(&m);
         let mut opts = SimplifyOptions::with_ratio(m.triangles.len(), 0.3).unwrap();
         opts.backend = Backend::Gpu;
@@ -91,7 +95,7 @@ fn each_stage_matches_its_cpu_twin() {
         // edge_costs (quadrics feed it; compared through the candidates they produce). The GPU's
         // candidates are read after its whole round: validate has only added face counts.
         cpu.costs(&p, ne as u32);
-        let g_cand: Vec<EdgeCandidate> = pod(rd("candidates", 32 * ne));
+        let g_cand: Vec<EdgeCandidate> = pod(rd("candidates", size_of::<EdgeCandidate>() * ne));
         let mut mismatched = 0;
         for (e, (g, c)) in g_cand.iter().zip(&cpu.candidates).enumerate() {
             let same_validity = (g.cost_bits == INVALID_COST) == (c.cost_bits == INVALID_COST);
@@ -101,6 +105,7 @@ fn each_stage_matches_its_cpu_twin() {
             }
             if g.cost_bits != INVALID_COST {
                 assert_eq!((g.keep, g.remove), (c.keep, c.remove), "{name}: edge {e}");
+                assert_eq!(g.attr_map, c.attr_map, "{name}: attribute map of edge {e}");
                 let (gc, cc) = (f32::from_bits(g.cost_bits), f32::from_bits(c.cost_bits));
                 assert!(
                     close(gc, cc, 1e-3) || gc.max(cc) < 1e-12,
@@ -164,7 +169,7 @@ fn each_stage_matches_its_cpu_twin() {
             "{name}: dispatch_args"
         );
         let faces = |v: &[EdgeCandidate]| v.iter().map(|c| c.faces).collect::<Vec<_>>();
-        let g_after: Vec<EdgeCandidate> = pod(rd("candidates", 32 * ne));
+        let g_after: Vec<EdgeCandidate> = pod(rd("candidates", size_of::<EdgeCandidate>() * ne));
         assert_eq!(
             faces(&g_after),
             faces(&cpu.candidates),
@@ -182,6 +187,12 @@ fn each_stage_matches_its_cpu_twin() {
             pod::<u32>(rd("indices", 4 * cpu.indices.len())),
             cpu.indices,
             "{name}: indices"
+        );
+        // The seam corners' attribute vertices, rewritten by collapse and carried by compaction.
+        assert_eq!(
+            pod::<FaceExtra>(rd("face_extra", 16 * cpu.face_extra.len())),
+            cpu.face_extra,
+            "{name}: face_extra"
         );
         let g_pos: Vec<[f32; 4]> = pod(rd("positions", 16 * cpu.positions.len()));
         for (v, (g, c)) in g_pos.iter().zip(&cpu.positions).enumerate() {
@@ -239,6 +250,22 @@ fn pipeline_keeps_invariants_and_agrees_with_cpu_parallel() {
                 d.distance.two_sided.mean_rel
             );
         }
+    }
+}
+
+/// Seams thin out on the GPU as on the CPU twin: the seam rules' result, and the same face
+/// count as cpu-parallel.
+#[test]
+fn gpu_thins_seams_like_cpu_parallel() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let m = seamed_torus();
+    for ratio in [0.1, 0.02] {
+        let (g, gr) = run(&m, Backend::Gpu, ratio);
+        check_seamed_torus(&format!("gpu seamed torus at {ratio}"), &m, &g, &gr);
+        let (c, _) = run(&m, Backend::CpuParallel, ratio);
+        assert_eq!(g.triangles.len(), c.triangles.len(), "at {ratio}");
     }
 }
 

@@ -265,56 +265,12 @@ fn partitioned_run_is_as_good_as_sequential_and_deterministic() {
 /// without tearing: the welded surface stays a closed torus and every output vertex keeps UVs.
 #[test]
 fn uv_seams_slide_without_tearing() {
-    let (nu, nv) = (48usize, 24usize);
-    let mut pos = Vec::new();
-    let mut uvs = Vec::new();
-    for j in 0..nv {
-        for i in 0..=nu {
-            let (a, b) = (
-                (i % nu) as f64 / nu as f64 * std::f64::consts::TAU,
-                j as f64 / nv as f64 * std::f64::consts::TAU,
-            );
-            let r = 1.0 + 0.35 * b.cos();
-            pos.push([
-                (r * a.cos()) as f32,
-                (r * a.sin()) as f32,
-                (0.35 * b.sin()) as f32,
-            ]);
-            uvs.push([i as f32 / nu as f32, j as f32 / nv as f32]);
-        }
-    }
-    let id = |i: usize, j: usize| ((j % nv) * (nu + 1) + i) as u32;
-    let mut tris = Vec::new();
-    for j in 0..nv {
-        for i in 0..nu {
-            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    let mut m = Mesh::new(pos, tris);
-    m.uvs = Some(uvs);
+    let m = seamed_torus();
     assert_eq!(topology(&m).euler_characteristic, 0);
     for ratio in [0.1, 0.02] {
         let opts = SimplifyOptions::with_ratio(m.triangles.len(), ratio).unwrap();
         let (out, report) = simplify(&m, &opts).unwrap();
-        check_invariants(&format!("seamed torus at {ratio}"), &m, &out, &report);
-        assert_eq!(report.stop_reason, StopReason::TargetReached, "{report:?}");
-        assert_eq!(out.uvs.as_ref().map(Vec::len), Some(out.positions.len()));
-        // The seam is still there: some positions carry two vertices with u = 0 and u = 1.
-        let uv = out.uvs.as_ref().unwrap();
-        let seam = (0..out.positions.len())
-            .filter(|&v| {
-                uv[v][0] == 1.0
-                    && (0..out.positions.len())
-                        .any(|w| uv[w][0] == 0.0 && out.positions[w] == out.positions[v])
-            })
-            .count();
-        assert!(seam >= 3, "the seam vanished ({seam} split vertices left)");
-        // ... and it thinned out: it started with one vertex per ring, 24.
-        assert!(
-            seam < 24,
-            "the seam kept all its {seam} vertices: seam vertices do not slide"
-        );
+        check_seamed_torus(&format!("seamed torus at {ratio}"), &m, &out, &report);
     }
 }
 

@@ -3,12 +3,14 @@
 //! (error scaled up for poor triangle quality, MeshLab-style), and the cost histogram the ceiling
 //! is picked from. The topological checks (link condition, border pinch, lone triangle,
 //! tetrahedral fold) scan both endpoints' neighbourhoods and rarely fail on a manifold, so they
-//! run in `validate`, only for the edges that win a selection pass.
+//! run in `validate`, only for the edges that win a selection pass. Seam vertices follow the
+//! greedy reference's rules: a free vertex may move onto one, and one may slide along its seam
+//! onto a seam neighbour; the candidate carries the attribute map `collapse` applies.
 
 use super::common::*;
 use super::{face_of, faces_of};
 use crate::gpu::types::{
-    Counters, EdgeCandidate, HIST_SHIFT, INVALID_COST, Params, Quadric, flag, state,
+    Counters, EdgeCandidate, FaceExtra, HIST_SHIFT, NO_ATTR, Params, Quadric, flag, state,
 };
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
@@ -21,8 +23,74 @@ pub enum Verdict {
     Candidate(EdgeCandidate),
 }
 
+/// The attribute vertex face `f` uses at its corner on vertex `v`.
+fn corner_attr(indices: &[u32], face_extra: &[FaceExtra], f: u32, v: u32) -> u32 {
+    let t = face_of(indices, f);
+    let i = t.iter().position(|&u| u == v).unwrap_or(2);
+    face_extra[f as usize].attr[i]
+}
+
+/// The faces and their attribute vertices, as the seam rules read them.
+struct Corners<'a> {
+    indices: &'a [u32],
+    offsets: &'a [u32],
+    vertex_faces: &'a [u32],
+    face_extra: &'a [FaceExtra],
+}
+
+impl Corners<'_> {
+    /// Free vertex `r` moving onto seam vertex `k`: its corners take the attribute vertex `k`
+    /// has in the faces on the edge, which must agree (else the edge runs along the seam).
+    fn onto_seam(&self, k: u32, r: u32) -> Option<[u32; 4]> {
+        let mut to = NO_ATTR;
+        for &f in faces_of(self.offsets, self.vertex_faces, r) {
+            if face_of(self.indices, f).contains(&k) {
+                let a = corner_attr(self.indices, self.face_extra, f, k);
+                if to != NO_ATTR && to != a {
+                    return None;
+                }
+                to = a;
+            }
+        }
+        (to != NO_ATTR).then_some([NO_ATTR, to, NO_ATTR, NO_ATTR])
+    }
+
+    /// Seam vertex `r` sliding along edge (r, k) onto seam vertex `k` (the greedy's
+    /// `seam_slide`): `r` is free to go (not pinned, not on a border), has two attribute
+    /// vertices, and the two faces on the edge use different ones at both ends. Returns
+    /// (from₁, to₁, from₂, to₂).
+    fn seam_slide(&self, flags: &[u32], r: u32, k: u32) -> Option<[u32; 4]> {
+        if flags[r as usize] & (flag::PINNED | flag::BORDER) != 0 {
+            return None;
+        }
+        let mut attrs = [NO_ATTR; 2];
+        let mut sides = [NO_ATTR; 4];
+        let mut n = 0;
+        for &f in faces_of(self.offsets, self.vertex_faces, r) {
+            let a = corner_attr(self.indices, self.face_extra, f, r);
+            if attrs[0] == NO_ATTR || attrs[0] == a {
+                attrs[0] = a;
+            } else if attrs[1] == NO_ATTR || attrs[1] == a {
+                attrs[1] = a;
+            } else {
+                return None; // a seam junction stays
+            }
+            if face_of(self.indices, f).contains(&k) {
+                if n == 2 {
+                    return None;
+                }
+                sides[2 * n] = a;
+                sides[2 * n + 1] = corner_attr(self.indices, self.face_extra, f, k);
+                n += 1;
+            }
+        }
+        (n == 2 && sides[0] != sides[2] && sides[1] != sides[3]).then_some(sides)
+    }
+}
+
 /// The survivor, its new position and the quadric error (`cost_bits`; `pos.w` = error relative
-/// to the diagonal, squared). Frozen vertices and two pinned ends are refused here.
+/// to the diagonal, squared). Two pinned ends, and seam vertices other than by the seam rules
+/// (`flag::SEAM`), are refused here.
 #[allow(clippy::too_many_arguments)]
 pub fn placement(
     params: &Params,
@@ -33,17 +101,19 @@ pub fn placement(
     offsets: &[u32],
     vertex_faces: &[u32],
     face_normals: &[[f32; 4]],
+    face_extra: &[FaceExtra],
     a: u32,
     b: u32,
 ) -> Verdict {
     let (fla, flb) = (flags[a as usize], flags[b as usize]);
-    if (fla | flb) & flag::FROZEN != 0 {
-        return Verdict::Invalid;
-    }
-    let (pin_a, pin_b) = (fla & flag::PINNED != 0, flb & flag::PINNED != 0);
-    if pin_a && pin_b {
-        return Verdict::Invalid;
-    }
+    let corners = Corners {
+        indices,
+        offsets,
+        vertex_faces,
+        face_extra,
+    };
+    // Seam vertices keep their position like pinned ones.
+    let fixed = |fl: u32| fl & (flag::PINNED | flag::SEAM) != 0;
     let pa = xyz(positions[a as usize]);
     let pb = xyz(positions[b as usize]);
     let dab = sub(pb, pa);
@@ -52,9 +122,25 @@ pub fn placement(
         &quadrics[a as usize],
         &quadric_shift(&quadrics[b as usize], sub(pa, pb)),
     );
-    let (keep, remove, y) = if pin_a {
+    let mut attr_map = None;
+    let (keep, remove, y) = if fixed(fla) && fixed(flb) {
+        // Only a seam vertex sliding along its seam onto a seam neighbour; b first, as the
+        // greedy tries.
+        if fla & flb & flag::SEAM == 0 {
+            return Verdict::Invalid;
+        }
+        if let Some(m) = corners.seam_slide(flags, b, a) {
+            attr_map = Some(m);
+            (a, b, [0.0; 3])
+        } else if let Some(m) = corners.seam_slide(flags, a, b) {
+            attr_map = Some(m);
+            (b, a, dab)
+        } else {
+            return Verdict::Invalid;
+        }
+    } else if fixed(fla) {
         (a, b, [0.0; 3])
-    } else if pin_b {
+    } else if fixed(flb) {
         (b, a, dab)
     } else {
         let y = match quadric_optimum(&q) {
@@ -79,6 +165,12 @@ pub fn placement(
             (b, a, y)
         }
     };
+    if flags[keep as usize] & flag::SEAM != 0 && attr_map.is_none() {
+        let Some(m) = corners.onto_seam(keep, remove) else {
+            return Verdict::Invalid;
+        };
+        attr_map = Some(m);
+    }
     let error = quadric_eval(&q, y);
     let pos = add(pa, y);
 
@@ -139,6 +231,7 @@ pub fn placement(
         remove,
         cost_bits: priority.to_bits(),
         faces: 0,
+        attr_map: attr_map.unwrap_or([NO_ATTR; 4]),
     })
 }
 
@@ -153,6 +246,7 @@ pub fn edge_costs(
     offsets: &[u32],                  // per vertex + 1
     vertex_faces: &[u32],             // per corner
     face_normals: &[[f32; 4]],        // per face
+    face_extra: &[FaceExtra],         // per face
     edges: &[[u32; 2]],               // per edge
     edge_offsets: &[u32],             // per vertex + 1: the edge count at [vertex_count]
     candidates: &mut [EdgeCandidate], // per edge
@@ -177,14 +271,12 @@ pub fn edge_costs(
                 offsets,
                 vertex_faces,
                 face_normals,
+                face_extra,
                 a,
                 b,
             );
             *st = state::OUT;
-            *out = EdgeCandidate {
-                cost_bits: INVALID_COST,
-                ..Default::default()
-            };
+            *out = EdgeCandidate::INVALID;
             match verdict {
                 Verdict::Invalid => {}
                 Verdict::OverMaxError => {

@@ -286,6 +286,7 @@ impl CpuRounds {
                 &s.offsets,
                 &s.vertex_faces,
                 &s.face_normals,
+                &s.face_extra,
                 &s.edges,
                 &s.edge_offsets,
                 &mut s.candidates,
@@ -426,6 +427,10 @@ impl CpuRounds {
                 Scatter::new(&mut s.quadrics),
                 Scatter::new(&mut s.flags),
                 Scatter::new(&mut s.remap),
+                &s.indices,
+                &s.offsets,
+                &s.vertex_faces,
+                Scatter::new(&mut s.face_extra),
             )
         });
         self.time("compact_mark", |s| {

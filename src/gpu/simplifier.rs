@@ -525,6 +525,7 @@ impl<'a> GpuRounds<'a> {
             "flags" => &h.flags,
             "indices" => &h.indices,
             "face_normals" => &h.face_normals,
+            "face_extra" => &h.face_extra,
             // The buffers the last round compacted from.
             "positions_before" => &other.positions,
             "quadrics_before" => &other.quadrics,
@@ -715,7 +716,7 @@ impl RoundRunner for GpuRounds<'_> {
             "edge_costs",
             &[
                 &params, &pos, &quad, &flags, &idx, &offsets, &vf, &fnorm, &edges, &eoff, &cand,
-                &est, &hist, &counters,
+                &est, &hist, &counters, &fextra,
             ],
             PER_EDGE,
         );
@@ -793,7 +794,10 @@ impl RoundRunner for GpuRounds<'_> {
         self.pass(
             &mut enc,
             "collapse",
-            &[&params, &cand, &est, &eoff, &pos, &quad, &flags, &remap],
+            &[
+                &params, &cand, &est, &eoff, &pos, &quad, &flags, &remap, &idx, &offsets, &vf,
+                &fextra,
+            ],
             PER_EDGE,
         );
         self.pass(

@@ -26,9 +26,12 @@ pub mod flag {
     /// Keeps its position and is never removed (non-manifold spot, locked border); a free
     /// neighbour may still collapse onto it.
     pub const PINNED: u32 = 2;
-    /// On an attribute seam (UV, normal or colour discontinuity): no edge touching it collapses,
-    /// so the corners around it keep their attributes exactly.
-    pub const FROZEN: u32 = 4;
+    /// On an attribute seam (UV, normal or colour discontinuity): keeps its position, as the
+    /// greedy reference's seam vertices do. A free neighbour may collapse onto it, its corners
+    /// taking the seam vertex's attributes on their side; it is removed only by sliding along
+    /// the seam onto a seam neighbour, each side mapping to its own attribute vertex. Its
+    /// corners' attribute vertices (`FaceExtra::attr`) are kept current for that.
+    pub const SEAM: u32 = 4;
     /// Moved by a collapse: the output takes its new position (unmoved vertices keep their
     /// input coordinates bit for bit).
     pub const MOVED: u32 = 8;
@@ -133,6 +136,26 @@ pub struct EdgeCandidate {
     pub cost_bits: u32,
     /// Faces on the edge, 1 (border) or 2, what the collapse removes; set by `validate`.
     pub faces: u32,
+    /// When the survivor is a seam vertex, the attribute vertices the removed vertex's
+    /// corners take, as (from, to) pairs: `[NO_ATTR, to, NO_ATTR, NO_ATTR]` for a free vertex
+    /// moving onto the seam (all its corners take `to`), `[from₁, to₁, from₂, to₂]` for a seam
+    /// vertex sliding along its seam (one pair per side). `[NO_ATTR; 4]` otherwise.
+    pub attr_map: [u32; 4],
+}
+
+/// No attribute vertex: an empty `EdgeCandidate::attr_map` entry.
+pub const NO_ATTR: u32 = u32::MAX;
+
+impl EdgeCandidate {
+    /// What an edge that may not collapse holds.
+    pub const INVALID: EdgeCandidate = EdgeCandidate {
+        pos: [0.0; 4],
+        keep: 0,
+        remove: 0,
+        cost_bits: INVALID_COST,
+        faces: 0,
+        attr_map: [NO_ATTR; 4],
+    };
 }
 
 /// Per-face data carried through compaction alongside the indices: the attribute vertex of

@@ -23,6 +23,80 @@ pub fn generated_meshes() -> Vec<(&'static str, Mesh)> {
     ]
 }
 
+/// A torus whose UV chart is cut open along one meridian: the 24 vertices there are stored
+/// twice (same position, u = 0 and u = 1).
+pub fn seamed_torus() -> Mesh {
+    let (nu, nv) = (48usize, 24usize);
+    let mut pos = Vec::new();
+    let mut uvs = Vec::new();
+    for j in 0..nv {
+        for i in 0..=nu {
+            let (a, b) = (
+                (i % nu) as f64 / nu as f64 * std::f64::consts::TAU,
+                j as f64 / nv as f64 * std::f64::consts::TAU,
+            );
+            let r = 1.0 + 0.35 * b.cos();
+            pos.push([
+                (r * a.cos()) as f32,
+                (r * a.sin()) as f32,
+                (0.35 * b.sin()) as f32,
+            ]);
+            uvs.push([i as f32 / nu as f32, j as f32 / nv as f32]);
+        }
+    }
+    let id = |i: usize, j: usize| ((j % nv) * (nu + 1) + i) as u32;
+    let mut tris = Vec::new();
+    for j in 0..nv {
+        for i in 0..nu {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let mut m = Mesh::new(pos, tris);
+    m.uvs = Some(uvs);
+    m
+}
+
+/// A simplified [`seamed_torus`]: the invariants, the target reached (the seam may not pin it
+/// away), UVs on every vertex, no face mixing the two sides of the seam (u near 0 with u near
+/// 1), and the seam still there but thinned out (seam vertices slide along it).
+pub fn check_seamed_torus(label: &str, input: &Mesh, out: &Mesh, report: &SimplifyReport) {
+    check_invariants(label, input, out, report);
+    assert_eq!(
+        report.stop_reason,
+        StopReason::TargetReached,
+        "{label}: {report:?}"
+    );
+    let uv = out.uvs.as_ref().expect("UVs kept");
+    assert_eq!(uv.len(), out.positions.len(), "{label}");
+    for t in &out.triangles {
+        let us = t.map(|v| uv[v as usize][0]);
+        let spread =
+            us.iter().fold(0f32, |m, &a| m.max(a)) - us.iter().fold(1f32, |m, &a| m.min(a));
+        assert!(
+            spread < 0.5,
+            "{label}: a face straddles the seam, u = {us:?}"
+        );
+    }
+    // Some positions carry two vertices with u = 0 and u = 1.
+    let seam = (0..out.positions.len())
+        .filter(|&v| {
+            uv[v][0] == 1.0
+                && (0..out.positions.len())
+                    .any(|w| uv[w][0] == 0.0 && out.positions[w] == out.positions[v])
+        })
+        .count();
+    assert!(
+        seam >= 3,
+        "{label}: the seam vanished ({seam} split vertices left)"
+    );
+    // ... and it thinned out: it started with one vertex per ring, 24.
+    assert!(
+        seam < 24,
+        "{label}: the seam kept all its {seam} vertices: seam vertices do not slide"
+    );
+}
+
 /// Every face with its own three vertices: welding must recover the surface.
 pub fn triangle_soup(m: &Mesh) -> Mesh {
     let mut pos = Vec::new();
