@@ -1,7 +1,8 @@
 // Each winner moves its survivor to the new position with both quadrics re-centred there and
 // summed, carries the border bit, and points the removed vertex at the survivor; when the
-// survivor is a seam vertex, the removed vertex's corners take their attribute vertices from
-// the candidate's map. Winners share no face, hence no vertex, so these writes never meet.
+// survivor is a seam vertex, the removed vertex's corners take their attribute vertices by the
+// seam rule edge_costs checked. Winners share no face, hence no vertex, so these writes never
+// meet.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> candidates: array<EdgeCandidate>; // per edge
@@ -16,11 +17,56 @@
 @group(0) @binding(10) var<storage, read> vertex_faces: array<u32>;       // per corner
 @group(0) @binding(11) var<storage, read_write> face_extra: array<FaceExtra>; // per face
 
-// The attribute vertex a corner of the removed vertex takes under map m.
+// The attribute vertex face f uses at its corner on vertex v.
+fn corner_attr(f: u32, v: u32) -> u32 {
+    let t = face_of(f);
+    let x = face_extra[f];
+    if (t.x == v) { return x.attr0; }
+    if (t.y == v) { return x.attr1; }
+    return x.attr2;
+}
+
+// The attribute vertex a corner of the removed vertex takes under map m (see NO_ATTR in
+// src/gpu/types.rs).
 fn mapped(m: vec4<u32>, a: u32) -> u32 {
     if (m.x == NO_ATTR || a == m.x) { return m.y; }
     if (a == m.z) { return m.w; }
     return a;
+}
+
+// The removed vertex r's corners onto seam vertex k: the map from the faces on the edge (locked
+// since edge_costs checked it): each side's pair for a seam vertex sliding along its seam, k's
+// attribute vertex for all corners of a free one.
+fn onto_seam_corners(k: u32, r: u32) {
+    let slides = (flags[r] & FLAG_SEAM) != 0u;
+    var m = vec4<u32>(NO_ATTR);
+    var n = 0u;
+    for (var i = offsets[r]; i < offsets[r + 1u]; i = i + 1u) {
+        let f = vertex_faces[i];
+        if (has(face_of(f), k)) {
+            if (!slides) {
+                m.y = corner_attr(f, k);
+            } else if (n == 0u) {
+                m.x = corner_attr(f, r);
+                m.y = corner_attr(f, k);
+            } else {
+                m.z = corner_attr(f, r);
+                m.w = corner_attr(f, k);
+            }
+            n = n + 1u;
+        }
+    }
+    // The faces that stay (those on the edge go); they are locked by this winner alone.
+    for (var i = offsets[r]; i < offsets[r + 1u]; i = i + 1u) {
+        let f = vertex_faces[i];
+        let t = face_of(f);
+        if (has(t, k)) { continue; }
+        var x = face_extra[f];
+        if (t.x == r) { x.attr0 = mapped(m, x.attr0); }
+        if (t.y == r) { x.attr1 = mapped(m, x.attr1); }
+        if (t.z == r) { x.attr2 = mapped(m, x.attr2); }
+        face_extra[f] = x;
+    }
 }
 
 @compute @workgroup_size(256)
@@ -32,6 +78,9 @@ fn collapse(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     let c = candidates[e];
     let k = c.keep;
     let r = c.remove;
+    if ((flags[k] & FLAG_SEAM) != 0u) {
+        onto_seam_corners(k, r);
+    }
     let pk = positions[k].xyz;
     let pr = positions[r].xyz;
     let p = c.pos.xyz;
@@ -41,17 +90,4 @@ fn collapse(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     flags[k] = flags[k] | (flags[r] & FLAG_BORDER) | moved;
     positions[k] = vec4<f32>(p, 1.0);
     remap[r] = k;
-    if (c.attr_map.y != NO_ATTR) {
-        // The faces that stay (those on the edge go); they are locked by this winner alone.
-        for (var i = offsets[r]; i < offsets[r + 1u]; i = i + 1u) {
-            let f = vertex_faces[i];
-            let t = face_of(f);
-            if (has(t, k)) { continue; }
-            var x = face_extra[f];
-            if (t.x == r) { x.attr0 = mapped(c.attr_map, x.attr0); }
-            if (t.y == r) { x.attr1 = mapped(c.attr_map, x.attr1); }
-            if (t.z == r) { x.attr2 = mapped(c.attr_map, x.attr2); }
-            face_extra[f] = x;
-        }
-    }
 }

@@ -86,11 +86,10 @@ struct EdgeCandidate {
     remove: u32,
     cost_bits: u32,
     faces: u32,
-    attr_map: vec4<u32>,
 }
 
 fn invalid_candidate() -> EdgeCandidate {
-    return EdgeCandidate(vec4<f32>(0.0), 0u, 0u, INVALID_COST, 0u, vec4<u32>(NO_ATTR));
+    return EdgeCandidate(vec4<f32>(0.0), 0u, 0u, INVALID_COST, 0u);
 }
 
 struct FaceExtra {

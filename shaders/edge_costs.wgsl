@@ -1,7 +1,7 @@
 // Per edge: the collapse position, quadric error, flip and needle checks of the faces that move,
 // the quality-scaled priority, and the cost histogram; the topological checks wait for validate.
-// Seam vertices follow the greedy reference's rules (onto_seam, seam_slide), the candidate
-// carrying the attribute map collapse applies. Relies on the current CSR face lists and on the
+// Seam vertices follow the greedy reference's rules (onto_seam, seam_slide); collapse makes the
+// attribute map again from the same faces. Relies on the current CSR face lists and on the
 // seam corners' attribute vertices in face_extra.
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -149,7 +149,10 @@ fn evaluate(a: u32, b: u32) -> Verdict {
         if (attr_map.y == NO_ATTR) { return invalid(); }
     }
     let error = quadric_eval(q, y);
-    let pos = pa + y;
+    // A survivor that keeps its position keeps it bit for bit (pa + (pb - pa) need not be pb):
+    // a seam vertex marked moved would leave its other attribute vertices behind.
+    var pos = pa + y;
+    if ((flags[keep] & (FLAG_PINNED | FLAG_SEAM)) != 0u) { pos = positions[keep].xyz; }
 
     var min_q = 3.0e38;
     for (var side = 0u; side < 2u; side = side + 1u) {
@@ -194,7 +197,7 @@ fn evaluate(a: u32, b: u32) -> Verdict {
     if (err2 > params.max_error2) {
         return Verdict(VERDICT_OVER, invalid_candidate());
     }
-    return Verdict(VERDICT_OK, EdgeCandidate(vec4<f32>(pos, err2), keep, remove, bitcast<u32>(priority), 0u, attr_map));
+    return Verdict(VERDICT_OK, EdgeCandidate(vec4<f32>(pos, err2), keep, remove, bitcast<u32>(priority), 0u));
 }
 
 @compute @workgroup_size(256)

@@ -105,7 +105,6 @@ fn each_stage_matches_its_cpu_twin() {
             }
             if g.cost_bits != INVALID_COST {
                 assert_eq!((g.keep, g.remove), (c.keep, c.remove), "{name}: edge {e}");
-                assert_eq!(g.attr_map, c.attr_map, "{name}: attribute map of edge {e}");
                 let (gc, cc) = (f32::from_bits(g.cost_bits), f32::from_bits(c.cost_bits));
                 assert!(
                     close(gc, cc, 1e-3) || gc.max(cc) < 1e-12,

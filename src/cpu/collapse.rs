@@ -1,15 +1,14 @@
 //! Twin of shaders/collapse.wgsl: each winner moves its survivor to the new position, gives it
 //! the sum of both quadrics (re-centred on the new position) and the removed vertex's border
 //! bit, and points the removed vertex at the survivor; when the survivor is a seam vertex, the
-//! removed vertex's corners take their attribute vertices from the candidate's map. Winners
-//! share no face, hence no vertex, so these writes never meet.
+//! removed vertex's corners take their attribute vertices by the seam rule `edge_costs`
+//! checked. Winners share no face, hence no vertex, so these writes never meet.
 
 use super::common::{quadric_add, quadric_shift, sub, xyz};
 use super::{Scatter, face_of, faces_of, par_for};
 use crate::gpu::types::{EdgeCandidate, FaceExtra, NO_ATTR, Params, Quadric, flag, state};
 
-/// The attribute vertex a corner of the removed vertex takes under `m`
-/// (`EdgeCandidate::attr_map`).
+/// The attribute vertex a corner of the removed vertex takes under map `m` (see [`NO_ATTR`]).
 fn mapped(m: [u32; 4], a: u32) -> u32 {
     if m[0] == NO_ATTR || a == m[0] {
         m[1]
@@ -17,6 +16,68 @@ fn mapped(m: [u32; 4], a: u32) -> u32 {
         m[3]
     } else {
         a
+    }
+}
+
+/// The faces and their attribute vertices, for rewriting the removed vertex's corners.
+struct Corners<'a> {
+    indices: &'a [u32],
+    offsets: &'a [u32],
+    vertex_faces: &'a [u32],
+    face_extra: Scatter<'a, FaceExtra>,
+}
+
+impl Corners<'_> {
+    /// The attribute vertex face `f` uses at its corner on vertex `v`.
+    ///
+    /// # Safety
+    /// No other thread writes face `f` meanwhile.
+    unsafe fn corner_attr(&self, f: u32, v: u32) -> u32 {
+        let t = face_of(self.indices, f);
+        let i = t.iter().position(|&u| u == v).unwrap_or(2);
+        // SAFETY: the caller's.
+        unsafe { self.face_extra.read(f as usize).attr[i] }
+    }
+
+    /// The removed vertex `r`'s corners onto seam vertex `k`: the map from the faces on the
+    /// edge (locked since `edge_costs` checked it): each side's pair for a seam vertex sliding
+    /// along its seam, `k`'s attribute vertex for all corners of a free one.
+    ///
+    /// # Safety
+    /// The faces around `r` are this thread's alone (the winner's face locks).
+    unsafe fn onto_seam(&self, flags: &Scatter<u32>, k: u32, r: u32) {
+        let faces = faces_of(self.offsets, self.vertex_faces, r);
+        // SAFETY: the caller's: r's faces and flags are this winner's alone.
+        unsafe {
+            let slides = flags.read(r as usize) & flag::SEAM != 0;
+            let mut m = [NO_ATTR; 4];
+            let mut n = 0;
+            for &f in faces {
+                if face_of(self.indices, f).contains(&k) {
+                    if !slides {
+                        m[1] = self.corner_attr(f, k);
+                    } else if n < 2 {
+                        m[2 * n] = self.corner_attr(f, r);
+                        m[2 * n + 1] = self.corner_attr(f, k);
+                    }
+                    n += 1;
+                }
+            }
+            // The faces that stay (those on the edge go).
+            for &f in faces {
+                let t = face_of(self.indices, f);
+                if t.contains(&k) {
+                    continue;
+                }
+                let mut x = self.face_extra.read(f as usize);
+                for (i, &u) in t.iter().enumerate() {
+                    if u == r {
+                        x.attr[i] = mapped(m, x.attr[i]);
+                    }
+                }
+                self.face_extra.write(f as usize, x);
+            }
+        }
     }
 }
 
@@ -36,6 +97,12 @@ pub fn collapse(
     face_extra: Scatter<FaceExtra>, // per face
 ) {
     let edge_count = edge_offsets[params.vertex_count as usize];
+    let corners = Corners {
+        indices,
+        offsets,
+        vertex_faces,
+        face_extra,
+    };
     par_for(edge_count, |e| {
         if edge_state[e as usize] != state::WON {
             return;
@@ -46,6 +113,9 @@ pub fn collapse(
         // writes only its own two vertices and the faces around the removed one, which the
         // face locks of `validate` give to this winner alone.
         unsafe {
+            if flags.read(k) & flag::SEAM != 0 {
+                corners.onto_seam(&flags, c.keep, c.remove);
+            }
             let pk = positions.read(k);
             let pr = positions.read(r);
             let p = xyz(c.pos);
@@ -58,22 +128,6 @@ pub fn collapse(
             flags.write(k, flags.read(k) | (flags.read(r) & flag::BORDER) | moved);
             positions.write(k, [p[0], p[1], p[2], 1.0]);
             remap.write(r, k as u32);
-            if c.attr_map[1] != NO_ATTR {
-                // The faces that stay (those on the edge go).
-                for &f in faces_of(offsets, vertex_faces, c.remove) {
-                    let t = face_of(indices, f);
-                    if t.contains(&c.keep) {
-                        continue;
-                    }
-                    let mut x = face_extra.read(f as usize);
-                    for (i, &u) in t.iter().enumerate() {
-                        if u == c.remove {
-                            x.attr[i] = mapped(c.attr_map, x.attr[i]);
-                        }
-                    }
-                    face_extra.write(f as usize, x);
-                }
-            }
         }
     });
 }

@@ -5,7 +5,7 @@
 //! tetrahedral fold) scan both endpoints' neighbourhoods and rarely fail on a manifold, so they
 //! run in `validate`, only for the edges that win a selection pass. Seam vertices follow the
 //! greedy reference's rules: a free vertex may move onto one, and one may slide along its seam
-//! onto a seam neighbour; the candidate carries the attribute map `collapse` applies.
+//! onto a seam neighbour (`collapse` makes the attribute map again from the same faces).
 
 use super::common::*;
 use super::{face_of, faces_of};
@@ -122,18 +122,17 @@ pub fn placement(
         &quadrics[a as usize],
         &quadric_shift(&quadrics[b as usize], sub(pa, pb)),
     );
-    let mut attr_map = None;
+    let mut slides = false;
     let (keep, remove, y) = if fixed(fla) && fixed(flb) {
         // Only a seam vertex sliding along its seam onto a seam neighbour; b first, as the
         // greedy tries.
         if fla & flb & flag::SEAM == 0 {
             return Verdict::Invalid;
         }
-        if let Some(m) = corners.seam_slide(flags, b, a) {
-            attr_map = Some(m);
+        slides = true;
+        if corners.seam_slide(flags, b, a).is_some() {
             (a, b, [0.0; 3])
-        } else if let Some(m) = corners.seam_slide(flags, a, b) {
-            attr_map = Some(m);
+        } else if corners.seam_slide(flags, a, b).is_some() {
             (b, a, dab)
         } else {
             return Verdict::Invalid;
@@ -165,14 +164,20 @@ pub fn placement(
             (b, a, y)
         }
     };
-    if flags[keep as usize] & flag::SEAM != 0 && attr_map.is_none() {
-        let Some(m) = corners.onto_seam(keep, remove) else {
-            return Verdict::Invalid;
-        };
-        attr_map = Some(m);
+    if flags[keep as usize] & flag::SEAM != 0
+        && !slides
+        && corners.onto_seam(keep, remove).is_none()
+    {
+        return Verdict::Invalid;
     }
     let error = quadric_eval(&q, y);
-    let pos = add(pa, y);
+    // A survivor that keeps its position keeps it bit for bit (pa + (pb - pa) need not be pb):
+    // a seam vertex marked moved would leave its other attribute vertices behind.
+    let pos = if flags[keep as usize] & (flag::PINNED | flag::SEAM) != 0 {
+        xyz(positions[keep as usize])
+    } else {
+        add(pa, y)
+    };
 
     // Faces that move: normals may not turn past the limit (against the current and the input
     // normal), no needle may appear; the worst new quality scales the priority.
@@ -231,7 +236,6 @@ pub fn placement(
         remove,
         cost_bits: priority.to_bits(),
         faces: 0,
-        attr_map: attr_map.unwrap_or([NO_ATTR; 4]),
     })
 }
 

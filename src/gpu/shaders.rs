@@ -132,6 +132,10 @@ pub const STAGES: &[(&str, &[&str], &str)] = &[
     ),
 ];
 
+/// The most storage buffers a stage binds (edge_costs); the device must allow as many per
+/// stage. A unit test counts them in every stage.
+pub const MAX_STORAGE_BUFFERS: u32 = 14;
+
 pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
 /// Face and CSR list accessors, for the stages that bind `indices` and `vertex_faces`.
 pub const MESH: &str = include_str!("../../shaders/mesh.wgsl");
@@ -162,6 +166,23 @@ mod tests {
         .validate(&module)
         .unwrap_or_else(|e| panic!("shaders/{stem}.wgsl does not validate: {e:?}"));
         module
+    }
+
+    #[test]
+    fn no_stage_binds_more_storage_buffers_than_the_device_check_asks_for() {
+        let most = STAGES
+            .iter()
+            .map(|(stem, _, src)| {
+                let module = parse(stem, src);
+                module
+                    .global_variables
+                    .iter()
+                    .filter(|(_, v)| matches!(v.space, naga::AddressSpace::Storage { .. }))
+                    .count() as u32
+            })
+            .max()
+            .unwrap_or(0);
+        assert_eq!(most, MAX_STORAGE_BUFFERS);
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! read-back is the 64-byte counters block (and the stage timestamps when the device has them).
 
 use super::context::{ErrorSink, checked_buffer, checked_buffer_init};
-use super::shaders::{STAGES, source};
+use super::shaders::{MAX_STORAGE_BUFFERS, STAGES, source};
 use super::types::*;
 use crate::error::{Error, Result};
 use crate::parallel::{Download, RoundRunner, StageTimes, Upload};
@@ -36,9 +36,10 @@ impl GpuSimplifier {
         let t = Instant::now();
         let errors = ErrorSink::install(device);
         let limits = device.limits();
-        if limits.max_storage_buffers_per_shader_stage < 10 {
+        if limits.max_storage_buffers_per_shader_stage < MAX_STORAGE_BUFFERS {
             return Err(Error::Gpu(format!(
-                "the device binds at most {} storage buffers per stage; the simplifier needs 10",
+                "the device binds at most {} storage buffers per stage; the simplifier needs \
+                 {MAX_STORAGE_BUFFERS}",
                 limits.max_storage_buffers_per_shader_stage
             )));
         }

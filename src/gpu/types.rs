@@ -136,15 +136,7 @@ pub struct EdgeCandidate {
     pub cost_bits: u32,
     /// Faces on the edge, 1 (border) or 2, what the collapse removes; set by `validate`.
     pub faces: u32,
-    /// When the survivor is a seam vertex, the attribute vertices the removed vertex's
-    /// corners take, as (from, to) pairs: `[NO_ATTR, to, NO_ATTR, NO_ATTR]` for a free vertex
-    /// moving onto the seam (all its corners take `to`), `[from₁, to₁, from₂, to₂]` for a seam
-    /// vertex sliding along its seam (one pair per side). `[NO_ATTR; 4]` otherwise.
-    pub attr_map: [u32; 4],
 }
-
-/// No attribute vertex: an empty `EdgeCandidate::attr_map` entry.
-pub const NO_ATTR: u32 = u32::MAX;
 
 impl EdgeCandidate {
     /// What an edge that may not collapse holds.
@@ -154,9 +146,17 @@ impl EdgeCandidate {
         remove: 0,
         cost_bits: INVALID_COST,
         faces: 0,
-        attr_map: [NO_ATTR; 4],
     };
 }
+
+/// No attribute vertex, in the seam rules' attribute maps: (from, to) pairs for the removed
+/// vertex's corners when the survivor is a seam vertex, `[NO_ATTR, to, NO_ATTR, NO_ATTR]` for a
+/// free vertex moving onto the seam (all its corners take `to`), `[from₁, to₁, from₂, to₂]` for
+/// a seam vertex sliding along its seam (one pair per side). `edge_costs` checks that the map
+/// exists, `collapse` makes it again from the faces on the edge (locked and unchanged in
+/// between): 16 more bytes per candidate would put the 1M scan's candidate buffer over
+/// lavapipe's 128 MiB binding limit.
+pub const NO_ATTR: u32 = u32::MAX;
 
 /// Per-face data carried through compaction alongside the indices: the attribute vertex of
 /// each corner (for seam corners) and the face's index in the input (materials, groups).
