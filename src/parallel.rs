@@ -98,6 +98,28 @@ pub struct Upload {
     pub seams: usize,
 }
 
+/// The attribute vertex (of the welded input) of every corner of the rounds' faces: a seam
+/// corner's own, which the collapses keep current, any other corner's its vertex's.
+pub fn corner_attributes(
+    flags: &[u32],
+    vertex_attr: &[u32],
+    indices: &[u32],
+    face_extra: &[FaceExtra],
+) -> Vec<u32> {
+    indices
+        .iter()
+        .enumerate()
+        .map(|(c, &v)| {
+            let v = v as usize;
+            if flags[v] & flag::SEAM != 0 {
+                face_extra[c / 3].attr[c % 3]
+            } else {
+                vertex_attr[v]
+            }
+        })
+        .collect()
+}
+
 /// The rounds' buffers read back at the end.
 #[derive(Debug, Clone, Default)]
 pub struct Download {
@@ -236,19 +258,8 @@ impl Upload {
             }
         }
         let nf = d.face_extra.len();
-        out.triangles = (0..nf)
-            .map(|f| {
-                let x = &d.face_extra[f];
-                [0, 1, 2].map(|k| {
-                    let v = d.indices[3 * f + k] as usize;
-                    if d.flags[v] & flag::SEAM != 0 {
-                        x.attr[k]
-                    } else {
-                        d.vertex_attr[v]
-                    }
-                })
-            })
-            .collect();
+        let attrs = corner_attributes(&d.flags, &d.vertex_attr, &d.indices, &d.face_extra);
+        out.triangles = attrs.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
         let origin = |f: usize| d.face_extra[f].origin as usize;
         out.face_materials = self
             .welded

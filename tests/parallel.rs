@@ -110,6 +110,32 @@ fn seams_are_kept_and_attributes_follow() {
     }
 }
 
+/// Before any collapse, every corner's attribute vertex as the rounds see it (what the output
+/// and the viewer's per-corner UVs are made from) is the input corner's own, on both sides of a
+/// seam.
+#[test]
+fn corner_attributes_of_the_upload_are_the_input_corners() {
+    use meshslim::parallel::{Upload, corner_attributes};
+    let m = seamed_torus();
+    let up = Upload::new(&m);
+    let attrs = corner_attributes(&up.flags, &up.vertex_attr, &up.indices, &up.face_extra);
+    assert_eq!(attrs.len(), up.indices.len());
+    let uv = up.welded.uvs.as_ref().unwrap();
+    let mut seam_corners = 0;
+    for (f, x) in up.face_extra.iter().enumerate() {
+        let input = up.welded.triangles[x.origin as usize];
+        for k in 0..3 {
+            let got = attrs[3 * f + k];
+            // The same position and the same UV as the input corner: its own attribute vertex.
+            assert_eq!(got, input[k], "face {f} corner {k}");
+            seam_corners += (up.flags[up.indices[3 * f + k] as usize] != 0) as usize;
+            assert_eq!(uv[got as usize], uv[input[k] as usize]);
+        }
+    }
+    // 24 seam vertices with six corners each.
+    assert_eq!(seam_corners, 24 * 6);
+}
+
 /// The rounds thin a seam out like the greedy reference: seam vertices slide along it and free
 /// ones collapse onto it, so the seam does not pin the target away.
 #[test]

@@ -1,9 +1,12 @@
-// Draws the simplifier's own buffers: positions (vec4, normalized frame) as the first vertex
-// buffer and its u32 indices, plus per-vertex extras the viewer keeps beside them (distance to
-// the original surface for the heatmap, a smooth normal, a texture coordinate). Flat normals come
-// from screen-space derivatives, so the flat modes need none of the extras.
-// Relies on: every extra buffer holds one entry per vertex of the GpuMesh drawn with it
-// (SceneMesh sizes them so), as the indirect draw may index any vertex the rounds kept.
+// Draws the simplifier's own buffers: its u32 indices and positions (vec4, normalized frame),
+// read by the vertex shader (vertex pulling: the draw runs one invocation per corner, so a seam
+// vertex can show each side's texture coordinate), plus extras the viewer keeps beside them:
+// per vertex the distance to the original surface (heatmap) and a smooth normal, per corner a
+// texture coordinate. Flat normals come from screen-space derivatives, so the flat modes need
+// none of the extras.
+// Relies on: the per-vertex extras hold one entry per vertex of the GpuMesh drawn with them and
+// the UVs one per corner (SceneMesh sizes them so), as the indirect draw may reach any corner
+// and vertex the rounds kept.
 
 // One per drawn instance (dynamic uniform offset). Keep in sync with `ViewUniform` in
 // src/viewer/render.rs.
@@ -20,6 +23,11 @@ struct View {
 @group(0) @binding(0) var<uniform> view: View;
 @group(1) @binding(0) var albedo: texture_2d<f32>;
 @group(1) @binding(1) var albedo_sampler: sampler;
+@group(2) @binding(0) var<storage, read> indices: array<u32>;         // per corner
+@group(2) @binding(1) var<storage, read> positions: array<vec4<f32>>; // per vertex
+@group(2) @binding(2) var<storage, read> errors: array<f32>;          // per vertex
+@group(2) @binding(3) var<storage, read> normals: array<f32>;         // per vertex × 3
+@group(2) @binding(4) var<storage, read> uvs: array<vec2<f32>>;       // per corner
 
 struct VOut {
     @builtin(position) clip: vec4<f32>,
@@ -30,18 +38,15 @@ struct VOut {
 }
 
 @vertex
-fn vs_main(
-    @location(0) position: vec4<f32>,
-    @location(1) error: f32,
-    @location(2) normal: vec3<f32>,
-    @location(3) uv: vec2<f32>,
-) -> VOut {
+fn vs_main(@builtin(vertex_index) corner: u32) -> VOut {
+    let v = indices[corner];
+    let position = positions[v];
     var o: VOut;
     o.clip = view.view_proj * vec4<f32>(position.xyz, 1.0);
     o.local = position.xyz;
-    o.error = error;
-    o.normal = normal;
-    o.uv = uv;
+    o.error = errors[v];
+    o.normal = vec3<f32>(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);
+    o.uv = uvs[corner];
     return o;
 }
 

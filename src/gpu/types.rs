@@ -169,7 +169,9 @@ pub struct FaceExtra {
 }
 
 /// Indexed indirect draw arguments, as wgpu's `DrawIndexedIndirectArgs`, written by
-/// `draw_args` so a renderer draws the current mesh without reading its size back.
+/// `draw_args` so a renderer draws the current mesh without reading its size back. First index
+/// and base vertex stay 0, so the first four words also serve a non-indexed indirect draw of
+/// one invocation per corner (the viewer's vertex pulling).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct DrawArgs {

@@ -57,21 +57,23 @@ impl Default for Style {
     }
 }
 
-/// A drawable mesh: the [`GpuMesh`] as the simplifier left it, and per-vertex extras beside it,
-/// one entry per vertex of the GpuMesh, in its order.
+/// A drawable mesh: the [`GpuMesh`] as the simplifier left it, and extras beside it: one entry
+/// per vertex of the GpuMesh, in its order, or per corner for the UVs.
 pub struct SceneMesh {
     pub gpu: GpuMesh,
     /// f32 per vertex: distance to the original surface, relative to its diagonal.
     pub error: wgpu::Buffer,
     /// [f32; 3] per vertex: area-weighted normal (zero where unknown: flat shading there).
     pub normals: wgpu::Buffer,
-    /// [f32; 2] per vertex.
+    /// [f32; 2] per corner (3 per face), so that a seam vertex shows each side's own.
     pub uvs: wgpu::Buffer,
     pub vertices: usize,
     pub faces: usize,
     pub has_uvs: bool,
     /// Largest value in `error`.
     pub max_error: f32,
+    /// The buffers the vertex shader reads, bound once, on first draw.
+    group: std::sync::OnceLock<wgpu::BindGroup>,
 }
 
 /// Per-vertex extras made on the host.
@@ -79,6 +81,7 @@ pub struct SceneMesh {
 pub struct Extras {
     pub error: Vec<f32>,
     pub normals: Vec<[f32; 3]>,
+    /// Per corner (3 per face).
     pub uvs: Option<Vec<[f32; 2]>>,
 }
 
@@ -98,7 +101,7 @@ impl SceneMesh {
                 label,
                 data,
                 len,
-                wgpu::BufferUsages::VERTEX,
+                wgpu::BufferUsages::STORAGE,
             )
         };
         let max_error = extras.error.iter().fold(0f32, |m, &e| m.max(e));
@@ -117,13 +120,14 @@ impl SceneMesh {
             uvs: buf(
                 "meshslim.viewer.vertex_uvs",
                 bytemuck::cast_slice(uvs),
-                vertices * 8,
+                faces * 3 * 8,
             )?,
             has_uvs: extras.uvs.is_some(),
             gpu,
             vertices,
             faces,
             max_error,
+            group: std::sync::OnceLock::new(),
         })
     }
 }
@@ -277,11 +281,15 @@ impl Target {
 
 /// The mesh pipelines (fill, and wireframe where the device draws line polygons) and the
 /// per-instance uniforms.
+/// Storage buffers of one mesh the vertex shader reads (group 2 of shaders/viewer/mesh.wgsl).
+const MESH_BINDINGS: u32 = 5;
+
 pub struct Renderer {
     fill: wgpu::RenderPipeline,
     wire: Option<wgpu::RenderPipeline>,
     view_layout: wgpu::BindGroupLayout,
     texture_layout: wgpu::BindGroupLayout,
+    mesh_layout: wgpu::BindGroupLayout,
     slots: wgpu::Buffer,
     slot_count: u64,
     view_group: wgpu::BindGroup,
@@ -331,34 +339,32 @@ impl Renderer {
                 },
             ],
         });
+        // The GpuMesh's indices and positions as the simplifier wrote them, then the extras:
+        // read by the vertex shader, one invocation per corner.
+        let mesh_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("meshslim.viewer.mesh_buffers"),
+            entries: &(0..MESH_BINDINGS)
+                .map(|binding| wgpu::BindGroupLayoutEntry {
+                    binding,
+                    visibility: wgpu::ShaderStages::VERTEX,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                })
+                .collect::<Vec<_>>(),
+        });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("meshslim.viewer.mesh"),
-            bind_group_layouts: &[Some(&view_layout), Some(&texture_layout)],
+            bind_group_layouts: &[
+                Some(&view_layout),
+                Some(&texture_layout),
+                Some(&mesh_layout),
+            ],
             immediate_size: 0,
         });
-        let buffers = [
-            // GpuMesh positions: vec4 per vertex, as the simplifier writes them.
-            Some(wgpu::VertexBufferLayout {
-                array_stride: 16,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x4],
-            }),
-            Some(wgpu::VertexBufferLayout {
-                array_stride: 4,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![1 => Float32],
-            }),
-            Some(wgpu::VertexBufferLayout {
-                array_stride: 12,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![2 => Float32x3],
-            }),
-            Some(wgpu::VertexBufferLayout {
-                array_stride: 8,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![3 => Float32x2],
-            }),
-        ];
         let pipeline = |label: &str, fs: &str, line: bool| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
@@ -367,7 +373,7 @@ impl Renderer {
                     module: &module,
                     entry_point: Some("vs_main"),
                     compilation_options: Default::default(),
-                    buffers: &buffers,
+                    buffers: &[],
                 },
                 primitive: wgpu::PrimitiveState {
                     polygon_mode: if line {
@@ -419,6 +425,7 @@ impl Renderer {
             wire,
             view_layout,
             texture_layout,
+            mesh_layout,
             view_group,
             slots,
             slot_count,
@@ -606,12 +613,33 @@ impl Renderer {
             pass.set_pipeline(pipeline);
             for (i, (mesh, _)) in items.iter().enumerate() {
                 pass.set_bind_group(0, &self.view_group, &[(i as u64 * SLOT) as u32]);
-                pass.set_vertex_buffer(0, mesh.gpu.positions.slice(..));
-                pass.set_vertex_buffer(1, mesh.error.slice(..));
-                pass.set_vertex_buffer(2, mesh.normals.slice(..));
-                pass.set_vertex_buffer(3, mesh.uvs.slice(..));
-                pass.set_index_buffer(mesh.gpu.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed_indirect(&mesh.gpu.draw_args, 0);
+                let group = mesh.group.get_or_init(|| {
+                    let buffers = [
+                        &mesh.gpu.indices,
+                        &mesh.gpu.positions,
+                        &mesh.error,
+                        &mesh.normals,
+                        &mesh.uvs,
+                    ];
+                    device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("meshslim.viewer.mesh_buffers"),
+                        layout: &self.mesh_layout,
+                        entries: &buffers
+                            .iter()
+                            .enumerate()
+                            .map(|(i, b)| wgpu::BindGroupEntry {
+                                binding: i as u32,
+                                resource: b.as_entire_binding(),
+                            })
+                            .collect::<Vec<_>>(),
+                    })
+                });
+                pass.set_bind_group(2, group, &[]);
+                // Not indexed: the vertex shader reads the index buffer itself, one invocation
+                // per corner. The simplifier's indexed arguments serve as they are: their first
+                // four words (index count, instances, first index 0, base vertex 0) read as
+                // (vertex count, instances, first vertex, first instance).
+                pass.draw_indirect(&mesh.gpu.draw_args, 0);
             }
         }
     }

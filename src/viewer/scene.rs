@@ -7,7 +7,9 @@ use crate::error::{Error, Result};
 use crate::gpu::{GpuMesh, GpuRounds, GpuSimplifier};
 use crate::mesh::Mesh;
 use crate::metrics::{CompareOptions, TriangleBvh, compare};
-use crate::parallel::{Driver, RoundRunner, RoundsReport, SELECTION_PASSES, Upload};
+use crate::parallel::{
+    Driver, RoundRunner, RoundsReport, SELECTION_PASSES, Upload, corner_attributes,
+};
 use crate::simplify::{Backend, SimplifyOptions, SimplifyReport};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -102,7 +104,10 @@ impl Model {
     pub fn original(&self, device: &wgpu::Device) -> Result<SceneMesh> {
         let up = &self.up;
         let gpu = GpuMesh::from_arrays(device, &up.positions, &up.indices, up.center, up.scale)?;
-        let uvs = class_uvs(up, &up.vertex_attr);
+        let uvs = corner_uvs(
+            up,
+            &corner_attributes(&up.flags, &up.vertex_attr, &up.indices, &up.face_extra),
+        );
         let extras = Extras {
             error: Vec::new(),
             normals: vertex_normals(&up.positions, &up.indices),
@@ -139,10 +144,11 @@ impl Model {
     }
 }
 
-/// Each position class's UV: that of the attribute vertex the rounds keep for it (`vertex_attr`).
-fn class_uvs(up: &Upload, vertex_attr: &[u32]) -> Option<Vec<[f32; 2]>> {
+/// Each corner's UV: that of its attribute vertex (see [`corner_attributes`]), so a seam
+/// vertex shows each side's own.
+fn corner_uvs(up: &Upload, corner_attr: &[u32]) -> Option<Vec<[f32; 2]>> {
     let uv = up.welded.uvs.as_ref()?;
-    Some(vertex_attr.iter().map(|&a| uv[a as usize]).collect())
+    Some(corner_attr.iter().map(|&a| uv[a as usize]).collect())
 }
 
 /// The first material library's first `map_Kd`, read as PNG; a note when one is named but
@@ -289,7 +295,10 @@ pub fn simplify(
             // back; what is drawn is the rounds' own buffers.
             let d = rounds.download()?;
             let indices = d.indices.clone();
-            let uvs = class_uvs(up, &d.vertex_attr);
+            let uvs = corner_uvs(
+                up,
+                &corner_attributes(&d.flags, &d.vertex_attr, &d.indices, &d.face_extra),
+            );
             let gpu = rounds.into_mesh(up)?;
             (gpu, d.positions, indices, mesh, report, uvs)
         }
@@ -305,7 +314,10 @@ pub fn simplify(
                 model.up.center,
                 model.up.scale,
             )?;
-            let uvs = mesh.uvs.clone();
+            let uvs = mesh
+                .uvs
+                .as_ref()
+                .map(|uv| indices.iter().map(|&v| uv[v as usize]).collect());
             (gpu, positions, indices, mesh, report, uvs)
         }
     };
