@@ -128,7 +128,8 @@ fn corner_attributes_of_the_upload_are_the_input_corners() {
             let got = attrs[3 * f + k];
             // The same position and the same UV as the input corner: its own attribute vertex.
             assert_eq!(got, input[k], "face {f} corner {k}");
-            seam_corners += (up.flags[up.indices[3 * f + k] as usize] != 0) as usize;
+            let v = up.indices[3 * f + k] as usize;
+            seam_corners += (up.flags[v] & meshslim::gpu::types::flag::SEAM != 0) as usize;
             assert_eq!(uv[got as usize], uv[input[k] as usize]);
         }
     }

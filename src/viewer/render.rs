@@ -76,7 +76,7 @@ pub struct SceneMesh {
     group: std::sync::OnceLock<wgpu::BindGroup>,
 }
 
-/// Per-vertex extras made on the host.
+/// Extras made on the host: per vertex, except the UVs (per corner).
 #[derive(Debug, Clone, Default)]
 pub struct Extras {
     pub error: Vec<f32>,
@@ -117,10 +117,17 @@ impl SceneMesh {
                 bytemuck::cast_slice(&extras.normals),
                 vertices * 12,
             )?,
+            // Per corner, the largest extra: only when there are UVs (without, the shader's
+            // reads land past the end, which wgpu's bounds checks keep safe, and only the
+            // texture mode, unavailable then, would show them).
             uvs: buf(
-                "meshslim.viewer.vertex_uvs",
+                "meshslim.viewer.corner_uvs",
                 bytemuck::cast_slice(uvs),
-                faces * 3 * 8,
+                if extras.uvs.is_some() {
+                    faces * 3 * 8
+                } else {
+                    0
+                },
             )?,
             has_uvs: extras.uvs.is_some(),
             gpu,
@@ -279,11 +286,11 @@ impl Target {
     }
 }
 
-/// The mesh pipelines (fill, and wireframe where the device draws line polygons) and the
-/// per-instance uniforms.
 /// Storage buffers of one mesh the vertex shader reads (group 2 of shaders/viewer/mesh.wgsl).
 const MESH_BINDINGS: u32 = 5;
 
+/// The mesh pipelines (fill, and wireframe where the device draws line polygons) and the
+/// per-instance uniforms.
 pub struct Renderer {
     fill: wgpu::RenderPipeline,
     wire: Option<wgpu::RenderPipeline>,
