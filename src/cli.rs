@@ -148,9 +148,9 @@ pub struct ViewArgs {
     #[arg(long, value_name = "FILE.png")]
     pub screenshot: Option<PathBuf>,
 
-    /// A PNG texture for the texture mode (default: the OBJ material's map_Kd, else the only PNG
-    /// beside a mesh that has UVs)
-    #[arg(long, value_name = "FILE.png")]
+    /// A PNG or JPEG texture for the texture mode (default: the OBJ material's map_Kd, else the
+    /// only PNG or JPEG beside a mesh that has UVs)
+    #[arg(long, value_name = "FILE.png|jpg")]
     pub texture: Option<PathBuf>,
 
     /// With --screenshot: simplify to this fraction of the faces on the GPU first, in (0, 1]
@@ -206,7 +206,7 @@ fn run_view(args: ViewArgs) -> Result<ExitCode> {
                 let mesh = load(input, &progress)?;
                 let mut m = crate::viewer::Model::from_mesh(input.display(), mesh).map_err(lib)?;
                 if let Some(t) = &args.texture {
-                    m.texture = Some(crate::viewer::scene::read_png(t).map_err(lib)?);
+                    m.texture = Some(crate::viewer::scene::read_texture(t).map_err(lib)?);
                 }
                 Ok(m)
             }

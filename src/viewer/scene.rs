@@ -42,12 +42,12 @@ pub struct Model {
 
 impl Model {
     /// Reads `path` and its texture: `texture` if given, else the first material's `map_Kd`
-    /// PNG, else the only PNG in the mesh's folder when the mesh has UVs.
+    /// image, else the only PNG or JPEG in the mesh's folder when the mesh has UVs.
     pub fn open(path: &Path, texture: Option<&Path>) -> Result<Model> {
         let t = Instant::now();
         let mesh = crate::io::read(path)?;
         let (texture, note) = match texture {
-            Some(t) => (Some(read_png(t)?), None),
+            Some(t) => (Some(read_texture(t)?), None),
             None => find_texture(path, &mesh),
         };
         let mut m = Model::from_mesh(path.display().to_string(), mesh)?;
@@ -173,20 +173,20 @@ fn find_texture(path: &Path, mesh: &Mesh) -> (Option<Image>, Option<String>) {
             continue;
         };
         let file = mtl.parent().unwrap_or(dir).join(name);
-        return match read_png(&file) {
+        return match read_texture(&file) {
             Ok(img) => (Some(img), None),
             Err(e) => (None, Some(e.to_string())),
         };
     }
-    // No material names one: a mesh with UVs whose folder holds exactly one PNG (a scan and its
-    // texture, as ../shared/models/spot ships) takes that one.
+    // No material names one: a mesh with UVs whose folder holds exactly one PNG or JPEG (a scan
+    // and its texture, as ../shared/models/spot ships) takes that one.
     if mesh.uvs.is_some() {
         let pngs: Vec<PathBuf> = std::fs::read_dir(dir)
             .into_iter()
             .flatten()
             .flatten()
             .map(|e| e.path())
-            .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")))
+            .filter(|p| is_texture_file(p))
             // The viewer's own screenshots are not textures.
             .filter(|p| {
                 !p.file_name()
@@ -194,7 +194,7 @@ fn find_texture(path: &Path, mesh: &Mesh) -> (Option<Image>, Option<String>) {
             })
             .collect();
         if let [only] = &pngs[..] {
-            return match read_png(only) {
+            return match read_texture(only) {
                 Ok(img) => (Some(img), None),
                 Err(e) => (None, Some(e.to_string())),
             };
@@ -203,14 +203,19 @@ fn find_texture(path: &Path, mesh: &Mesh) -> (Option<Image>, Option<String>) {
     (None, None)
 }
 
-/// A PNG file as RGBA8.
-pub fn read_png(path: &Path) -> Result<Image> {
-    let is_png = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-    if !is_png {
+/// Texture file extensions the viewer reads (by content, through the `image` crate).
+const TEXTURE_EXTENSIONS: [&str; 3] = ["png", "jpg", "jpeg"];
+
+fn is_texture_file(p: &Path) -> bool {
+    p.extension()
+        .is_some_and(|e| TEXTURE_EXTENSIONS.iter().any(|x| e.eq_ignore_ascii_case(x)))
+}
+
+/// A PNG or JPEG file (scans ship their textures as either) as RGBA8.
+pub fn read_texture(path: &Path) -> Result<Image> {
+    if !is_texture_file(path) {
         return Err(Error::InvalidOption(format!(
-            "{}: only PNG textures are read",
+            "{}: only PNG and JPEG textures are read",
             path.display()
         )));
     }
@@ -218,24 +223,15 @@ pub fn read_png(path: &Path) -> Result<Image> {
         path: path.to_path_buf(),
         source: e,
     })?;
-    let pixmap = resvg::tiny_skia::Pixmap::decode_png(&bytes).map_err(|e| Error::Parse {
+    let img = image::load_from_memory(&bytes).map_err(|e| Error::Parse {
         path: path.to_path_buf(),
         location: crate::error::Location::Unknown,
-        message: format!("not a readable PNG: {e}"),
+        message: format!("not a readable PNG or JPEG: {e}"),
     })?;
-    // tiny-skia keeps premultiplied alpha; textures are drawn opaque, so undo it.
-    let mut rgba = pixmap.data().to_vec();
-    for px in rgba.chunks_exact_mut(4) {
-        let a = px[3] as u32;
-        if a != 0 && a != 255 {
-            for c in &mut px[..3] {
-                *c = ((*c as u32 * 255 + a / 2) / a).min(255) as u8;
-            }
-        }
-    }
+    let rgba = img.to_rgba8();
     Ok(Image {
-        rgba,
-        size: (pixmap.width(), pixmap.height()),
+        size: rgba.dimensions(),
+        rgba: rgba.into_raw(),
     })
 }
 
@@ -385,4 +381,48 @@ pub fn lod_levels(
         )?);
     }
     Ok(levels)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// PNG and JPEG textures read to the same RGBA8 (JPEG within its loss); other files and
+    /// broken ones give errors naming the file.
+    #[test]
+    fn textures_read_from_png_and_jpeg() {
+        let dir = tempfile::tempdir().unwrap();
+        let img = image::RgbImage::from_fn(16, 8, |x, _| {
+            if x < 8 {
+                image::Rgb([200, 30, 30])
+            } else {
+                image::Rgb([240, 240, 240])
+            }
+        });
+        for name in ["t.png", "t.JPG", "t.jpeg"] {
+            let path = dir.path().join(name);
+            img.save(&path).unwrap();
+            let t = read_texture(&path).unwrap();
+            assert_eq!(t.size, (16, 8), "{name}");
+            assert_eq!(t.rgba.len(), 16 * 8 * 4);
+            let left = &t.rgba[4 * 2..4 * 2 + 4];
+            let right = &t.rgba[4 * 13..4 * 13 + 4];
+            assert!(
+                left[0] > 150 && left[1] < 80 && left[3] == 255,
+                "{name}: {left:?}"
+            );
+            assert!(right.iter().all(|&c| c > 200), "{name}: {right:?}");
+        }
+        let bad = dir.path().join("broken.jpg");
+        std::fs::write(&bad, b"not a jpeg").unwrap();
+        let e = read_texture(&bad)
+            .err()
+            .expect("broken.jpg read")
+            .to_string();
+        assert!(e.contains("broken.jpg"), "{e}");
+        let other = dir.path().join("t.tga");
+        std::fs::write(&other, b"").unwrap();
+        let e = read_texture(&other).err().expect("t.tga read").to_string();
+        assert!(e.contains("PNG and JPEG"), "{e}");
+    }
 }
