@@ -17,15 +17,6 @@
 @group(0) @binding(10) var<storage, read> vertex_faces: array<u32>;       // per corner
 @group(0) @binding(11) var<storage, read_write> face_extra: array<FaceExtra>; // per face
 
-// The attribute vertex face f uses at its corner on vertex v.
-fn corner_attr(f: u32, v: u32) -> u32 {
-    let t = face_of(f);
-    let x = face_extra[f];
-    if (t.x == v) { return x.attr0; }
-    if (t.y == v) { return x.attr1; }
-    return x.attr2;
-}
-
 // The attribute vertex a corner of the removed vertex takes under map m (see NO_ATTR in
 // src/gpu/types.rs).
 fn mapped(m: vec4<u32>, a: u32) -> u32 {

@@ -33,15 +33,6 @@ fn invalid() -> Verdict {
     return Verdict(VERDICT_INVALID, invalid_candidate());
 }
 
-// The attribute vertex face f uses at its corner on vertex v.
-fn corner_attr(f: u32, v: u32) -> u32 {
-    let t = face_of(f);
-    let x = face_extra[f];
-    if (t.x == v) { return x.attr0; }
-    if (t.y == v) { return x.attr1; }
-    return x.attr2;
-}
-
 // Free vertex r moving onto seam vertex k: its corners take the attribute vertex k has in the
 // faces on the edge, which must agree (else the edge runs along the seam). .y = NO_ATTR if not.
 fn onto_seam(k: u32, r: u32) -> vec4<u32> {

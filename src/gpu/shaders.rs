@@ -1,6 +1,7 @@
 //! The WGSL stages: each file in shaders/ is one stage (prefix_sum has its three steps), compiled
-//! as shaders/common.wgsl (and shaders/mesh.wgsl for stages reading the faces' CSR lists)
-//! followed by the stage's own source. Tests parse and validate every
+//! as shaders/common.wgsl (and shaders/mesh.wgsl for stages reading the faces' CSR lists, then
+//! shaders/seams.wgsl for those reading the corners' attribute vertices) followed by the stage's
+//! own source. Tests parse and validate every
 //! stage with naga — no GPU needed — and compare the WGSL structs with their Rust twins.
 
 /// (file stem, entry points, source) of every stage.
@@ -139,16 +140,25 @@ pub const MAX_STORAGE_BUFFERS: u32 = 14;
 pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
 /// Face and CSR list accessors, for the stages that bind `indices` and `vertex_faces`.
 pub const MESH: &str = include_str!("../../shaders/mesh.wgsl");
+/// Corner attribute accessors, for the stages that also bind `face_extra`.
+pub const SEAMS: &str = include_str!("../../shaders/seams.wgsl");
 
-/// The full source of a stage: the common definitions, the mesh accessors when the stage binds
-/// the buffers they read, then the stage.
+/// The full source of a stage: the common definitions, the mesh and seam accessors when the
+/// stage binds the buffers they read, then the stage.
 pub fn source(stage_source: &str) -> String {
-    let binds = |var: &str| stage_source.contains(&format!("var<storage, read> {var}:"));
+    let binds = |var: &str| {
+        ["read", "read_write"]
+            .iter()
+            .any(|access| stage_source.contains(&format!("var<storage, {access}> {var}:")))
+    };
+    let mut src = COMMON.to_string();
     if binds("indices") && binds("vertex_faces") {
-        format!("{COMMON}\n{MESH}\n{stage_source}")
-    } else {
-        format!("{COMMON}\n{stage_source}")
+        src = format!("{src}\n{MESH}");
+        if binds("face_extra") {
+            src = format!("{src}\n{SEAMS}");
+        }
     }
+    format!("{src}\n{stage_source}")
 }
 
 #[cfg(test)]
@@ -209,7 +219,7 @@ mod tests {
             let name = entry.file_name().into_string().unwrap();
             let stem = name.trim_end_matches(".wgsl");
             assert!(
-                stem == "common" || stem == "mesh" || STAGES.iter().any(|s| s.0 == stem),
+                ["common", "mesh", "seams"].contains(&stem) || STAGES.iter().any(|s| s.0 == stem),
                 "shaders/{name} is not listed in STAGES"
             );
         }
