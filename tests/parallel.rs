@@ -137,6 +137,72 @@ fn corner_attributes_of_the_upload_are_the_input_corners() {
     assert_eq!(seam_corners, 24 * 6);
 }
 
+/// The rounds' quadrics carry the greedy reference's seam constraint planes: on a flat grid
+/// with an L-shaped UV seam, sliding the corner of the L along one arm costs something, sliding
+/// a vertex along a straight stretch of the seam nothing (the face planes alone cost nothing on
+/// a flat grid).
+#[test]
+fn seam_bends_cost_to_slide_away() {
+    use meshslim::cpu::CpuRounds;
+    use meshslim::cpu::common::quadric_eval;
+    use meshslim::parallel::{SELECTION_PASSES, Upload};
+    let mut m = meshslim::mesh::grid(8);
+    let mut uvs: Vec<[f32; 2]> = m.positions.iter().map(|p| [p[0], p[1]]).collect();
+    // The lower-left quarter's faces take vertices of their own with shifted UVs: a seam along
+    // x = 0.5 below y = 0.5 and along y = 0.5 left of x = 0.5, bending at (0.5, 0.5).
+    for t in m.triangles.iter_mut() {
+        let c = t.iter().fold([0.0f32; 2], |c, &v| {
+            let p = m.positions[v as usize];
+            [c[0] + p[0] / 3.0, c[1] + p[1] / 3.0]
+        });
+        if c[0] < 0.5 && c[1] < 0.5 {
+            for v in t.iter_mut() {
+                let p = m.positions[*v as usize];
+                m.positions.push(p);
+                uvs.push([p[0] + 2.0, p[1]]);
+                *v = (m.positions.len() - 1) as u32;
+            }
+        }
+    }
+    m.uvs = Some(uvs);
+    let up = Upload::new(&m);
+    let opts = SimplifyOptions::with_ratio(m.triangles.len(), 0.5).unwrap();
+    let p = up.base_params(&opts);
+    let mut cpu = CpuRounds::new(&up, SELECTION_PASSES);
+    cpu.build_adjacency(&p);
+    cpu.setup(&p);
+    // Vertices by their grid position, through the upload's normalized frame.
+    let id = |x: f32, y: f32| {
+        let q = [0, 1].map(|i| (([x, y][i] as f64 - up.center[i]) * up.scale) as f32);
+        up.positions
+            .iter()
+            .position(|w| (w[0] - q[0]).abs() < 1e-6 && (w[1] - q[1]).abs() < 1e-6)
+            .expect("a grid vertex")
+    };
+    let cost = |v: usize, onto: usize| {
+        let (a, b) = (cpu.positions[v], cpu.positions[onto]);
+        quadric_eval(&cpu.quadrics[v], [b[0] - a[0], b[1] - a[1], b[2] - a[2]])
+    };
+    let corner = id(0.5, 0.5);
+    let straight = id(0.5, 0.25);
+    assert!(
+        up.flags[corner] != 0 && up.flags[straight] != 0,
+        "both on the seam"
+    );
+    // Along the seam from a straight stretch: free. Off the bend: the other arm's plane costs.
+    assert!(
+        cost(straight, id(0.5, 0.125)) < 1e-12,
+        "{}",
+        cost(straight, id(0.5, 0.125))
+    );
+    assert!(
+        // The arm's plane at distance e from the point, weighted |e|², e = 1/8 of the grid.
+        cost(corner, id(0.5, 0.375)) > 1e-6,
+        "{}",
+        cost(corner, id(0.5, 0.375))
+    );
+}
+
 /// The rounds thin a seam out like the greedy reference: seam vertices slide along it and free
 /// ones collapse onto it, so the seam does not pin the target away.
 #[test]

@@ -235,6 +235,7 @@ impl CpuRounds {
                 &s.vertex_faces,
                 &s.face_normals,
                 &mut s.quadrics,
+                &s.face_extra,
             )
         });
     }

@@ -1,13 +1,28 @@
 //! Twin of shaders/vertex_quadrics.wgsl (first round): each vertex gathers the area-weighted plane
 //! quadrics of its faces and, for each border edge at it, Hoppe's constraint plane through the
-//! edge perpendicular to its face, weighted by the squared edge length. A gather in the sorted
-//! face order, so the sums do not depend on thread timing. Quadrics are relative to the vertex.
+//! edge perpendicular to its face, weighted by the squared edge length; likewise for each
+//! attribute-seam edge (its two faces use different attribute vertices at an end), perpendicular
+//! to their mean normal, as the greedy reference does. A gather in the sorted face order, so the
+//! sums do not depend on thread timing. Quadrics are relative to the vertex.
 
 use super::common::{cross, dot, length, quadric_add, quadric_from_plane, scale, sub, xyz};
 use super::vertex_flags::count_containing;
 use super::{face_of, faces_of, par_for_mut};
-use crate::gpu::types::{Params, Quadric};
+use crate::gpu::types::{FaceExtra, Params, Quadric};
 
+/// The constraint plane through edge `e` (from the vertex) perpendicular to `surface`, weighted
+/// by the border weight and the squared edge length; zero when degenerate.
+fn edge_plane(params: &Params, e: [f32; 3], surface: [f32; 3]) -> Quadric {
+    let c = cross(e, surface);
+    let l = length(c);
+    if l > 0.0 {
+        quadric_from_plane(scale(c, 1.0 / l), 0.0, params.border_weight * dot(e, e))
+    } else {
+        Quadric::default()
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 pub fn vertex_quadrics(
     params: &Params,
     positions: &[[f32; 4]],    // per vertex
@@ -16,7 +31,13 @@ pub fn vertex_quadrics(
     vertex_faces: &[u32],      // per corner
     face_normals: &[[f32; 4]], // per face: unit normal, area
     quadrics: &mut [Quadric],  // per vertex
+    face_extra: &[FaceExtra],  // per face
 ) {
+    // The attribute vertex face `f` uses at its corner on `v` (shaders/seams.wgsl).
+    let corner_attr = |f: u32, v: u32| {
+        let t = face_of(indices, f);
+        face_extra[f as usize].attr[t.iter().position(|&u| u == v).unwrap_or(2)]
+    };
     par_for_mut(&mut quadrics[..params.vertex_count as usize], |v, out| {
         let pv = xyz(positions[v as usize]);
         let list = faces_of(offsets, vertex_faces, v);
@@ -31,14 +52,31 @@ pub fn vertex_quadrics(
             }
             if params.border_weight > 0.0 {
                 for u in t {
-                    if u != v && count_containing(indices, list, u) == 1 {
-                        let e = sub(xyz(positions[u as usize]), pv);
-                        let c = cross(e, xyz(fnrm));
-                        let l = length(c);
-                        if l > 0.0 {
-                            let w = params.border_weight * dot(e, e);
-                            q = quadric_add(&q, &quadric_from_plane(scale(c, 1.0 / l), 0.0, w));
+                    if u == v {
+                        continue;
+                    }
+                    let e = sub(xyz(positions[u as usize]), pv);
+                    match count_containing(indices, list, u) {
+                        1 => q = quadric_add(&q, &edge_plane(params, e, xyz(fnrm))),
+                        2 => {
+                            // Once per edge: from the first of its two faces in the (sorted)
+                            // list. In the first round every corner still has its input
+                            // attribute vertex.
+                            let g = list
+                                .iter()
+                                .copied()
+                                .find(|&g| g != f && face_of(indices, g).contains(&u))
+                                .unwrap_or(f);
+                            if g > f
+                                && (corner_attr(f, v) != corner_attr(g, v)
+                                    || corner_attr(f, u) != corner_attr(g, u))
+                            {
+                                let gn = xyz(face_normals[g as usize]);
+                                let avg = [fnrm[0] + gn[0], fnrm[1] + gn[1], fnrm[2] + gn[2]];
+                                q = quadric_add(&q, &edge_plane(params, e, avg));
+                            }
                         }
+                        _ => {}
                     }
                 }
             }

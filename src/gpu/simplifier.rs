@@ -687,7 +687,7 @@ impl RoundRunner for GpuRounds<'_> {
             self.pass(
                 &mut enc,
                 "vertex_quadrics",
-                &[&params, &pos, &idx, &offsets, &vf, &fnorm, &quad],
+                &[&params, &pos, &idx, &offsets, &vf, &fnorm, &quad, &fextra],
                 wg(nv),
             );
         }
