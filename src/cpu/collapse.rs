@@ -5,7 +5,7 @@
 //! checked. Winners share no face, hence no vertex, so these writes never meet.
 
 use super::common::{quadric_add, quadric_shift, sub, xyz};
-use super::{Scatter, face_of, faces_of, par_for};
+use super::{Scatter, corner_on, face_of, faces_of, par_for};
 use crate::gpu::types::{EdgeCandidate, FaceExtra, NO_ATTR, Params, Quadric, flag, state};
 
 /// The attribute vertex a corner of the removed vertex takes under map `m` (see [`NO_ATTR`]).
@@ -33,8 +33,7 @@ impl Corners<'_> {
     /// # Safety
     /// No other thread writes face `f` meanwhile.
     unsafe fn corner_attr(&self, f: u32, v: u32) -> u32 {
-        let t = face_of(self.indices, f);
-        let i = t.iter().position(|&u| u == v).unwrap_or(2);
+        let i = corner_on(self.indices, f, v);
         // SAFETY: the caller's.
         unsafe { self.face_extra.read(f as usize).attr[i] }
     }

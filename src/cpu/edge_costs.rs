@@ -8,7 +8,7 @@
 //! onto a seam neighbour (`collapse` makes the attribute map again from the same faces).
 
 use super::common::*;
-use super::{face_of, faces_of};
+use super::{corner_attr, face_of, faces_of};
 use crate::gpu::types::{
     Counters, EdgeCandidate, FaceExtra, HIST_SHIFT, NO_ATTR, Params, Quadric, flag, state,
 };
@@ -21,13 +21,6 @@ pub enum Verdict {
     /// Valid so far, but its error exceeds the maximum.
     OverMaxError,
     Candidate(EdgeCandidate),
-}
-
-/// The attribute vertex face `f` uses at its corner on vertex `v`.
-fn corner_attr(indices: &[u32], face_extra: &[FaceExtra], f: u32, v: u32) -> u32 {
-    let t = face_of(indices, f);
-    let i = t.iter().position(|&u| u == v).unwrap_or(2);
-    face_extra[f as usize].attr[i]
 }
 
 /// The faces and their attribute vertices, as the seam rules read them.

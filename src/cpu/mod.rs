@@ -57,6 +57,23 @@ pub fn face_of(indices: &[u32], f: u32) -> [u32; 3] {
     [indices[i], indices[i + 1], indices[i + 2]]
 }
 
+/// Which corner of face `f` is on vertex `v` (the last when none), as shaders/seams.wgsl's
+/// `corner_attr` picks it.
+#[inline]
+pub fn corner_on(indices: &[u32], f: u32, v: u32) -> usize {
+    face_of(indices, f)
+        .iter()
+        .position(|&u| u == v)
+        .unwrap_or(2)
+}
+
+/// Twin of shaders/seams.wgsl's `corner_attr`: the attribute vertex face `f` uses at its corner
+/// on vertex `v`.
+#[inline]
+pub fn corner_attr(indices: &[u32], face_extra: &[FaceExtra], f: u32, v: u32) -> u32 {
+    face_extra[f as usize].attr[corner_on(indices, f, v)]
+}
+
 /// A u32 buffer seen as atomics, as the shaders declare it `array<atomic<u32>>`.
 pub fn atomics(s: &mut [u32]) -> &[AtomicU32] {
     // SAFETY: AtomicU32 has the same size and bit validity as u32 and an alignment of 4, which

@@ -7,7 +7,7 @@
 
 use super::common::{cross, dot, length, quadric_add, quadric_from_plane, scale, sub, xyz};
 use super::vertex_flags::count_containing;
-use super::{face_of, faces_of, par_for_mut};
+use super::{corner_attr, face_of, faces_of, par_for_mut};
 use crate::gpu::types::{FaceExtra, Params, Quadric};
 
 /// The constraint plane through edge `e` (from the vertex) perpendicular to `surface`, weighted
@@ -33,11 +33,7 @@ pub fn vertex_quadrics(
     quadrics: &mut [Quadric],  // per vertex
     face_extra: &[FaceExtra],  // per face
 ) {
-    // The attribute vertex face `f` uses at its corner on `v` (shaders/seams.wgsl).
-    let corner_attr = |f: u32, v: u32| {
-        let t = face_of(indices, f);
-        face_extra[f as usize].attr[t.iter().position(|&u| u == v).unwrap_or(2)]
-    };
+    let corner_attr = |f: u32, v: u32| corner_attr(indices, face_extra, f, v);
     par_for_mut(&mut quadrics[..params.vertex_count as usize], |v, out| {
         let pv = xyz(positions[v as usize]);
         let list = faces_of(offsets, vertex_faces, v);
