@@ -1288,6 +1288,9 @@ const PARTITION_MIN_FACES: usize = 100_000;
 const REGION_FACES: usize = 32_768;
 /// Regions of the second level.
 const SECOND_LEVEL_REGIONS: usize = 4;
+/// Cost ceiling step between the epochs of a level whose floors keep it from reaching its
+/// stop (see [`partitioned_level`]); a few epochs still report progress.
+const UNSTOPPABLE_LEVEL_STEP: f32 = 64.0;
 
 /// The partitioned levels stop once the mesh is within 20% of the target.
 fn partitioned_stop(target: usize) -> usize {
@@ -1521,13 +1524,29 @@ fn partitioned_level(
         })
         .collect();
 
-    // Epochs of doubling cost ceilings, from far below the cheapest edge.
+    // Epochs of rising cost ceilings, from far below the cheapest edge.
     let stop_at = partitioned_stop(opts.target_faces);
     let total = |subs: &[Region]| {
         subs.iter()
             .map(|s| s.state.faces - s.own_cut)
             .sum::<usize>()
             + cut_faces
+    };
+    // The ceilings matter only for where the level stops: a region's collapses come in its own
+    // cost order whatever the ceilings, so a region that runs down to its floor ends the same.
+    // When the floors keep the level above `stop_at` (every level at 1%, the first at 10%),
+    // large steps give the same result in fewer epochs; each epoch walks through every
+    // region's data again from a cold cache. Measured on the 1M scan at 1%, same output: 1.35 s
+    // with doubling, 1.17 s with steps of 64.
+    let lowest = subs
+        .iter()
+        .map(|s| s.floor.saturating_sub(s.own_cut + 1))
+        .sum::<usize>()
+        + cut_faces;
+    let step = if lowest > stop_at {
+        UNSTOPPABLE_LEVEL_STEP
+    } else {
+        2.0
     };
     let mut ceiling = 1e-30f32;
     loop {
@@ -1545,7 +1564,7 @@ fn partitioned_level(
         {
             break;
         }
-        ceiling *= 2.0;
+        ceiling *= step;
     }
 
     // Write the regions back into the whole mesh: moved vertices, merged quadrics, live faces.
