@@ -149,8 +149,8 @@ impl Prepared {
                 .min()
                 .unwrap_or(0)
         });
-        let faces: Vec<[u32; 3]> = order.iter().map(|&f| faces[f as usize]).collect();
-        let face_origin: Vec<u32> = order.iter().map(|&f| face_origin[f as usize]).collect();
+        let faces: Vec<[u32; 3]> = order.par_iter().map(|&f| faces[f as usize]).collect();
+        let face_origin: Vec<u32> = order.par_iter().map(|&f| face_origin[f as usize]).collect();
 
         let (center, scale) = match mesh.bounds() {
             Some(b) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
@@ -158,7 +158,7 @@ impl Prepared {
             None => ([0.0; 3], 1.0),
         };
         let pos: Vec<[f64; 3]> = firsts
-            .iter()
+            .par_iter()
             .map(|&v| {
                 let p = mesh.positions[v as usize];
                 // Keep in step with `Prepared::normalize`.
@@ -420,8 +420,12 @@ impl Prepared {
 
 /// Indices `0..n` ordered by `key(i) < buckets`, stable (a counting sort), and where each
 /// bucket starts in that order (`buckets + 1` entries).
-fn counting_sort(buckets: usize, n: usize, key: impl Fn(usize) -> u32) -> (Vec<u32>, Vec<u32>) {
-    let keys: Vec<u32> = (0..n).map(&key).collect();
+fn counting_sort(
+    buckets: usize,
+    n: usize,
+    key: impl Fn(usize) -> u32 + Sync,
+) -> (Vec<u32>, Vec<u32>) {
+    let keys: Vec<u32> = (0..n).into_par_iter().map(&key).collect();
     let mut start = vec![0u32; buckets + 1];
     for &k in &keys {
         start[k as usize + 1] += 1;
@@ -482,6 +486,7 @@ pub(crate) fn spatial_order(
         part(q(0)) | (part(q(1)) << 1) | (part(q(2)) << 2)
     };
     let mut keyed: Vec<(u32, u32)> = (0..firsts.len() as u32)
+        .into_par_iter()
         .map(|c| (code(firsts[c as usize]), c))
         .collect();
     keyed.par_sort_unstable();
@@ -490,8 +495,8 @@ pub(crate) fn spatial_order(
     for (new, &old) in order.iter().enumerate() {
         rank[old as usize] = new as u32;
     }
-    let firsts = order.iter().map(|&old| firsts[old as usize]).collect();
-    (topo.into_iter().map(|t| rank[t as usize]).collect(), firsts)
+    let firsts = order.par_iter().map(|&old| firsts[old as usize]).collect();
+    (topo.par_iter().map(|&t| rank[t as usize]).collect(), firsts)
 }
 
 /// What [`State::evaluate_below`] found for an edge.
