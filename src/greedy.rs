@@ -1338,13 +1338,13 @@ pub fn simplify_greedy(
     let p = if regions > 1 && target < nf {
         let mut report = |faces: usize| progress((nf - faces) as f32 / need);
         let first = Cuts::first(p.pos.len(), regions);
-        let p = partitioned_level(p, opts, first, &mut levels, &mut report);
+        let p = partitioned_level(p, opts, first, None, &mut levels, &mut report);
         if p.faces.len() > partitioned_stop(target) && !opts.cancel.is_cancelled() {
             // The second level: fewer, larger regions, each cut half a first-level region
             // along the Morton order from a first-level cut, so the vertices the first level
             // had to pin are interior now and thin out with the rest.
             let second = first.second(SECOND_LEVEL_REGIONS);
-            partitioned_level(p, opts, second, &mut levels, &mut report)
+            partitioned_level(p, opts, second, None, &mut levels, &mut report)
         } else {
             p
         }
@@ -1434,11 +1434,13 @@ impl Cuts {
 }
 
 /// One partitioned level of [`simplify_greedy`], its regions as `cuts` says: returns the whole
-/// mesh, reduced, prepared for the next level or the final queue; adds to `stats`.
+/// mesh, reduced, prepared for the next level or the final queue; adds to `stats`. `step`
+/// overrides the factor between the epochs' cost ceilings (tests).
 fn partitioned_level(
     mut p: Prepared,
     opts: &SimplifyOptions,
     cuts: Cuts,
+    step: Option<f32>,
     stats: &mut LevelStats,
     progress: &mut dyn FnMut(usize),
 ) -> Prepared {
@@ -1548,11 +1550,11 @@ fn partitioned_level(
         .map(|s| s.floor.saturating_sub(s.own_cut + 1))
         .sum::<usize>()
         + cut_faces;
-    let step = if lowest > stop_at {
+    let step = step.unwrap_or(if lowest > stop_at {
         UNSTOPPABLE_LEVEL_STEP
     } else {
         2.0
-    };
+    });
     let mut ceiling = 1e-30f32;
     loop {
         let limit = ceiling.to_bits();
@@ -1703,6 +1705,32 @@ mod tests {
         lax.min_quality = 0.0;
         let (mut s, _) = State::new(Prepared::new(&m, &lax), &lax);
         assert!(s.evaluate(centre, folding).is_some());
+    }
+
+    /// A level that its floors keep above its stop ends the same whatever the steps between
+    /// its cost ceilings: each region takes its collapses in its own cost order down to its
+    /// floor. (This is what lets such a level take steps of 64 instead of doubling.)
+    #[test]
+    fn unstoppable_level_ignores_ceiling_steps() {
+        let m = crate::mesh::noisy_sphere(5, 0.002, 3);
+        let opts = SimplifyOptions::with_ratio(m.triangles.len(), 0.01).unwrap();
+        let level = |step| {
+            let p = Prepared::new(&m, &opts);
+            let cuts = Cuts::first(p.pos.len(), 8);
+            let mut stats = LevelStats::default();
+            let p = partitioned_level(p, &opts, cuts, Some(step), &mut stats, &mut |_| {});
+            (p.faces, p.pos, stats.collapses)
+        };
+        let doubling = level(2.0);
+        assert!(
+            doubling.0.len() > partitioned_stop(opts.target_faces),
+            "the floors should keep this level above its stop: {} faces",
+            doubling.0.len()
+        );
+        assert!(doubling.2 > 0, "the level collapsed nothing");
+        for step in [64.0, 1e30] {
+            assert!(level(step) == doubling, "steps of {step} changed the level");
+        }
     }
 
     /// The queue gives entries back in (key, a, b, stamp) order across buckets and within one,
