@@ -61,7 +61,12 @@ pub fn select_cost(
         }
         let inv = !c.cost_bits;
         for f in around(offsets, vertex_faces, edges[e]) {
-            face_best[f as usize].fetch_max(inv, Relaxed);
+            // The atomic read-modify-write only where it can raise the value: max is
+            // idempotent, and most faces already hold a key at least as good.
+            let slot = &face_best[f as usize];
+            if slot.load(Relaxed) < inv {
+                slot.fetch_max(inv, Relaxed);
+            }
         }
     });
 }
@@ -91,8 +96,12 @@ pub fn select_id(
         {
             return;
         }
+        let rank = !tie_rank(e);
         for f in around(offsets, vertex_faces, edges[eu]) {
-            face_id[f as usize].fetch_max(!tie_rank(e), Relaxed);
+            let slot = &face_id[f as usize];
+            if slot.load(Relaxed) < rank {
+                slot.fetch_max(rank, Relaxed);
+            }
         }
     });
 }
