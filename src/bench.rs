@@ -134,6 +134,7 @@ fn with_meshopt(
         triangles: bytemuck::cast_slice(&out).to_vec(),
         normals: mesh.normals.clone(),
         uvs: mesh.uvs.clone(),
+        uv_origin: mesh.uv_origin,
         colors: mesh.colors.clone(),
         ..Default::default()
     };

@@ -44,7 +44,7 @@ pub mod simplify;
 pub mod viewer;
 
 pub use error::{Error, Location, Result};
-pub use mesh::{Aabb, Material, Mesh};
+pub use mesh::{Aabb, Material, Mesh, UvOrigin};
 pub use simplify::{
     Backend, SimplifyOptions, SimplifyReport, StopReason, simplify, simplify_with_progress,
 };

@@ -6,7 +6,7 @@ use std::cell::Cell;
 use std::path::{Path, PathBuf};
 
 use meshslim::io::{self, Format, WriteOptions};
-use meshslim::{Material, Mesh};
+use meshslim::{Material, Mesh, UvOrigin};
 
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
@@ -283,6 +283,9 @@ fn gltf_round_trips() {
     let full = full_mesh();
     let mut no_libs = full.clone();
     no_libs.material_libs.clear();
+    // UVs as glTF counts them come back bit for bit (a mesh read from OBJ or PLY has them
+    // converted: `uvs_convert_between_formats`).
+    no_libs.uv_origin = UvOrigin::TopLeft;
     let geo = geometry_only(&full);
     let mut one_group = geo.clone();
     one_group.groups = vec!["solo".into()];
@@ -299,6 +302,51 @@ fn gltf_round_trips() {
     assert!(glb.starts_with(b"glTF"));
     let gltf = std::fs::read_to_string(dir.path().join("m0.gltf")).unwrap();
     assert!(gltf.contains("data:application/octet-stream;base64,"));
+}
+
+/// OBJ and PLY count UVs from the texture's bottom-left corner, glTF from its top-left: a mesh
+/// converted from one to the other keeps its texture the right way up (v → 1 − v), and comes
+/// back to the UVs it started with.
+#[test]
+fn uvs_convert_between_formats() {
+    let dir = tmp();
+    // v values whose 1 − v is exact in f32, so the comparisons can be exact.
+    let uvs = vec![
+        [0.1, 0.0],
+        [0.2, 0.25],
+        [0.3, 0.5],
+        [0.4, 0.75],
+        [0.5, 1.0],
+        [0.6, 0.125],
+    ];
+    let flipped: Vec<[f32; 2]> = uvs.iter().map(|&[u, v]| [u, 1.0 - v]).collect();
+    for from in ["obj", "ply"] {
+        let mut m = geometry_only(&full_mesh());
+        m.uvs = Some(uvs.clone());
+        let src = dir.path().join(format!("src.{from}"));
+        io::write(&src, &m).unwrap();
+        let read = io::read(&src).unwrap();
+        assert_eq!(read.uv_origin, UvOrigin::BottomLeft, "{from}");
+        assert_eq!(read.uvs.as_ref().unwrap(), &uvs, "{from}");
+        for ext in ["gltf", "glb"] {
+            let path = dir.path().join(format!("{from}.{ext}"));
+            io::write(&path, &read).unwrap();
+            // The reader takes TEXCOORD_0 as the file has it.
+            let g = io::read(&path).unwrap();
+            assert_eq!(g.uv_origin, UvOrigin::TopLeft, "{from} -> {ext}");
+            assert_eq!(g.uvs.as_ref().unwrap(), &flipped, "{from} -> {ext}");
+            for back_ext in ["obj", "ply"] {
+                let back = dir.path().join(format!("{from}-{ext}.{back_ext}"));
+                io::write(&back, &g).unwrap();
+                let b = io::read(&back).unwrap();
+                assert_eq!(
+                    b.uvs.as_ref().unwrap(),
+                    &uvs,
+                    "{from} -> {ext} -> {back_ext}"
+                );
+            }
+        }
+    }
 }
 
 #[test]

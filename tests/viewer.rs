@@ -5,6 +5,7 @@
 mod common;
 
 use common::*;
+use meshslim::UvOrigin;
 use meshslim::viewer::{Mode, Model, Style, screenshot};
 use resvg::tiny_skia::Pixmap;
 
@@ -111,6 +112,55 @@ fn spherical_uvs(p: &[[f32; 3]]) -> Vec<[f32; 2]> {
             ]
         })
         .collect()
+}
+
+/// glTF counts UVs from the texture's top-left corner, OBJ from its bottom-left: the same
+/// surface with its UVs stored either way draws the same picture, and the picture shows a flip.
+#[test]
+fn uv_origin_keeps_the_texture_upright() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let sphere = meshslim::mesh::noisy_sphere(3, 0.0, 1);
+    // On a 1/64 grid, so that 1 - v is exact and both ways give the same bits.
+    let uvs: Vec<[f32; 2]> = spherical_uvs(&sphere.positions)
+        .into_iter()
+        .map(|t| t.map(|x| (x * 64.0).round() / 64.0))
+        .collect();
+    let flipped: Vec<[f32; 2]> = uvs.iter().map(|&[u, v]| [u, 1.0 - v]).collect();
+    // Red above, white below: upside down is another picture.
+    let n = 32u32;
+    let rgba = (0..n * n)
+        .flat_map(|i| {
+            if i / n < n / 2 {
+                [220, 40, 40, 255]
+            } else {
+                [250; 4]
+            }
+        })
+        .collect();
+    let texture = meshslim::viewer::scene::Image { rgba, size: (n, n) };
+    let draw = |uvs: &[[f32; 2]], origin| {
+        let mut m = sphere.clone();
+        m.uvs = Some(uvs.to_vec());
+        m.uv_origin = origin;
+        let mut model = Model::from_mesh("sphere".into(), m).unwrap();
+        model.texture = Some(texture.clone());
+        let style = Style {
+            mode: Mode::Texture,
+            ..Style::default()
+        };
+        screenshot(&model, 1.0, style, (96, 72)).unwrap().png
+    };
+    let upright = draw(&uvs, UvOrigin::BottomLeft);
+    assert!(
+        draw(&flipped, UvOrigin::TopLeft) == upright,
+        "top-left UVs drew another picture"
+    );
+    assert!(
+        draw(&flipped, UvOrigin::BottomLeft) != upright,
+        "a flipped texture drew the same picture: the test cannot see a flip"
+    );
 }
 
 /// A red and white checkerboard.

@@ -10,7 +10,9 @@
 //! with no scene at all, every mesh once, untransformed), with the node transforms applied
 //! (normals by the inverse transpose; winding flipped under a mirroring transform). Attributes:
 //! `POSITION`, `NORMAL`, `TEXCOORD_0`, `COLOR_0` (float or normalised integers), indices u8/u16/u32
-//! or none. Primitives that share attribute accessors under the same transform share vertices.
+//! or none. UVs are kept as glTF counts them, from the image's top-left corner
+//! (`Mesh::uv_origin` = `TopLeft`); the OBJ and PLY writers flip them, and this writer flips
+//! those read from OBJ or PLY. Primitives that share attribute accessors under the same transform share vertices.
 //! Materials: every document material, by name (`material_N` when unnamed), plus `default` for
 //! primitives without one; `face_materials` is `None` when the document has no materials. Groups:
 //! one per glTF mesh (`mesh_N` when unnamed); `face_groups` is `None` when only one unnamed mesh
@@ -29,7 +31,7 @@ use json::validation::Checked;
 use serde_json::{Value, json};
 
 use crate::error::{Error, Location, Result};
-use crate::mesh::{Material, Mesh};
+use crate::mesh::{Material, Mesh, UvOrigin};
 
 const GLB_MAGIC: &[u8; 4] = b"glTF";
 const CHUNK_JSON: u32 = 0x4E4F_534A;
@@ -523,6 +525,9 @@ fn build(doc: &Doc) -> Result<Mesh> {
     }
     mesh.normals = fill(out.normals, nv, [0.0; 3]);
     mesh.uvs = fill(out.uvs, nv, [0.0; 2]);
+    if mesh.uvs.is_some() {
+        mesh.uv_origin = UvOrigin::TopLeft;
+    }
     mesh.colors = fill(out.colors, nv, [1.0; 4]);
     if !mesh.materials.is_empty() {
         mesh.face_materials = Some(out.face_materials);
@@ -790,7 +795,8 @@ fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
             );
             attrs.insert("NORMAL".into(), json!(i));
         }
-        if let Some(t) = &mesh.uvs {
+        // glTF counts UVs from the image's top-left corner.
+        if let Some(t) = mesh.uvs_from(UvOrigin::TopLeft) {
             let i = push_attr(
                 &mut bin,
                 &mut t.iter().flatten().copied(),

@@ -37,7 +37,7 @@ use std::io::{self, BufRead, BufReader, Write};
 use std::path::Path;
 
 use crate::error::{Error, Location, Result};
-use crate::mesh::{Material, Mesh};
+use crate::mesh::{Material, Mesh, UvOrigin};
 
 const NONE: u32 = u32::MAX;
 /// Tags a seam vertex number in `triangles` while parsing.
@@ -422,8 +422,9 @@ pub fn write_obj<W: Write>(w: &mut W, mesh: &Mesh) -> io::Result<()> {
             flush(&mut out, w)?;
         }
     }
-    if let Some(uvs) = &mesh.uvs {
-        for t in uvs {
+    // OBJ counts UVs from the image's bottom-left corner.
+    if let Some(uvs) = mesh.uvs_from(UvOrigin::BottomLeft) {
+        for t in uvs.iter() {
             let _ = writeln!(out, "vt {} {}", t[0], t[1]);
             if out.len() > 60_000 {
                 flush(&mut out, w)?;

@@ -38,7 +38,7 @@ use std::io::{self, BufRead, BufReader, Read, Write};
 use std::path::Path;
 
 use crate::error::{Error, Location, Result};
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, UvOrigin};
 
 /// Encoding of a PLY file body.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -883,6 +883,8 @@ fn colors_are_bytes(colors: &[[f32; 4]]) -> bool {
 /// Writes `mesh` as PLY in the given encoding.
 pub fn write_ply<W: Write>(w: &mut W, mesh: &Mesh, encoding: PlyEncoding) -> io::Result<()> {
     let nv = mesh.positions.len();
+    // PLY's u, v follow OBJ's convention (the tools that write them: MeshLab, Blender).
+    let uvs = mesh.uvs_from(UvOrigin::BottomLeft);
     let byte_colors = mesh.colors.as_deref().is_some_and(colors_are_bytes);
     let idx_type = if nv > i32::MAX as usize {
         "uint"
@@ -934,7 +936,7 @@ pub fn write_ply<W: Write>(w: &mut W, mesh: &Mesh, encoding: PlyEncoding) -> io:
                     }
                 }
             }
-            if let Some(t) = &mesh.uvs {
+            if let Some(t) = &uvs {
                 let _ = write!(line, " {} {}", t[i][0], t[i][1]);
             }
             line.push('\n');
@@ -975,7 +977,7 @@ pub fn write_ply<W: Write>(w: &mut W, mesh: &Mesh, encoding: PlyEncoding) -> io:
                 }
             }
         }
-        if let Some(t) = &mesh.uvs {
+        if let Some(t) = &uvs {
             put!(t[i][0]);
             put!(t[i][1]);
         }

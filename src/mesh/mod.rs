@@ -31,6 +31,11 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
     pub normals: Option<Vec<[f32; 3]>>,
     pub uvs: Option<Vec<[f32; 2]>>,
+    /// Which corner of the texture image `uvs` count from, as the file they came from does:
+    /// kept as read, so a mesh written back in its own format has the same UVs bit for bit,
+    /// and converted (v → 1 − v) only when it is written in a format of the other convention.
+    /// The default (`BottomLeft`) when there are no UVs.
+    pub uv_origin: UvOrigin,
     /// Linear RGBA in 0..=1.
     pub colors: Option<Vec<[f32; 4]>>,
     /// Per-face index into `materials`.
@@ -41,6 +46,16 @@ pub struct Mesh {
     /// Per-face index into `groups` (OBJ `o`/`g`, glTF meshes).
     pub face_groups: Option<Vec<u32>>,
     pub groups: Vec<String>,
+}
+
+/// Where UV (0, 0) is in the texture image.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum UvOrigin {
+    /// OBJ, PLY (and OpenGL): the bottom-left corner, v grows upwards.
+    #[default]
+    BottomLeft,
+    /// glTF (and Vulkan, DirectX, Metal images): the top-left corner, v grows downwards.
+    TopLeft,
 }
 
 /// Axis-aligned bounding box.
@@ -84,6 +99,21 @@ impl Mesh {
             triangles,
             ..Default::default()
         }
+    }
+
+    /// The UVs counted from `origin`: borrowed when that is how they are stored, else flipped
+    /// (v → 1 − v, in f64 so that 1 − v rounds once).
+    pub fn uvs_from(&self, origin: UvOrigin) -> Option<std::borrow::Cow<'_, [[f32; 2]]>> {
+        let uvs = self.uvs.as_deref()?;
+        Some(if origin == self.uv_origin {
+            std::borrow::Cow::Borrowed(uvs)
+        } else {
+            std::borrow::Cow::Owned(
+                uvs.iter()
+                    .map(|&[u, v]| [u, (1.0 - v as f64) as f32])
+                    .collect(),
+            )
+        })
     }
 
     pub fn vertex_count(&self) -> usize {

@@ -98,6 +98,7 @@ impl Mesh {
             triangles: Vec::new(),
             normals: None,
             uvs: None,
+            uv_origin: self.uv_origin,
             colors: None,
             face_materials: self.face_materials.clone(),
             materials: self.materials.clone(),

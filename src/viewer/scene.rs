@@ -5,7 +5,7 @@
 use super::render::{Extras, SceneMesh, vertex_normals};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuMesh, GpuRounds, GpuSimplifier};
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, UvOrigin};
 use crate::metrics::{CompareOptions, TriangleBvh, compare};
 use crate::parallel::{
     Driver, RoundRunner, RoundsReport, SELECTION_PASSES, Upload, corner_attributes,
@@ -145,9 +145,10 @@ impl Model {
 }
 
 /// Each corner's UV: that of its attribute vertex (see [`corner_attributes`]), so a seam
-/// vertex shows each side's own.
+/// vertex shows each side's own. Counted from the image's bottom-left corner, as the shader
+/// samples them (glTF's are flipped here).
 fn corner_uvs(up: &Upload, corner_attr: &[u32]) -> Option<Vec<[f32; 2]>> {
-    let uv = up.welded.uvs.as_ref()?;
+    let uv = up.welded.uvs_from(UvOrigin::BottomLeft)?;
     Some(corner_attr.iter().map(|&a| uv[a as usize]).collect())
 }
 
@@ -311,8 +312,7 @@ pub fn simplify(
                 model.up.scale,
             )?;
             let uvs = mesh
-                .uvs
-                .as_ref()
+                .uvs_from(UvOrigin::BottomLeft)
                 .map(|uv| indices.iter().map(|&v| uv[v as usize]).collect());
             (gpu, positions, indices, mesh, report, uvs)
         }
