@@ -90,12 +90,7 @@ fn full_mesh() -> Mesh {
     ]);
     m.groups = vec!["top".into(), "bottom".into()];
     m.face_groups = Some(vec![0, 0, 0, 0, 1, 1, 1, 1]);
-    m.materials = vec![
-        Material { name: "red".into() },
-        Material {
-            name: "blue".into(),
-        },
-    ];
+    m.materials = vec![Material::named("red"), Material::named("blue")];
     m.face_materials = Some(vec![0, 0, 1, 1, 0, 0, 1, 1]);
     m.material_libs = vec!["scene.mtl".into()];
     m
@@ -346,6 +341,92 @@ fn uvs_convert_between_formats() {
                 );
             }
         }
+    }
+}
+
+/// A textured glTF scan stays textured: materials (PBR factors, texture references,
+/// extensions), textures, samplers and images come through reading, simplifying and writing
+/// as .gltf or .glb; an image the file names by URI is read and embedded, and extensions the
+/// carried objects do not use are not declared again.
+#[test]
+fn gltf_textures_survive_simplification() {
+    let dir = tmp();
+    let mut m = meshslim::mesh::noisy_sphere(3, 0.001, 2);
+    m.uvs = Some(
+        m.positions
+            .iter()
+            .map(|p| [0.5 + 0.5 * p[0], 0.5 + 0.5 * p[1]])
+            .collect(),
+    );
+    let path = dir.path().join("scan.gltf");
+    io::write(&path, &m).unwrap();
+    // A real PNG beside the file, named by URI.
+    let png_path = dir.path().join("albedo.png");
+    image::RgbaImage::from_pixel(4, 2, image::Rgba([200, 100, 50, 255]))
+        .save(&png_path)
+        .unwrap();
+    let png = std::fs::read(&png_path).unwrap();
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let material = serde_json::json!({
+        "name": "skin",
+        "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0.0},
+        "doubleSided": true,
+        "extensions": {"KHR_materials_unlit": {}}
+    });
+    doc["materials"] = serde_json::json!([material]);
+    doc["meshes"][0]["primitives"][0]["material"] = serde_json::json!(0);
+    doc["textures"] = serde_json::json!([{"source": 0, "sampler": 0}]);
+    doc["samplers"] = serde_json::json!([{"magFilter": 9729, "minFilter": 9987}]);
+    doc["images"] = serde_json::json!([{"uri": "albedo.png", "name": "albedo"}]);
+    doc["extensionsUsed"] = serde_json::json!(["KHR_materials_unlit", "EXT_not_carried"]);
+    std::fs::write(&path, serde_json::to_string(&doc).unwrap()).unwrap();
+
+    let read = io::read(&path).unwrap();
+    assert_eq!(read.materials.len(), 1);
+    assert_eq!(read.materials[0].name, "skin");
+    let mut definition = material.clone();
+    definition.as_object_mut().unwrap().remove("name");
+    assert_eq!(read.materials[0].gltf.as_ref(), Some(&definition));
+    let t = &read.textures;
+    assert_eq!(
+        t.textures,
+        vec![serde_json::json!({"source": 0, "sampler": 0})]
+    );
+    assert_eq!(t.samplers.len(), 1);
+    assert_eq!(t.images.len(), 1);
+    assert_eq!(
+        t.images[0].data.as_deref(),
+        Some(&png[..]),
+        "the URI's file is read"
+    );
+    assert_eq!(t.images[0].name.as_deref(), Some("albedo"));
+    assert_eq!(t.extensions_used, vec!["KHR_materials_unlit".to_string()]);
+
+    let opts = meshslim::SimplifyOptions::with_ratio(read.triangles.len(), 0.25).unwrap();
+    let (out, _) = meshslim::simplify(&read, &opts).unwrap();
+    assert!(out.triangles.len() < read.triangles.len());
+    assert_eq!(out.materials, read.materials);
+    assert_eq!(out.textures, read.textures);
+
+    // Written elsewhere: the image goes into the file, so nothing points back at albedo.png.
+    let away = tmp();
+    for ext in ["glb", "gltf"] {
+        let p = away.path().join(format!("small.{ext}"));
+        io::write(&p, &out).unwrap();
+        let back = io::read(&p).unwrap();
+        assert_eq!(back.materials, out.materials, "{ext}");
+        assert_eq!(back.textures.textures, out.textures.textures, "{ext}");
+        assert_eq!(back.textures.samplers, out.textures.samplers, "{ext}");
+        assert_eq!(
+            back.textures.extensions_used, out.textures.extensions_used,
+            "{ext}"
+        );
+        let img = &back.textures.images[0];
+        assert_eq!(img.data.as_deref(), Some(&png[..]), "{ext}: image embedded");
+        assert_eq!(img.mime_type.as_deref(), Some("image/png"), "{ext}");
+        assert_eq!(img.uri, None, "{ext}");
+        assert_eq!(back.triangles.len(), out.triangles.len(), "{ext}");
     }
 }
 

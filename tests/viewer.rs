@@ -163,6 +163,41 @@ fn uv_origin_keeps_the_texture_upright() {
     );
 }
 
+/// A glTF scan's material names its base colour texture, embedded in the file: the viewer
+/// shows that image (no GPU needed to find and decode it).
+#[test]
+fn gltf_base_color_texture_is_found() {
+    use serde_json::json;
+    let dir = tempfile::tempdir().unwrap();
+    let mut m = meshslim::mesh::noisy_sphere(2, 0.0, 1);
+    m.uvs = Some(spherical_uvs(&m.positions));
+    m.uv_origin = UvOrigin::TopLeft;
+    let mut png = Vec::new();
+    image::RgbaImage::from_pixel(4, 2, image::Rgba([1, 2, 3, 255]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    m.materials = vec![meshslim::Material {
+        name: "skin".into(),
+        gltf: Some(json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}})),
+    }];
+    m.face_materials = Some(vec![0; m.triangles.len()]);
+    m.textures.textures = vec![json!({"source": 0})];
+    m.textures.images = vec![meshslim::mesh::TextureImage {
+        data: Some(png),
+        mime_type: Some("image/png".into()),
+        ..Default::default()
+    }];
+    let path = dir.path().join("scan.glb");
+    meshslim::io::write(&path, &m).unwrap();
+    let model = Model::open(&path, None).unwrap();
+    assert_eq!(model.texture_note, None);
+    let t = model
+        .texture
+        .expect("the base colour texture was not found");
+    assert_eq!(t.size, (4, 2));
+    assert_eq!(&t.rgba[..4], &[1, 2, 3, 255]);
+}
+
 /// A red and white checkerboard.
 fn checker(n: u32) -> meshslim::viewer::scene::Image {
     let mut rgba = Vec::new();

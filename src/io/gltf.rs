@@ -14,7 +14,11 @@
 //! (`Mesh::uv_origin` = `TopLeft`); the OBJ and PLY writers flip them, and this writer flips
 //! those read from OBJ or PLY. Primitives that share attribute accessors under the same transform share vertices.
 //! Materials: every document material, by name (`material_N` when unnamed), plus `default` for
-//! primitives without one; `face_materials` is `None` when the document has no materials. Groups:
+//! primitives without one; `face_materials` is `None` when the document has no materials. Each
+//! material's JSON (PBR factors, texture references, extensions), the textures, samplers and
+//! images are carried to the output unchanged (`Mesh::textures`), each image as bytes from its
+//! buffer view, data URI or file (written back embedded), so a textured scan comes out
+//! textured; the extensions they use stay declared. Groups:
 //! one per glTF mesh (`mesh_N` when unnamed); `face_groups` is `None` when only one unnamed mesh
 //! is drawn. Vertices missing an attribute another primitive has get zero (white for colours).
 //! Not supported (an error): sparse accessors, accessors without a buffer view.
@@ -31,7 +35,7 @@ use json::validation::Checked;
 use serde_json::{Value, json};
 
 use crate::error::{Error, Location, Result};
-use crate::mesh::{Material, Mesh, UvOrigin};
+use crate::mesh::{Material, Mesh, TextureImage, Textures, UvOrigin};
 
 const GLB_MAGIC: &[u8; 4] = b"glTF";
 const CHUNK_JSON: u32 = 0x4E4F_534A;
@@ -246,8 +250,38 @@ fn normal_matrix(m: &Mat) -> [[f64; 3]; 3] {
 
 struct Doc<'a> {
     root: json::Root,
+    /// Materials, textures, samplers and images as raw JSON: carried through unchanged
+    /// (`json::Root` drops the extensions it does not know).
+    carried: Carried,
     buffers: Vec<Vec<u8>>,
     path: &'a Path,
+}
+
+#[derive(serde::Deserialize, Default)]
+#[serde(default, rename_all = "camelCase")]
+struct Carried {
+    materials: Vec<Value>,
+    textures: Vec<Value>,
+    samplers: Vec<Value>,
+    images: Vec<Value>,
+    extensions_used: Vec<String>,
+    extensions_required: Vec<String>,
+}
+
+/// The names of the extensions `v` uses: the keys of every `extensions` object in it.
+fn extension_names(v: &Value, out: &mut std::collections::BTreeSet<String>) {
+    match v {
+        Value::Object(o) => {
+            for (k, x) in o {
+                if let ("extensions", Value::Object(e)) = (k.as_str(), x) {
+                    out.extend(e.keys().cloned());
+                }
+                extension_names(x, out);
+            }
+        }
+        Value::Array(a) => a.iter().for_each(|x| extension_names(x, out)),
+        _ => {}
+    }
 }
 
 impl Doc<'_> {
@@ -464,9 +498,12 @@ pub fn read(path: &Path) -> Result<Mesh> {
         };
         Error::parse(path, at, format!("invalid glTF JSON: {e}"))
     })?;
+    let carried: Carried = serde_json::from_slice(json_bytes)
+        .map_err(|e| Error::parse(path, Location::Unknown, format!("invalid glTF JSON: {e}")))?;
     let buffers = load_buffers(&root, blob, path)?;
     let doc = Doc {
         root,
+        carried,
         buffers,
         path,
     };
@@ -486,6 +523,90 @@ struct Out {
     groups_used: Vec<usize>,
 }
 
+/// A glTF material object without its name (that is `Material::name`); `None` when nothing else
+/// is left, as for a material written from an OBJ's `usemtl` name.
+fn material_definition(v: &Value) -> Option<Value> {
+    let mut o = v.as_object()?.clone();
+    o.remove("name");
+    (!o.is_empty()).then_some(Value::Object(o))
+}
+
+/// The document's textures, samplers and images, each image's bytes read from its buffer view,
+/// data URI or file. An image file that cannot be read keeps its URI alone: the mesh is still
+/// worth simplifying, and the URI is written back as it was.
+fn textures(doc: &Doc) -> Result<Textures> {
+    let c = &doc.carried;
+    let mut images = Vec::with_capacity(c.images.len());
+    for (i, img) in c.images.iter().enumerate() {
+        let what = format!("image {i}");
+        let text = |k: &str| img.get(k).and_then(Value::as_str).map(str::to_string);
+        let uri = text("uri");
+        let data = if let Some(v) = img.get("bufferView") {
+            let view = v
+                .as_u64()
+                .and_then(|v| doc.root.buffer_views.get(v as usize))
+                .ok_or_else(|| doc.err(format!("{what}: buffer view {v} does not exist")))?;
+            let buffer = doc
+                .buffers
+                .get(view.buffer.value())
+                .ok_or_else(|| doc.err(format!("{what}: its buffer does not exist")))?;
+            let start = view.byte_offset.map_or(0, |o| o.0) as usize;
+            let bytes = start
+                .checked_add(view.byte_length.0 as usize)
+                .and_then(|end| buffer.get(start..end))
+                .ok_or_else(|| doc.err(format!("{what}: its buffer view runs past its buffer")))?;
+            Some(bytes.to_vec())
+        } else {
+            match &uri {
+                Some(u) if u.starts_with("data:") => Some(
+                    u.split_once(";base64,")
+                        .and_then(|(_, b)| base64_decode(b))
+                        .ok_or_else(|| doc.err(format!("{what}: invalid base64 data URI")))?,
+                ),
+                Some(u) if !u.contains("://") => {
+                    let rel = String::from_utf8_lossy(&percent_decode(u)).into_owned();
+                    std::fs::read(doc.path.parent().unwrap_or(Path::new(".")).join(rel)).ok()
+                }
+                _ => None,
+            }
+        };
+        images.push(TextureImage {
+            name: text("name"),
+            mime_type: text("mimeType"),
+            // An embedded image is written back embedded; a data URI too, as bytes.
+            uri: uri.filter(|u| data.is_none() && !u.starts_with("data:")),
+            data,
+        });
+    }
+    let mut used = std::collections::BTreeSet::new();
+    for v in c
+        .materials
+        .iter()
+        .chain(&c.textures)
+        .chain(&c.samplers)
+        .chain(&c.images)
+    {
+        extension_names(v, &mut used);
+    }
+    Ok(Textures {
+        textures: c.textures.clone(),
+        samplers: c.samplers.clone(),
+        images,
+        extensions_used: c
+            .extensions_used
+            .iter()
+            .filter(|e| used.contains(*e))
+            .cloned()
+            .collect(),
+        extensions_required: c
+            .extensions_required
+            .iter()
+            .filter(|e| used.contains(*e))
+            .cloned()
+            .collect(),
+    })
+}
+
 fn build(doc: &Doc) -> Result<Mesh> {
     let root = &doc.root;
     let mut out = Out::default();
@@ -495,8 +616,10 @@ fn build(doc: &Doc) -> Result<Mesh> {
         .enumerate()
         .map(|(i, m)| Material {
             name: m.name.clone().unwrap_or_else(|| format!("material_{i}")),
+            gltf: doc.carried.materials.get(i).and_then(material_definition),
         })
         .collect();
+    out.mesh.textures = textures(doc)?;
     let scene = root
         .scene
         .as_ref()
@@ -730,9 +853,7 @@ fn add_mesh(doc: &Doc, mi: usize, m: &Mat, out: &mut Out) -> Result<()> {
             }
             None if doc.root.materials.is_empty() => 0,
             None => *out.default_material.get_or_insert_with(|| {
-                out.mesh.materials.push(Material {
-                    name: "default".into(),
-                });
+                out.mesh.materials.push(Material::named("default"));
                 out.mesh.materials.len() as u32 - 1
             }),
         };
@@ -882,11 +1003,77 @@ fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
         root["materials"] = Value::Array(
             mesh.materials
                 .iter()
-                .map(|m| json!({"name": m.name}))
+                .map(|m| match &m.gltf {
+                    Some(Value::Object(o)) => {
+                        let mut o = o.clone();
+                        o.insert("name".into(), json!(m.name));
+                        Value::Object(o)
+                    }
+                    _ => json!({"name": m.name}),
+                })
                 .collect(),
         );
     }
+    let t = &mesh.textures;
+    if !t.is_empty() {
+        let mut images = Vec::with_capacity(t.images.len());
+        for img in &t.images {
+            let mut out = serde_json::Map::new();
+            if let Some(n) = &img.name {
+                out.insert("name".into(), json!(n));
+            }
+            if let Some(data) = &img.data {
+                bin.resize(bin.len().next_multiple_of(4), 0);
+                let start = bin.len();
+                bin.extend_from_slice(data);
+                views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": data.len()}));
+                out.insert("bufferView".into(), json!(views.len() - 1));
+                // A buffer view image must name its type.
+                let mime = img
+                    .mime_type
+                    .clone()
+                    .unwrap_or_else(|| sniff_mime(data).into());
+                out.insert("mimeType".into(), json!(mime));
+            } else if let Some(uri) = &img.uri {
+                out.insert("uri".into(), json!(uri));
+                if let Some(m) = &img.mime_type {
+                    out.insert("mimeType".into(), json!(m));
+                }
+            }
+            images.push(Value::Object(out));
+        }
+        root["bufferViews"] = json!(views);
+        for (key, list) in [("textures", &t.textures), ("samplers", &t.samplers)] {
+            if !list.is_empty() {
+                root[key] = json!(list);
+            }
+        }
+        if !images.is_empty() {
+            root["images"] = json!(images);
+        }
+        for (key, list) in [
+            ("extensionsUsed", &t.extensions_used),
+            ("extensionsRequired", &t.extensions_required),
+        ] {
+            if !list.is_empty() {
+                root[key] = json!(list);
+            }
+        }
+    }
     (root, bin)
+}
+
+/// The MIME type of an encoded image, from its first bytes.
+fn sniff_mime(data: &[u8]) -> &'static str {
+    if data.starts_with(b"\x89PNG") {
+        "image/png"
+    } else if data.starts_with(&[0xFF, 0xD8]) {
+        "image/jpeg"
+    } else if data.len() >= 12 && &data[..4] == b"RIFF" && &data[8..12] == b"WEBP" {
+        "image/webp"
+    } else {
+        "application/octet-stream"
+    }
 }
 
 /// Writes `.gltf` (JSON with the buffer as a base64 data URI) or, with `binary`, `.glb`.

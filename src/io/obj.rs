@@ -357,11 +357,7 @@ fn read_from(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
                 .map(|m| if m == NONE { d } else { m })
                 .collect(),
         );
-        mesh.materials = materials
-            .list
-            .into_iter()
-            .map(|name| Material { name })
-            .collect();
+        mesh.materials = materials.list.into_iter().map(Material::named).collect();
     }
     mesh.material_libs = libs;
     Ok(mesh)

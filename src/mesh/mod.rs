@@ -14,10 +14,55 @@ pub use weld::{WeldResult, weld, weld_positions};
 
 use crate::error::{Error, Result};
 
-/// A named material, as OBJ `usemtl`/glTF materials name them. `library` is the OBJ `mtllib`.
+/// A named material, as OBJ `usemtl`/glTF materials name them.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Material {
     pub name: String,
+    /// The glTF material object as read, but for its name (PBR factors, texture references
+    /// into [`Mesh::textures`], alpha mode, extensions), written back as it was; `None` for
+    /// materials from OBJ (whose definitions stay in the `mtllib` file) and glTF materials that
+    /// are only a name.
+    pub gltf: Option<serde_json::Value>,
+}
+
+impl Material {
+    pub fn named(name: impl Into<String>) -> Material {
+        Material {
+            name: name.into(),
+            gltf: None,
+        }
+    }
+}
+
+/// The textures glTF materials refer to, carried through simplification so that a textured
+/// scan comes out textured.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Textures {
+    /// glTF `textures` entries as read: `source` and `sampler` index the lists below.
+    pub textures: Vec<serde_json::Value>,
+    /// glTF `samplers` entries as read.
+    pub samplers: Vec<serde_json::Value>,
+    pub images: Vec<TextureImage>,
+    /// The glTF extensions the carried objects use, and those of them the file required.
+    pub extensions_used: Vec<String>,
+    pub extensions_required: Vec<String>,
+}
+
+impl Textures {
+    pub fn is_empty(&self) -> bool {
+        self.textures.is_empty() && self.samplers.is_empty() && self.images.is_empty()
+    }
+}
+
+/// One texture image: its encoded bytes (PNG, JPEG, ...), embedded in the file or read from
+/// the file its URI names; or, when that file could not be read, the URI alone.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TextureImage {
+    pub name: Option<String>,
+    pub mime_type: Option<String>,
+    pub data: Option<Vec<u8>>,
+    /// The URI as the file gave it (none for an image embedded in a buffer view).
+    pub uri: Option<String>,
 }
 
 /// An indexed triangle mesh.
@@ -46,6 +91,8 @@ pub struct Mesh {
     /// Per-face index into `groups` (OBJ `o`/`g`, glTF meshes).
     pub face_groups: Option<Vec<u32>>,
     pub groups: Vec<String>,
+    /// Textures the materials use (glTF).
+    pub textures: Textures,
 }
 
 /// Where UV (0, 0) is in the texture image.

@@ -105,6 +105,7 @@ impl Mesh {
             material_libs: self.material_libs.clone(),
             face_groups: self.face_groups.clone(),
             groups: self.groups.clone(),
+            textures: self.textures.clone(),
         }
     }
 }

@@ -152,9 +152,12 @@ fn corner_uvs(up: &Upload, corner_attr: &[u32]) -> Option<Vec<[f32; 2]>> {
     Some(corner_attr.iter().map(|&a| uv[a as usize]).collect())
 }
 
-/// The first material library's first `map_Kd`, read as PNG; a note when one is named but
-/// unusable (the texture mode says why it is off).
+/// A glTF material's base colour texture, else the first material library's first `map_Kd`;
+/// a note when one is named but unusable (the texture mode says why it is off).
 fn find_texture(path: &Path, mesh: &Mesh) -> (Option<Image>, Option<String>) {
+    if let Some(found) = gltf_base_color(path, mesh) {
+        return found;
+    }
     // A bare file name has the empty path as its parent: the current folder.
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
@@ -224,15 +227,51 @@ pub fn read_texture(path: &Path) -> Result<Image> {
         path: path.to_path_buf(),
         source: e,
     })?;
-    let img = image::load_from_memory(&bytes).map_err(|e| Error::Parse {
+    decode_texture(&bytes).map_err(|message| Error::Parse {
         path: path.to_path_buf(),
         location: crate::error::Location::Unknown,
-        message: format!("not a readable PNG or JPEG: {e}"),
-    })?;
+        message,
+    })
+}
+
+fn decode_texture(bytes: &[u8]) -> std::result::Result<Image, String> {
+    let img =
+        image::load_from_memory(bytes).map_err(|e| format!("not a readable PNG or JPEG: {e}"))?;
     let rgba = img.to_rgba8();
     Ok(Image {
         size: rgba.dimensions(),
         rgba: rgba.into_raw(),
+    })
+}
+
+/// The base colour texture of the first glTF material that has one, decoded; `None` when no
+/// material names one.
+fn gltf_base_color(path: &Path, mesh: &Mesh) -> Option<(Option<Image>, Option<String>)> {
+    let t = &mesh.textures;
+    let (i, image) = mesh
+        .materials
+        .iter()
+        .filter_map(|m| m.gltf.as_ref())
+        .find_map(|g| {
+            let ti = g
+                .pointer("/pbrMetallicRoughness/baseColorTexture/index")?
+                .as_u64()?;
+            let src = t.textures.get(ti as usize)?.get("source")?.as_u64()? as usize;
+            Some((src, t.images.get(src)?))
+        })?;
+    let note = |m: String| format!("{}: image {i}: {m}", path.display());
+    Some(match &image.data {
+        Some(bytes) => match decode_texture(bytes) {
+            Ok(img) => (Some(img), None),
+            Err(e) => (None, Some(note(e))),
+        },
+        None => (
+            None,
+            Some(note(format!(
+                "cannot read {}",
+                image.uri.as_deref().unwrap_or("its data")
+            ))),
+        ),
     })
 }
 
