@@ -894,6 +894,15 @@ fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     let simplify_s = t.elapsed().as_secs_f64();
     drop(mesh);
 
+    if let Ok(format) = crate::io::Format::from_path(&output) {
+        for lost in crate::io::not_kept(&simplified, format) {
+            say(format!(
+                "note: {} ({}) does not keep {lost}",
+                output.display(),
+                format.extension()
+            ));
+        }
+    }
     let t = Instant::now();
     progress
         .spinner(format!("writing {}", output.display()), || {

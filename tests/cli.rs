@@ -499,3 +499,49 @@ fn round_backends_report_rounds_and_stages() {
         stdout(&o)
     );
 }
+
+/// Writing a format that cannot hold part of the mesh says what is left behind (on stderr,
+/// not with -q), and writing one that keeps everything says nothing.
+#[test]
+fn writing_a_poorer_format_says_what_it_drops() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut m = meshslim::mesh::noisy_sphere(3, 0.001, 2);
+    m.uvs = Some(m.positions.iter().map(|p| [p[0], p[1]]).collect());
+    m.materials = vec![meshslim::Material {
+        name: "skin".into(),
+        gltf: Some(serde_json::json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}})),
+    }];
+    m.face_materials = Some(vec![0; m.triangles.len()]);
+    m.textures.textures = vec![serde_json::json!({"source": 0})];
+    m.textures.images = vec![meshslim::mesh::TextureImage {
+        data: Some(b"\x89PNG not really".to_vec()),
+        ..Default::default()
+    }];
+    meshslim::io::write(&dir.path().join("scan.glb"), &m).unwrap();
+    for (out, dropped) in [
+        (
+            "small.obj",
+            Some("the glTF material definitions and 1 texture image(s)"),
+        ),
+        ("small.ply", Some("the glTF material definitions")),
+        ("small.stl", Some("the UVs, materials")),
+        ("small.glb", None),
+    ] {
+        let o = meshslim(&["simplify", "scan.glb", out, "--ratio", "0.5"], dir.path());
+        expect_code(&o, 0);
+        let err = stderr(&o);
+        match dropped {
+            Some(what) => assert!(
+                err.contains(&format!("note: {out} (")) && err.contains(what),
+                "{out}: {err}"
+            ),
+            None => assert!(!err.contains("does not keep"), "{out}: {err}"),
+        }
+        let o = meshslim(
+            &["simplify", "scan.glb", out, "--ratio", "0.5", "-q"],
+            dir.path(),
+        );
+        expect_code(&o, 0);
+        assert!(!stderr(&o).contains("note:"), "-q: {}", stderr(&o));
+    }
+}

@@ -99,6 +99,56 @@ pub fn write(path: &Path, mesh: &Mesh) -> Result<()> {
     write_with(path, mesh, &WriteOptions::default())
 }
 
+/// What of `mesh` a file in `format` does not keep, one phrase each, for a note before writing
+/// (empty when it keeps everything the mesh has).
+pub fn not_kept(mesh: &Mesh, format: Format) -> Vec<String> {
+    let mut lost = Vec::new();
+    let gltf = matches!(format, Format::Gltf | Format::Glb);
+    let gltf_materials =
+        !mesh.textures.is_empty() || mesh.materials.iter().any(|m| m.gltf.is_some());
+    if gltf_materials && !gltf {
+        lost.push(format!(
+            "the glTF material definitions and {} texture image(s) (.glb and .gltf keep them)",
+            mesh.textures.images.len()
+        ));
+    }
+    if !mesh.material_libs.is_empty() && format != Format::Obj && format != Format::Stl {
+        lost.push(format!(
+            "the colours and textures of the OBJ material libraries ({}){}",
+            mesh.material_libs.join(", "),
+            if gltf {
+                ": glTF gets the material names"
+            } else {
+                ""
+            }
+        ));
+    }
+    let mut attrs: Vec<&str> = Vec::new();
+    if format == Format::Stl {
+        for (has, what) in [
+            (mesh.normals.is_some(), "normals"),
+            (mesh.uvs.is_some(), "UVs"),
+            (mesh.colors.is_some(), "colours"),
+        ] {
+            if has {
+                attrs.push(what);
+            }
+        }
+    }
+    if matches!(format, Format::Stl | Format::Ply) {
+        if mesh.face_materials.is_some() {
+            attrs.push("materials");
+        }
+        if mesh.face_groups.is_some() {
+            attrs.push("groups");
+        }
+    }
+    if !attrs.is_empty() {
+        lost.push(format!("the {}", attrs.join(", ")));
+    }
+    lost
+}
+
 /// Writes a mesh, the format chosen by the file extension.
 pub fn write_with(path: &Path, mesh: &Mesh, options: &WriteOptions) -> Result<()> {
     write_format(path, mesh, Format::from_path(path)?, options)
