@@ -514,7 +514,7 @@ fn writing_a_poorer_format_says_what_it_drops() {
     m.face_materials = Some(vec![0; m.triangles.len()]);
     m.textures.textures = vec![serde_json::json!({"source": 0})];
     m.textures.images = vec![meshslim::mesh::TextureImage {
-        data: Some(b"\x89PNG not really".to_vec()),
+        data: Some(b"\x89PNG not really".to_vec().into()),
         ..Default::default()
     }];
     meshslim::io::write(&dir.path().join("scan.glb"), &m).unwrap();

@@ -346,8 +346,8 @@ fn uvs_convert_between_formats() {
 
 /// A textured glTF scan stays textured: materials (PBR factors, texture references,
 /// extensions), textures, samplers and images come through reading, simplifying and writing
-/// as .gltf or .glb; an image the file names by URI is read and embedded, and extensions the
-/// carried objects do not use are not declared again.
+/// as .gltf or .glb; an image the file names by URI is read and embedded once however many
+/// images name it; every extension the written objects use is declared, and only those.
 #[test]
 fn gltf_textures_survive_simplification() {
     let dir = tmp();
@@ -360,9 +360,9 @@ fn gltf_textures_survive_simplification() {
     );
     let path = dir.path().join("scan.gltf");
     io::write(&path, &m).unwrap();
-    // A real PNG beside the file, named by URI.
+    // A real PNG beside the file, named by URI (twice).
     let png_path = dir.path().join("albedo.png");
-    image::RgbaImage::from_pixel(4, 2, image::Rgba([200, 100, 50, 255]))
+    image::RgbaImage::from_pixel(64, 64, image::Rgba([200, 100, 50, 255]))
         .save(&png_path)
         .unwrap();
     let png = std::fs::read(&png_path).unwrap();
@@ -372,36 +372,41 @@ fn gltf_textures_survive_simplification() {
         "name": "skin",
         "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0.0},
         "doubleSided": true,
-        "extensions": {"KHR_materials_unlit": {}}
     });
-    doc["materials"] = serde_json::json!([material]);
+    // A second material with no texture but an extension: still declared on output.
+    let unlit = serde_json::json!({"name": "flat", "extensions": {"KHR_materials_unlit": {}}});
+    doc["materials"] = serde_json::json!([material, unlit]);
     doc["meshes"][0]["primitives"][0]["material"] = serde_json::json!(0);
-    doc["textures"] = serde_json::json!([{"source": 0, "sampler": 0}]);
+    doc["textures"] = serde_json::json!([{"source": 0, "sampler": 0}, {"source": 1}]);
     doc["samplers"] = serde_json::json!([{"magFilter": 9729, "minFilter": 9987}]);
-    doc["images"] = serde_json::json!([{"uri": "albedo.png", "name": "albedo"}]);
+    doc["images"] = serde_json::json!([
+        {"uri": "albedo.png", "name": "albedo"},
+        {"uri": "./albedo.png"}
+    ]);
     doc["extensionsUsed"] = serde_json::json!(["KHR_materials_unlit", "EXT_not_carried"]);
     std::fs::write(&path, serde_json::to_string(&doc).unwrap()).unwrap();
 
     let read = io::read(&path).unwrap();
-    assert_eq!(read.materials.len(), 1);
+    assert_eq!(read.materials.len(), 2);
     assert_eq!(read.materials[0].name, "skin");
     let mut definition = material.clone();
     definition.as_object_mut().unwrap().remove("name");
     assert_eq!(read.materials[0].gltf.as_ref(), Some(&definition));
     let t = &read.textures;
-    assert_eq!(
-        t.textures,
-        vec![serde_json::json!({"source": 0, "sampler": 0})]
-    );
+    assert_eq!(t.textures.len(), 2);
     assert_eq!(t.samplers.len(), 1);
-    assert_eq!(t.images.len(), 1);
+    assert_eq!(t.images.len(), 2);
     assert_eq!(
         t.images[0].data.as_deref(),
         Some(&png[..]),
         "the URI's file is read"
     );
     assert_eq!(t.images[0].name.as_deref(), Some("albedo"));
-    assert_eq!(t.extensions_used, vec!["KHR_materials_unlit".to_string()]);
+    let (a, b) = (t.images[0].data.as_ref(), t.images[1].data.as_ref());
+    assert!(
+        std::sync::Arc::ptr_eq(a.unwrap(), b.unwrap()),
+        "one file, one copy"
+    );
 
     let opts = meshslim::SimplifyOptions::with_ratio(read.triangles.len(), 0.25).unwrap();
     let (out, _) = meshslim::simplify(&read, &opts).unwrap();
@@ -418,16 +423,96 @@ fn gltf_textures_survive_simplification() {
         assert_eq!(back.materials, out.materials, "{ext}");
         assert_eq!(back.textures.textures, out.textures.textures, "{ext}");
         assert_eq!(back.textures.samplers, out.textures.samplers, "{ext}");
-        assert_eq!(
-            back.textures.extensions_used, out.textures.extensions_used,
-            "{ext}"
-        );
-        let img = &back.textures.images[0];
-        assert_eq!(img.data.as_deref(), Some(&png[..]), "{ext}: image embedded");
-        assert_eq!(img.mime_type.as_deref(), Some("image/png"), "{ext}");
-        assert_eq!(img.uri, None, "{ext}");
+        for img in &back.textures.images {
+            assert_eq!(img.data.as_deref(), Some(&png[..]), "{ext}: image embedded");
+            assert_eq!(img.mime_type.as_deref(), Some("image/png"), "{ext}");
+            assert_eq!(img.uri, None, "{ext}");
+        }
         assert_eq!(back.triangles.len(), out.triangles.len(), "{ext}");
+        if ext == "gltf" {
+            let written: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+            assert_eq!(
+                written["extensionsUsed"],
+                serde_json::json!(["KHR_materials_unlit"])
+            );
+            assert_eq!(
+                written["images"][0]["bufferView"],
+                written["images"][1]["bufferView"]
+            );
+        }
     }
+}
+
+/// Images the reader cannot or must not read keep their URIs (a file outside the glTF's
+/// folder is not copied into the output); texture references on a second UV set, which the
+/// output would not have, are dropped from the written material; a bad image never fails the
+/// read of the geometry.
+#[test]
+fn gltf_images_outside_the_folder_and_other_uv_sets() {
+    let dir = tmp();
+    let sub = dir.path().join("scan");
+    std::fs::create_dir(&sub).unwrap();
+    std::fs::write(dir.path().join("secret.png"), b"\x89PNG secret").unwrap();
+    let mut m = geometry_only(&full_mesh());
+    m.uvs = full_mesh().uvs;
+    let path = sub.join("m.gltf");
+    io::write(&path, &m).unwrap();
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let abs = dir.path().join("secret.png").display().to_string();
+    doc["images"] = serde_json::json!([
+        {"uri": "../secret.png"},
+        {"uri": abs},
+        {"bufferView": 999},
+        {"uri": "missing.png"}
+    ]);
+    doc["textures"] = serde_json::json!([{"source": 0}, {"source": 2}, {"source": 3}]);
+    doc["materials"] = serde_json::json!([{
+        "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+        "occlusionTexture": {"index": 0, "texCoord": 1},
+        "emissiveTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": 1}}}
+    }]);
+    doc["meshes"][0]["primitives"][0]["material"] = serde_json::json!(0);
+    std::fs::write(&path, serde_json::to_string(&doc).unwrap()).unwrap();
+    let read = io::read(&path).unwrap();
+    assert_eq!(read.triangles.len(), m.triangles.len());
+    for (i, img) in read.textures.images.iter().enumerate() {
+        assert_eq!(img.data, None, "image {i} was read");
+    }
+    assert_eq!(
+        read.textures.images[0].uri.as_deref(),
+        Some("../secret.png")
+    );
+    let lost = io::not_kept(&read, io::Format::Glb);
+    assert!(
+        lost.iter()
+            .any(|l| l.contains("4 texture image(s) that could not be read")),
+        "{lost:?}"
+    );
+    assert!(lost.iter().any(|l| l.contains("second UV set")), "{lost:?}");
+
+    let out = dir.path().join("out.gltf");
+    io::write(&out, &read).unwrap();
+    let written: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let mat = &written["materials"][0];
+    assert!(mat.get("occlusionTexture").is_none(), "{mat}");
+    assert!(mat.get("emissiveTexture").is_none(), "{mat}");
+    assert_eq!(mat["pbrMetallicRoughness"]["baseColorTexture"]["index"], 0);
+    // Nothing embedded: the URIs as given, the secret's bytes nowhere.
+    for (i, img) in written["images"].as_array().unwrap().iter().enumerate() {
+        assert!(img.get("bufferView").is_none(), "image {i}: {img}");
+    }
+    assert_eq!(written["images"][0]["uri"], "../secret.png");
+    assert_eq!(written["images"][1]["uri"], serde_json::json!(abs));
+    // The image with neither bytes nor a URI is left out, and the textures follow.
+    assert_eq!(written["images"].as_array().unwrap().len(), 3);
+    assert_eq!(written["images"][2]["uri"], "missing.png");
+    assert_eq!(
+        written["textures"],
+        serde_json::json!([{"source": 0}, {}, {"source": 2}])
+    );
 }
 
 #[test]

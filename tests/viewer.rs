@@ -153,6 +153,23 @@ fn uv_origin_keeps_the_texture_upright() {
         screenshot(&model, 1.0, style, (96, 72)).unwrap().png
     };
     let upright = draw(&uvs, UvOrigin::BottomLeft);
+    // The sphere's UVs put v = 1 at its top (+y), the image's first rows are red, and
+    // bottom-left UVs sample row 0 at v = 1: the top of the drawn sphere is red, the bottom not.
+    let img = Pixmap::decode_png(&upright).unwrap();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let red_share = |rows: std::ops::Range<usize>| {
+        let px: Vec<&[u8]> = rows
+            .flat_map(|y| (0..w).map(move |x| (y * w + x) * 4))
+            .map(|i| &img.data()[i..i + 4])
+            .filter(|p| !is_background(p))
+            .collect();
+        px.iter().filter(|p| p[0] > 150 && p[1] < 120).count() as f64 / px.len().max(1) as f64
+    };
+    let (top, bottom) = (red_share(0..h / 2), red_share(h / 2..h));
+    assert!(
+        top > 0.5 && bottom < 0.5,
+        "red should be on top: {top:.2} of the upper half's pixels red, {bottom:.2} of the lower's"
+    );
     assert!(
         draw(&flipped, UvOrigin::TopLeft) == upright,
         "top-left UVs drew another picture"
@@ -183,7 +200,7 @@ fn gltf_base_color_texture_is_found() {
     m.face_materials = Some(vec![0; m.triangles.len()]);
     m.textures.textures = vec![json!({"source": 0})];
     m.textures.images = vec![meshslim::mesh::TextureImage {
-        data: Some(png),
+        data: Some(png.into()),
         mime_type: Some("image/png".into()),
         ..Default::default()
     }];

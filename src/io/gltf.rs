@@ -29,6 +29,7 @@
 
 use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use gltf::json;
 use json::validation::Checked;
@@ -264,7 +265,6 @@ struct Carried {
     textures: Vec<Value>,
     samplers: Vec<Value>,
     images: Vec<Value>,
-    extensions_used: Vec<String>,
     extensions_required: Vec<String>,
 }
 
@@ -532,79 +532,88 @@ fn material_definition(v: &Value) -> Option<Value> {
 }
 
 /// The document's textures, samplers and images, each image's bytes read from its buffer view,
-/// data URI or file. An image file that cannot be read keeps its URI alone: the mesh is still
-/// worth simplifying, and the URI is written back as it was.
-fn textures(doc: &Doc) -> Result<Textures> {
+/// data URI or file. An image that cannot be read (a missing file, a bad buffer view) keeps
+/// its URI alone: the mesh is still worth simplifying, and `io::not_kept` says so. Images that
+/// name the same buffer view or file share one copy of the bytes (so a small file cannot make
+/// the reader copy a large buffer many times), and a URI is read only as a path inside the
+/// glTF's folder: an absolute path or one climbing out with `..` would copy any file the user
+/// can read into the output.
+fn textures(doc: &Doc) -> Textures {
     let c = &doc.carried;
+    let dir = doc.path.parent().unwrap_or(Path::new("."));
+    let mut by_view: HashMap<usize, Option<Arc<[u8]>>> = HashMap::new();
+    let mut by_file: HashMap<std::path::PathBuf, Option<Arc<[u8]>>> = HashMap::new();
+    let view_bytes = |v: usize| -> Option<Arc<[u8]>> {
+        let view = doc.root.buffer_views.get(v)?;
+        let buffer = doc.buffers.get(view.buffer.value())?;
+        let start = usize::try_from(view.byte_offset.map_or(0, |o| o.0)).ok()?;
+        let len = usize::try_from(view.byte_length.0).ok()?;
+        let bytes = buffer.get(start..start.checked_add(len)?)?;
+        (!bytes.is_empty()).then(|| Arc::from(bytes))
+    };
     let mut images = Vec::with_capacity(c.images.len());
-    for (i, img) in c.images.iter().enumerate() {
-        let what = format!("image {i}");
+    for img in &c.images {
         let text = |k: &str| img.get(k).and_then(Value::as_str).map(str::to_string);
         let uri = text("uri");
+        let mut mime_type = text("mimeType");
         let data = if let Some(v) = img.get("bufferView") {
-            let view = v
-                .as_u64()
-                .and_then(|v| doc.root.buffer_views.get(v as usize))
-                .ok_or_else(|| doc.err(format!("{what}: buffer view {v} does not exist")))?;
-            let buffer = doc
-                .buffers
-                .get(view.buffer.value())
-                .ok_or_else(|| doc.err(format!("{what}: its buffer does not exist")))?;
-            let start = view.byte_offset.map_or(0, |o| o.0) as usize;
-            let bytes = start
-                .checked_add(view.byte_length.0 as usize)
-                .and_then(|end| buffer.get(start..end))
-                .ok_or_else(|| doc.err(format!("{what}: its buffer view runs past its buffer")))?;
-            Some(bytes.to_vec())
+            v.as_u64()
+                .and_then(|v| usize::try_from(v).ok())
+                .and_then(|v| by_view.entry(v).or_insert_with(|| view_bytes(v)).clone())
         } else {
             match &uri {
-                Some(u) if u.starts_with("data:") => Some(
-                    u.split_once(";base64,")
-                        .and_then(|(_, b)| base64_decode(b))
-                        .ok_or_else(|| doc.err(format!("{what}: invalid base64 data URI")))?,
-                ),
+                Some(u) if u.starts_with("data:") => {
+                    let (head, payload) = u.split_once(";base64,").unwrap_or((u, ""));
+                    if mime_type.is_none() {
+                        mime_type = Some(head.trim_start_matches("data:").to_string())
+                            .filter(|m| !m.is_empty());
+                    }
+                    base64_decode(payload)
+                        .filter(|b| !b.is_empty())
+                        .map(Arc::from)
+                }
                 Some(u) if !u.contains("://") => {
-                    let rel = String::from_utf8_lossy(&percent_decode(u)).into_owned();
-                    std::fs::read(doc.path.parent().unwrap_or(Path::new(".")).join(rel)).ok()
+                    let given = std::path::PathBuf::from(
+                        String::from_utf8_lossy(&percent_decode(u)).into_owned(),
+                    );
+                    use std::path::Component::{CurDir, Normal};
+                    let inside = given.components().all(|c| matches!(c, Normal(_) | CurDir));
+                    // `a.png` and `./a.png` are one file.
+                    let rel: std::path::PathBuf = given
+                        .components()
+                        .filter(|c| matches!(c, Normal(_)))
+                        .collect();
+                    inside
+                        .then(|| {
+                            by_file
+                                .entry(rel.clone())
+                                .or_insert_with(|| {
+                                    std::fs::read(dir.join(&rel))
+                                        .ok()
+                                        .filter(|b| !b.is_empty())
+                                        .map(Arc::from)
+                                })
+                                .clone()
+                        })
+                        .flatten()
                 }
                 _ => None,
             }
         };
         images.push(TextureImage {
             name: text("name"),
-            mime_type: text("mimeType"),
-            // An embedded image is written back embedded; a data URI too, as bytes.
+            mime_type,
+            // An image read is written back embedded; one that could not be keeps its URI.
             uri: uri.filter(|u| data.is_none() && !u.starts_with("data:")),
             data,
         });
     }
-    let mut used = std::collections::BTreeSet::new();
-    for v in c
-        .materials
-        .iter()
-        .chain(&c.textures)
-        .chain(&c.samplers)
-        .chain(&c.images)
-    {
-        extension_names(v, &mut used);
-    }
-    Ok(Textures {
+    Textures {
         textures: c.textures.clone(),
         samplers: c.samplers.clone(),
         images,
-        extensions_used: c
-            .extensions_used
-            .iter()
-            .filter(|e| used.contains(*e))
-            .cloned()
-            .collect(),
-        extensions_required: c
-            .extensions_required
-            .iter()
-            .filter(|e| used.contains(*e))
-            .cloned()
-            .collect(),
-    })
+        extensions_required: c.extensions_required.clone(),
+    }
 }
 
 fn build(doc: &Doc) -> Result<Mesh> {
@@ -619,7 +628,7 @@ fn build(doc: &Doc) -> Result<Mesh> {
             gltf: doc.carried.materials.get(i).and_then(material_definition),
         })
         .collect();
-    out.mesh.textures = textures(doc)?;
+    out.mesh.textures = textures(doc);
     let scene = root
         .scene
         .as_ref()
@@ -1005,9 +1014,10 @@ fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
                 .iter()
                 .map(|m| match &m.gltf {
                     Some(Value::Object(o)) => {
-                        let mut o = o.clone();
-                        o.insert("name".into(), json!(m.name));
-                        Value::Object(o)
+                        let mut o = Value::Object(o.clone());
+                        drop_other_uv_sets(&mut o);
+                        o["name"] = json!(m.name);
+                        o
                     }
                     _ => json!({"name": m.name}),
                 })
@@ -1017,18 +1027,31 @@ fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
     let t = &mesh.textures;
     if !t.is_empty() {
         let mut images = Vec::with_capacity(t.images.len());
+        // One buffer view per distinct image: images that shared bytes when read share them.
+        let mut written: HashMap<*const u8, usize> = HashMap::new();
+        // An image with neither bytes nor a URI (a bad buffer view in the input) cannot be
+        // written: it is left out and the textures' `source` indices follow.
+        let mut new_index = Vec::with_capacity(t.images.len());
         for img in &t.images {
+            if img.data.is_none() && img.uri.is_none() {
+                new_index.push(None);
+                continue;
+            }
+            new_index.push(Some(images.len()));
             let mut out = serde_json::Map::new();
             if let Some(n) = &img.name {
                 out.insert("name".into(), json!(n));
             }
             if let Some(data) = &img.data {
-                bin.resize(bin.len().next_multiple_of(4), 0);
-                let start = bin.len();
-                bin.extend_from_slice(data);
-                views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": data.len()}));
-                out.insert("bufferView".into(), json!(views.len() - 1));
-                // A buffer view image must name its type.
+                let view = *written.entry(data.as_ptr()).or_insert_with(|| {
+                    bin.resize(bin.len().next_multiple_of(4), 0);
+                    let start = bin.len();
+                    bin.extend_from_slice(data);
+                    views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": data.len()}));
+                    views.len() - 1
+                });
+                out.insert("bufferView".into(), json!(view));
+                // An image in a buffer view must name its type.
                 let mime = img
                     .mime_type
                     .clone()
@@ -1043,7 +1066,16 @@ fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
             images.push(Value::Object(out));
         }
         root["bufferViews"] = json!(views);
-        for (key, list) in [("textures", &t.textures), ("samplers", &t.samplers)] {
+        let textures: Vec<Value> = t
+            .textures
+            .iter()
+            .map(|tex| {
+                let mut tex = tex.clone();
+                remap_sources(&mut tex, &new_index);
+                tex
+            })
+            .collect();
+        for (key, list) in [("textures", &textures), ("samplers", &t.samplers)] {
             if !list.is_empty() {
                 root[key] = json!(list);
             }
@@ -1051,13 +1083,24 @@ fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
         if !images.is_empty() {
             root["images"] = json!(images);
         }
-        for (key, list) in [
-            ("extensionsUsed", &t.extensions_used),
-            ("extensionsRequired", &t.extensions_required),
-        ] {
-            if !list.is_empty() {
-                root[key] = json!(list);
-            }
+    }
+    // Every extension the written materials, textures and samplers use is declared; those the
+    // input required stay required.
+    let mut used = std::collections::BTreeSet::new();
+    for key in ["materials", "textures", "samplers", "images"] {
+        if let Some(v) = root.get(key) {
+            extension_names(v, &mut used);
+        }
+    }
+    if !used.is_empty() {
+        let required: Vec<&String> = t
+            .extensions_required
+            .iter()
+            .filter(|e| used.contains(*e))
+            .collect();
+        root["extensionsUsed"] = json!(used);
+        if !required.is_empty() {
+            root["extensionsRequired"] = json!(required);
         }
     }
     (root, bin)
@@ -1071,9 +1114,57 @@ fn sniff_mime(data: &[u8]) -> &'static str {
         "image/jpeg"
     } else if data.len() >= 12 && &data[..4] == b"RIFF" && &data[8..12] == b"WEBP" {
         "image/webp"
+    } else if data.starts_with(b"\xABKTX 20\xBB") {
+        "image/ktx2"
     } else {
         "application/octet-stream"
     }
+}
+
+/// A texture's image references (`source`, and `source` in its extensions such as
+/// `KHR_texture_basisu`) mapped to the images written; one to an image left out is removed.
+fn remap_sources(tex: &mut Value, new_index: &[Option<usize>]) {
+    let Value::Object(o) = tex else { return };
+    if let Some(s) = o.get("source").and_then(Value::as_u64) {
+        match new_index.get(s as usize).copied().flatten() {
+            Some(n) => {
+                o.insert("source".into(), json!(n));
+            }
+            None => {
+                o.remove("source");
+            }
+        }
+    }
+    if let Some(Value::Object(ext)) = o.get_mut("extensions") {
+        ext.values_mut().for_each(|e| remap_sources(e, new_index));
+    }
+}
+
+/// Texture references on a UV set other than TEXCOORD_0 (`texCoord`, or the
+/// `KHR_texture_transform` override), removed from a material: meshslim keeps only the first
+/// UV set, and a reference to a missing one makes the file invalid. (`io::not_kept` says so.)
+fn drop_other_uv_sets(v: &mut Value) {
+    if let Value::Object(o) = v {
+        o.retain(|_, x| !other_uv_set(x));
+        o.values_mut().for_each(drop_other_uv_sets);
+    }
+}
+
+/// Whether `v` is a texture reference on a UV set other than the first.
+pub(crate) fn other_uv_set(v: &Value) -> bool {
+    let set = |x: &Value, p: &str| x.pointer(p).and_then(Value::as_u64).unwrap_or(0);
+    v.get("index").is_some()
+        && (set(v, "/texCoord") != 0 || set(v, "/extensions/KHR_texture_transform/texCoord") != 0)
+}
+
+/// Whether a material refers to a UV set other than the first anywhere.
+pub(crate) fn uses_other_uv_sets(v: &Value) -> bool {
+    other_uv_set(v)
+        || match v {
+            Value::Object(o) => o.values().any(uses_other_uv_sets),
+            Value::Array(a) => a.iter().any(uses_other_uv_sets),
+            _ => false,
+        }
 }
 
 /// Writes `.gltf` (JSON with the buffer as a base64 data URI) or, with `binary`, `.glb`.

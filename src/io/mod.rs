@@ -112,6 +112,28 @@ pub fn not_kept(mesh: &Mesh, format: Format) -> Vec<String> {
             mesh.textures.images.len()
         ));
     }
+    if gltf {
+        let unread = mesh
+            .textures
+            .images
+            .iter()
+            .filter(|i| i.data.is_none())
+            .count();
+        if unread > 0 {
+            lost.push(format!(
+                "{unread} texture image(s) that could not be read: their URIs are written as \
+                 the input gave them, relative to its folder"
+            ));
+        }
+        if mesh
+            .materials
+            .iter()
+            .filter_map(|m| m.gltf.as_ref())
+            .any(gltf::uses_other_uv_sets)
+        {
+            lost.push("texture references on a second UV set (only TEXCOORD_0 is kept)".into());
+        }
+    }
     if !mesh.material_libs.is_empty() && format != Format::Obj && format != Format::Stl {
         lost.push(format!(
             "the colours and textures of the OBJ material libraries ({}){}",

@@ -43,8 +43,8 @@ pub struct Textures {
     /// glTF `samplers` entries as read.
     pub samplers: Vec<serde_json::Value>,
     pub images: Vec<TextureImage>,
-    /// The glTF extensions the carried objects use, and those of them the file required.
-    pub extensions_used: Vec<String>,
+    /// The glTF extensions the file required; the writer declares those the objects it writes
+    /// still use (and every extension they use in `extensionsUsed`).
     pub extensions_required: Vec<String>,
 }
 
@@ -60,7 +60,9 @@ impl Textures {
 pub struct TextureImage {
     pub name: Option<String>,
     pub mime_type: Option<String>,
-    pub data: Option<Vec<u8>>,
+    /// Shared: images naming the same bytes, and every copy of a mesh (welding, simplifying,
+    /// the viewer's levels), hold one allocation.
+    pub data: Option<std::sync::Arc<[u8]>>,
     /// The URI as the file gave it (none for an image embedded in a buffer view).
     pub uri: Option<String>,
 }

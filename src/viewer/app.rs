@@ -313,7 +313,13 @@ impl ViewerApp {
         }
         self.save_path = m.path.as_ref().map_or("simplified.ply".into(), |p| {
             let stem = p.file_stem().map_or("mesh".into(), |s| s.to_string_lossy());
-            p.with_file_name(format!("{stem}-simplified.ply"))
+            // A glTF is saved as glTF, which keeps its materials and textures; anything else as
+            // PLY (fast, and it keeps normals, UVs and colours).
+            let ext = match crate::io::Format::from_path(p) {
+                Ok(f @ (crate::io::Format::Glb | crate::io::Format::Gltf)) => f.extension(),
+                _ => "ply",
+            };
+            p.with_file_name(format!("{stem}-simplified.{ext}"))
                 .display()
                 .to_string()
         });
@@ -548,7 +554,15 @@ impl ViewerApp {
             format!("{}: that is the input; choose another file", out.display())
         } else {
             match crate::io::write(&out, &s.mesh) {
-                Ok(()) => format!("saved {} ({} faces)", out.display(), s.mesh.triangles.len()),
+                Ok(()) => {
+                    let mut msg =
+                        format!("saved {} ({} faces)", out.display(), s.mesh.triangles.len());
+                    let format = crate::io::Format::from_path(&out);
+                    for lost in format.map_or(Vec::new(), |f| crate::io::not_kept(&s.mesh, f)) {
+                        msg += &format!("; not kept: {lost}");
+                    }
+                    msg
+                }
                 Err(e) => format!("save failed: {e}"),
             }
         };
