@@ -1085,7 +1085,9 @@ fn run_info(args: InfoArgs) -> Result<ExitCode> {
             "normals": mesh.normals.is_some(),
             "uvs": mesh.uvs.is_some(),
             "colors": mesh.colors.is_some(),
+            "uv_origin": mesh.uvs.as_ref().map(|_| uv_origin_name(mesh.uv_origin)),
             "materials": mesh.materials.len(),
+            "texture_images": mesh.textures.images.len(),
             "groups": mesh.groups.len(),
         });
         obj.extend(extra.as_object().cloned().unwrap_or_default());
@@ -1159,11 +1161,45 @@ fn run_info(args: InfoArgs) -> Result<ExitCode> {
                 attrs.join(", ")
             }
         )?;
+        if mesh.uvs.is_some() {
+            writeln!(
+                out,
+                "  uv origin          {} of the texture image",
+                uv_origin_name(mesh.uv_origin)
+            )?;
+        }
         writeln!(out, "  materials          {}", mesh.materials.len())?;
+        let images = &mesh.textures.images;
+        if !images.is_empty() {
+            let bytes: usize = images
+                .iter()
+                .filter_map(|i| i.data.as_ref())
+                .map(|d| d.len())
+                .sum();
+            let unread = images.iter().filter(|i| i.data.is_none()).count();
+            writeln!(
+                out,
+                "  texture images     {} ({:.1} MiB{})",
+                images.len(),
+                bytes as f64 / (1024.0 * 1024.0),
+                if unread > 0 {
+                    format!(", {unread} could not be read")
+                } else {
+                    String::new()
+                }
+            )?;
+        }
         writeln!(out, "  groups             {}", mesh.groups.len())?;
     }
     out.flush()?;
     Ok(ExitCode::SUCCESS)
+}
+
+fn uv_origin_name(o: crate::mesh::UvOrigin) -> &'static str {
+    match o {
+        crate::mesh::UvOrigin::BottomLeft => "bottom-left",
+        crate::mesh::UvOrigin::TopLeft => "top-left",
+    }
 }
 
 fn run_compare(args: CompareArgs) -> Result<ExitCode> {

@@ -518,6 +518,17 @@ fn writing_a_poorer_format_says_what_it_drops() {
         ..Default::default()
     }];
     meshslim::io::write(&dir.path().join("scan.glb"), &m).unwrap();
+    let o = meshslim(&["info", "scan.glb", "--json"], dir.path());
+    expect_code(&o, 0);
+    let info = json(&o);
+    assert_eq!(info["texture_images"], 1, "{info}");
+    assert_eq!(info["uv_origin"], "top-left", "{info}");
+    let o = meshslim(&["info", "scan.glb"], dir.path());
+    assert!(
+        stdout(&o).contains("texture images     1"),
+        "{}",
+        stdout(&o)
+    );
     for (out, dropped) in [
         (
             "small.obj",
