@@ -1085,7 +1085,7 @@ fn run_info(args: InfoArgs) -> Result<ExitCode> {
             "normals": mesh.normals.is_some(),
             "uvs": mesh.uvs.is_some(),
             "colors": mesh.colors.is_some(),
-            "uv_origin": mesh.uvs.as_ref().map(|_| uv_origin_name(mesh.uv_origin)),
+            "uv_origin": mesh.uvs.as_ref().map(|_| mesh.uv_origin.name()),
             "materials": mesh.materials.len(),
             "texture_images": mesh.textures.images.len(),
             "groups": mesh.groups.len(),
@@ -1165,7 +1165,7 @@ fn run_info(args: InfoArgs) -> Result<ExitCode> {
             writeln!(
                 out,
                 "  uv origin          {} of the texture image",
-                uv_origin_name(mesh.uv_origin)
+                mesh.uv_origin.name()
             )?;
         }
         writeln!(out, "  materials          {}", mesh.materials.len())?;
@@ -1193,13 +1193,6 @@ fn run_info(args: InfoArgs) -> Result<ExitCode> {
     }
     out.flush()?;
     Ok(ExitCode::SUCCESS)
-}
-
-fn uv_origin_name(o: crate::mesh::UvOrigin) -> &'static str {
-    match o {
-        crate::mesh::UvOrigin::BottomLeft => "bottom-left",
-        crate::mesh::UvOrigin::TopLeft => "top-left",
-    }
 }
 
 fn run_compare(args: CompareArgs) -> Result<ExitCode> {

@@ -440,6 +440,25 @@ impl Doc<'_> {
     }
 }
 
+/// A `data:` URI's media type and decoded bytes (`None` for another URI); the error says what
+/// is wrong with a data URI that cannot be decoded.
+fn data_uri(uri: &str) -> Option<std::result::Result<(&str, Vec<u8>), &'static str>> {
+    let rest = uri.strip_prefix("data:")?;
+    Some(match rest.split_once(";base64,") {
+        None => Err("only base64 data URIs are supported"),
+        Some((mime, payload)) => base64_decode(payload)
+            .map(|b| (mime, b))
+            .ok_or("invalid base64 in the data URI"),
+    })
+}
+
+/// A relative URI as a path (percent-decoded), to be joined to the glTF's folder.
+fn uri_path(uri: &str) -> std::path::PathBuf {
+    String::from_utf8_lossy(&percent_decode(uri))
+        .into_owned()
+        .into()
+}
+
 fn load_buffers(root: &json::Root, blob: Option<&[u8]>, path: &Path) -> Result<Vec<Vec<u8>>> {
     let mut out = Vec::new();
     for (i, b) in root.buffers.iter().enumerate() {
@@ -449,23 +468,17 @@ fn load_buffers(root: &json::Root, blob: Option<&[u8]>, path: &Path) -> Result<V
                 .filter(|_| i == 0)
                 .ok_or_else(|| err("no URI and no GLB BIN chunk".into()))?
                 .to_vec(),
-            Some(uri) if uri.starts_with("data:") => {
-                let payload = uri
-                    .split_once(";base64,")
-                    .map(|x| x.1)
-                    .ok_or_else(|| err("only base64 data URIs are supported".into()))?;
-                base64_decode(payload)
-                    .ok_or_else(|| err("invalid base64 in the data URI".into()))?
-            }
-            Some(uri) => {
-                if uri.contains("://") {
-                    return Err(err(format!("unsupported URI {uri:?}")));
+            Some(uri) => match data_uri(uri) {
+                Some(decoded) => decoded.map_err(|m| err(m.into()))?.1,
+                None => {
+                    if uri.contains("://") {
+                        return Err(err(format!("unsupported URI {uri:?}")));
+                    }
+                    let file = path.parent().unwrap_or(Path::new(".")).join(uri_path(uri));
+                    std::fs::read(&file)
+                        .map_err(|e| err(format!("cannot read {}: {e}", file.display())))?
                 }
-                let rel = String::from_utf8_lossy(&percent_decode(uri)).into_owned();
-                let file = path.parent().unwrap_or(Path::new(".")).join(rel);
-                std::fs::read(&file)
-                    .map_err(|e| err(format!("cannot read {}: {e}", file.display())))?
-            }
+            },
         };
         if (data.len() as u64) < b.byte_length.0 {
             return Err(err(format!(
@@ -561,21 +574,15 @@ fn textures(doc: &Doc) -> Textures {
                 .and_then(|v| usize::try_from(v).ok())
                 .and_then(|v| by_view.entry(v).or_insert_with(|| view_bytes(v)).clone())
         } else {
-            match &uri {
-                Some(u) if u.starts_with("data:") => {
-                    let (head, payload) = u.split_once(";base64,").unwrap_or((u, ""));
-                    if mime_type.is_none() {
-                        mime_type = Some(head.trim_start_matches("data:").to_string())
-                            .filter(|m| !m.is_empty());
+            match uri.as_deref().map(|u| (u, data_uri(u))) {
+                Some((_, Some(decoded))) => decoded.ok().and_then(|(mime, bytes)| {
+                    if mime_type.is_none() && !mime.is_empty() {
+                        mime_type = Some(mime.to_string());
                     }
-                    base64_decode(payload)
-                        .filter(|b| !b.is_empty())
-                        .map(Arc::from)
-                }
-                Some(u) if !u.contains("://") => {
-                    let given = std::path::PathBuf::from(
-                        String::from_utf8_lossy(&percent_decode(u)).into_owned(),
-                    );
+                    (!bytes.is_empty()).then(|| Arc::from(bytes))
+                }),
+                Some((u, None)) if !u.contains("://") => {
+                    let given = uri_path(u);
                     use std::path::Component::{CurDir, Normal};
                     let inside = given.components().all(|c| matches!(c, Normal(_) | CurDir));
                     // `a.png` and `./a.png` are one file.
@@ -1144,9 +1151,16 @@ fn remap_sources(tex: &mut Value, new_index: &[Option<usize>]) {
 /// `KHR_texture_transform` override), removed from a material: meshslim keeps only the first
 /// UV set, and a reference to a missing one makes the file invalid. (`io::not_kept` says so.)
 fn drop_other_uv_sets(v: &mut Value) {
-    if let Value::Object(o) = v {
-        o.retain(|_, x| !other_uv_set(x));
-        o.values_mut().for_each(drop_other_uv_sets);
+    match v {
+        Value::Object(o) => {
+            o.retain(|_, x| !other_uv_set(x));
+            o.values_mut().for_each(drop_other_uv_sets);
+        }
+        Value::Array(a) => {
+            a.retain(|x| !other_uv_set(x));
+            a.iter_mut().for_each(drop_other_uv_sets);
+        }
+        _ => {}
     }
 }
 

@@ -107,6 +107,16 @@ pub enum UvOrigin {
     TopLeft,
 }
 
+impl UvOrigin {
+    /// "bottom-left" or "top-left".
+    pub fn name(self) -> &'static str {
+        match self {
+            UvOrigin::BottomLeft => "bottom-left",
+            UvOrigin::TopLeft => "top-left",
+        }
+    }
+}
+
 /// Axis-aligned bounding box.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Aabb {
