@@ -1,150 +1,28 @@
-// Per edge: the collapse position, quadric error, flip and needle checks of the faces that move,
-// the quality-scaled priority, and the cost histogram; the topological checks wait for validate.
-// Seam vertices follow the greedy reference's rules (onto_seam, seam_slide); collapse makes the
-// attribute map again from the same faces. Relies on the current CSR face lists and on the
-// seam corners' attribute vertices in face_extra.
+// For the candidates whose error (edge_errors) is under the round's cost ceiling, the faces that
+// move: no normal may turn past the angle limit (against the current and the input normal), no
+// needle may appear, and the worst new quality scales the error up to the priority the selection
+// ranks by. The ceiling picks the edges that compete by their error; the priority orders them.
+// Edges over the ceiling drop out unchecked. The topological checks wait for validate. Relies on
+// edge_errors' candidates and cost_ceiling's ceiling.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;        // per vertex
-@group(0) @binding(2) var<storage, read> quadrics: array<Quadric>;           // per vertex
-@group(0) @binding(3) var<storage, read> flags: array<u32>;                  // per vertex
-@group(0) @binding(4) var<storage, read> indices: array<u32>;                // per face × 3
-@group(0) @binding(5) var<storage, read> offsets: array<u32>;                // per vertex + 1
-@group(0) @binding(6) var<storage, read> vertex_faces: array<u32>;           // per corner
-@group(0) @binding(7) var<storage, read> face_normals: array<vec4<f32>>;     // per face
-@group(0) @binding(8) var<storage, read> edges: array<vec2<u32>>;            // per edge
-@group(0) @binding(9) var<storage, read> edge_offsets: array<u32>;           // per vertex + 1
-@group(0) @binding(10) var<storage, read_write> candidates: array<EdgeCandidate>; // per edge
-@group(0) @binding(11) var<storage, read_write> edge_state: array<u32>;      // per edge
-@group(0) @binding(12) var<storage, read_write> histogram: array<atomic<u32>>; // HIST_BINS
-@group(0) @binding(13) var<storage, read_write> counters: array<atomic<u32>, 16>;
-@group(0) @binding(14) var<storage, read> face_extra: array<FaceExtra>;      // per face
+@group(0) @binding(2) var<storage, read> indices: array<u32>;                // per face × 3
+@group(0) @binding(3) var<storage, read> offsets: array<u32>;                // per vertex + 1
+@group(0) @binding(4) var<storage, read> vertex_faces: array<u32>;           // per corner
+@group(0) @binding(5) var<storage, read> face_normals: array<vec4<f32>>;     // per face
+@group(0) @binding(6) var<storage, read> edge_offsets: array<u32>;           // per vertex + 1
+@group(0) @binding(7) var<storage, read_write> candidates: array<EdgeCandidate>; // per edge
+@group(0) @binding(8) var<storage, read_write> edge_state: array<u32>;      // per edge
+@group(0) @binding(9) var<storage, read> counters: array<u32, 16>;
 
-const VERDICT_INVALID: u32 = 0u;
-const VERDICT_OVER: u32 = 1u;
-const VERDICT_OK: u32 = 2u;
-
-struct Verdict {
-    kind: u32,
-    c: EdgeCandidate,
-}
-
-fn invalid() -> Verdict {
-    return Verdict(VERDICT_INVALID, invalid_candidate());
-}
-
-// Free vertex r moving onto seam vertex k: its corners take the attribute vertex k has in the
-// faces on the edge, which must agree (else the edge runs along the seam). .y = NO_ATTR if not.
-fn onto_seam(k: u32, r: u32) -> vec4<u32> {
-    var to = NO_ATTR;
-    for (var i = offsets[r]; i < offsets[r + 1u]; i = i + 1u) {
-        let f = vertex_faces[i];
-        if (has(face_of(f), k)) {
-            let a = corner_attr(f, k);
-            if (to != NO_ATTR && to != a) { return vec4<u32>(NO_ATTR); }
-            to = a;
-        }
-    }
-    return vec4<u32>(NO_ATTR, to, NO_ATTR, NO_ATTR);
-}
-
-// Seam vertex r sliding along edge (r, k) onto seam vertex k (the greedy's seam_slide): r is
-// free to go (not pinned, not on a border), has two attribute vertices, and the two faces on
-// the edge use different ones at both ends. (from1, to1, from2, to2), or all NO_ATTR.
-fn seam_slide(r: u32, k: u32) -> vec4<u32> {
-    let none = vec4<u32>(NO_ATTR);
-    if ((flags[r] & (FLAG_PINNED | FLAG_BORDER)) != 0u) { return none; }
-    var attrs = vec2<u32>(NO_ATTR, NO_ATTR);
-    var sides = none;
-    var n = 0u;
-    for (var i = offsets[r]; i < offsets[r + 1u]; i = i + 1u) {
-        let f = vertex_faces[i];
-        let a = corner_attr(f, r);
-        if (attrs.x == NO_ATTR || attrs.x == a) {
-            attrs.x = a;
-        } else if (attrs.y == NO_ATTR || attrs.y == a) {
-            attrs.y = a;
-        } else {
-            return none; // a seam junction stays
-        }
-        if (has(face_of(f), k)) {
-            if (n == 2u) { return none; }
-            if (n == 0u) {
-                sides.x = a;
-                sides.y = corner_attr(f, k);
-            } else {
-                sides.z = a;
-                sides.w = corner_attr(f, k);
-            }
-            n = n + 1u;
-        }
-    }
-    if (n == 2u && sides.x != sides.z && sides.y != sides.w) { return sides; }
-    return none;
-}
-
-fn evaluate(a: u32, b: u32) -> Verdict {
-    let fla = flags[a];
-    let flb = flags[b];
-    // Seam vertices keep their position like pinned ones.
-    let fixed_a = (fla & (FLAG_PINNED | FLAG_SEAM)) != 0u;
-    let fixed_b = (flb & (FLAG_PINNED | FLAG_SEAM)) != 0u;
-    let pa = positions[a].xyz;
-    let pb = positions[b].xyz;
-    let dab = pb - pa;
-    let q = quadric_add(quadrics[a], quadric_shift(quadrics[b], pa - pb));
-    var keep = a;
-    var remove = b;
-    var y = vec3<f32>(0.0);
-    var attr_map = vec4<u32>(NO_ATTR);
-    if (fixed_a && fixed_b) {
-        // Only a seam vertex sliding along its seam onto a seam neighbour; b first, as the
-        // greedy tries.
-        if ((fla & flb & FLAG_SEAM) == 0u) { return invalid(); }
-        attr_map = seam_slide(b, a);
-        if (attr_map.y == NO_ATTR) {
-            attr_map = seam_slide(a, b);
-            keep = b;
-            remove = a;
-            y = dab;
-        }
-        if (attr_map.y == NO_ATTR) { return invalid(); }
-    } else if (fixed_a) {
-        y = vec3<f32>(0.0);
-    } else if (fixed_b) {
-        keep = b;
-        remove = a;
-        y = dab;
-    } else {
-        let opt = quadric_optimum(q);
-        if (opt.ok) {
-            y = opt.y;
-        } else {
-            var best = vec3<f32>(0.0);
-            var best_e = quadric_eval(q, best);
-            let e1 = quadric_eval(q, dab);
-            if (e1 < best_e) { best = dab; best_e = e1; }
-            let mid = dab * 0.5;
-            let e2 = quadric_eval(q, mid);
-            if (e2 < best_e) { best = mid; best_e = e2; }
-            y = best;
-        }
-        let dy = y - dab;
-        if (!(dot(y, y) <= dot(dy, dy))) {
-            keep = b;
-            remove = a;
-        }
-    }
-    if ((flags[keep] & FLAG_SEAM) != 0u && attr_map.y == NO_ATTR) {
-        attr_map = onto_seam(keep, remove);
-        if (attr_map.y == NO_ATTR) { return invalid(); }
-    }
-    let error = quadric_eval(q, y);
-    // A survivor that keeps its position keeps it bit for bit (pa + (pb - pa) need not be pb):
-    // a seam vertex marked moved would leave its other attribute vertices behind.
-    var pos = pa + y;
-    if ((flags[keep] & (FLAG_PINNED | FLAG_SEAM)) != 0u) { pos = positions[keep].xyz; }
-
+// The priority of collapsing c (its error scaled by the worst quality of the faces that move),
+// or -1 when a moving face would flip or become a needle.
+fn moved_faces(c: EdgeCandidate) -> f32 {
+    let keep = c.keep;
+    let remove = c.remove;
+    let pos = c.pos.xyz;
+    let error = bitcast<f32>(c.cost_bits);
     var min_q = 3.0e38;
     for (var side = 0u; side < 2u; side = side + 1u) {
         var moved = keep;
@@ -165,12 +43,12 @@ fn evaluate(a: u32, b: u32) -> Verdict {
             let n_new = cross(n1 - n0, n2 - n0);
             let l_old = length(n_old);
             let l_new = length(n_new);
-            if (!(l_new > 0.0)) { return invalid(); }
-            if (l_old > 0.0 && dot(n_old, n_new) < params.cos_max_angle * l_old * l_new) { return invalid(); }
+            if (!(l_new > 0.0)) { return -1.0; }
+            if (l_old > 0.0 && dot(n_old, n_new) < params.cos_max_angle * l_old * l_new) { return -1.0; }
             let fr = face_normals[f];
-            if (fr.w > 0.0 && dot(fr.xyz, n_new) < params.cos_max_angle * l_new) { return invalid(); }
+            if (fr.w > 0.0 && dot(fr.xyz, n_new) < params.cos_max_angle * l_new) { return -1.0; }
             let q_new = quality_from_area2(l_new, n0, n1, n2);
-            if (q_new < params.min_quality && q_new < triangle_quality(o0, o1, o2)) { return invalid(); }
+            if (q_new < params.min_quality && q_new < triangle_quality(o0, o1, o2)) { return -1.0; }
             min_q = min(min_q, q_new);
         }
     }
@@ -179,36 +57,26 @@ fn evaluate(a: u32, b: u32) -> Verdict {
     if (qt > 0.0 && min_q < qt) {
         priority = error * (qt / max(min_q, 1e-12));
     }
-    let weight = q.q2.z;
-    var err2 = 0.0;
-    if (weight > 0.0) { err2 = error / weight; }
-    if (!(is_finite(priority) && is_finite(err2) && is_finite(pos.x) && is_finite(pos.y) && is_finite(pos.z))) {
-        return invalid();
-    }
-    if (err2 > params.max_error2) {
-        return Verdict(VERDICT_OVER, invalid_candidate());
-    }
-    return Verdict(VERDICT_OK, EdgeCandidate(vec4<f32>(pos, err2), keep, remove, bitcast<u32>(priority), 0u));
+    if (!is_finite(priority)) { return -1.0; }
+    return priority;
 }
 
 @compute @workgroup_size(256)
 fn edge_costs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let e = gid.x + gid.y * nwg.x * WG;
-    if (e >= edge_offsets[params.vertex_count]) {
+    if (e >= edge_offsets[params.vertex_count] || edge_state[e] != STATE_CANDIDATE) {
         return;
     }
-    let ab = edges[e];
-    let v = evaluate(ab.x, ab.y);
-    edge_state[e] = STATE_OUT;
-    if (v.kind == VERDICT_OK) {
-        candidates[e] = v.c;
-        edge_state[e] = STATE_CANDIDATE;
-        atomicAdd(&histogram[v.c.cost_bits >> HIST_SHIFT], 1u);
-        atomicAdd(&counters[C_CANDIDATES], 1u);
-    } else {
+    let c = candidates[e];
+    if (c.cost_bits >= counters[C_CEILING]) {
+        edge_state[e] = STATE_OUT;
+        return;
+    }
+    let priority = moved_faces(c);
+    if (priority < 0.0) {
         candidates[e] = invalid_candidate();
-        if (v.kind == VERDICT_OVER) {
-            atomicAdd(&counters[C_OVER_MAX_ERROR], 1u);
-        }
+        edge_state[e] = STATE_OUT;
+    } else {
+        candidates[e].cost_bits = bitcast<u32>(priority);
     }
 }

@@ -21,7 +21,7 @@ fn select_cost(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     }
     let c = candidates[e];
     let ab = edges[e];
-    var blocked = c.cost_bits >= counters[C_CEILING];
+    var blocked = false;
     // No face is locked before the first winner: skip the scan in the first pass.
     let any_locked = counters[C_WINNERS] > 0u;
     for (var s = 0u; s < 2u && !blocked && any_locked; s = s + 1u) {

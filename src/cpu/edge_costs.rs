@@ -1,177 +1,34 @@
-//! Twin of shaders/edge_costs.wgsl: per edge, where the collapse would put the survivor, its
-//! quadric error, the faces that move (no flip past the angle limit, no needle) and the priority
-//! (error scaled up for poor triangle quality, MeshLab-style), and the cost histogram the ceiling
-//! is picked from. The topological checks (link condition, border pinch, lone triangle,
-//! tetrahedral fold) scan both endpoints' neighbourhoods and rarely fail on a manifold, so they
-//! run in `validate`, only for the edges that win a selection pass. Seam vertices follow the
-//! greedy reference's rules: a free vertex may move onto one, and one may slide along its seam
-//! onto a seam neighbour (`collapse` makes the attribute map again from the same faces).
+//! Twin of shaders/edge_costs.wgsl: for the candidates whose error (`edge_errors`) is under the
+//! round's cost ceiling, the faces that move: no normal may turn past the angle limit (against
+//! the current and the input normal), no needle may appear, and the worst new quality scales
+//! the error up to the priority the selection ranks by (MeshLab-style). The ceiling picks the
+//! edges that compete by their error; the priority orders them. Edges over the ceiling drop out
+//! unchecked: on the 1M scan at 1%, checking the moved faces of every edge was half the run.
+//! The topological checks (link condition, border pinch, lone triangle, tetrahedral fold) scan
+//! both endpoints' neighbourhoods and rarely fail on a manifold, so they run in `validate`,
+//! only for the edges that win a selection pass.
 
 use super::common::*;
-use super::{corner_attr, face_of, faces_of};
-use crate::gpu::types::{
-    Counters, EdgeCandidate, FaceExtra, HIST_SHIFT, NO_ATTR, Params, Quadric, flag, state,
-};
+use super::{face_of, faces_of};
+use crate::gpu::types::{Counters, EdgeCandidate, Params, state};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
-/// What `edge_costs` decided for one edge, before it is written out.
-pub enum Verdict {
-    Invalid,
-    /// Valid so far, but its error exceeds the maximum.
-    OverMaxError,
-    Candidate(EdgeCandidate),
-}
-
-/// The faces and their attribute vertices, as the seam rules read them.
-struct Corners<'a> {
-    indices: &'a [u32],
-    offsets: &'a [u32],
-    vertex_faces: &'a [u32],
-    face_extra: &'a [FaceExtra],
-}
-
-impl Corners<'_> {
-    /// Free vertex `r` moving onto seam vertex `k`: its corners take the attribute vertex `k`
-    /// has in the faces on the edge, which must agree (else the edge runs along the seam).
-    fn onto_seam(&self, k: u32, r: u32) -> Option<[u32; 4]> {
-        let mut to = NO_ATTR;
-        for &f in faces_of(self.offsets, self.vertex_faces, r) {
-            if face_of(self.indices, f).contains(&k) {
-                let a = corner_attr(self.indices, self.face_extra, f, k);
-                if to != NO_ATTR && to != a {
-                    return None;
-                }
-                to = a;
-            }
-        }
-        (to != NO_ATTR).then_some([NO_ATTR, to, NO_ATTR, NO_ATTR])
-    }
-
-    /// Seam vertex `r` sliding along edge (r, k) onto seam vertex `k` (the greedy's
-    /// `seam_slide`): `r` is free to go (not pinned, not on a border), has two attribute
-    /// vertices, and the two faces on the edge use different ones at both ends. Returns
-    /// (from₁, to₁, from₂, to₂).
-    fn seam_slide(&self, flags: &[u32], r: u32, k: u32) -> Option<[u32; 4]> {
-        if flags[r as usize] & (flag::PINNED | flag::BORDER) != 0 {
-            return None;
-        }
-        let mut attrs = [NO_ATTR; 2];
-        let mut sides = [NO_ATTR; 4];
-        let mut n = 0;
-        for &f in faces_of(self.offsets, self.vertex_faces, r) {
-            let a = corner_attr(self.indices, self.face_extra, f, r);
-            if attrs[0] == NO_ATTR || attrs[0] == a {
-                attrs[0] = a;
-            } else if attrs[1] == NO_ATTR || attrs[1] == a {
-                attrs[1] = a;
-            } else {
-                return None; // a seam junction stays
-            }
-            if face_of(self.indices, f).contains(&k) {
-                if n == 2 {
-                    return None;
-                }
-                sides[2 * n] = a;
-                sides[2 * n + 1] = corner_attr(self.indices, self.face_extra, f, k);
-                n += 1;
-            }
-        }
-        (n == 2 && sides[0] != sides[2] && sides[1] != sides[3]).then_some(sides)
-    }
-}
-
-/// The survivor, its new position and the quadric error (`cost_bits`; `pos.w` = error relative
-/// to the diagonal, squared). Two pinned ends, and seam vertices other than by the seam rules
-/// (`flag::SEAM`), are refused here.
+/// The priority of collapsing `c` (its error, as `edge_errors` wrote it, scaled by the worst
+/// quality of the faces that move), or None when a moving face would flip or become a needle.
 #[allow(clippy::too_many_arguments)]
-pub fn placement(
+pub fn moved_faces(
     params: &Params,
     positions: &[[f32; 4]],
-    quadrics: &[Quadric],
-    flags: &[u32],
     indices: &[u32],
     offsets: &[u32],
     vertex_faces: &[u32],
     face_normals: &[[f32; 4]],
-    face_extra: &[FaceExtra],
-    a: u32,
-    b: u32,
-) -> Verdict {
-    let (fla, flb) = (flags[a as usize], flags[b as usize]);
-    let corners = Corners {
-        indices,
-        offsets,
-        vertex_faces,
-        face_extra,
-    };
-    // Seam vertices keep their position like pinned ones.
-    let fixed = |fl: u32| fl & (flag::PINNED | flag::SEAM) != 0;
-    let pa = xyz(positions[a as usize]);
-    let pb = xyz(positions[b as usize]);
-    let dab = sub(pb, pa);
-    // b's quadric moved to a's origin: x - pb = (x - pa) + (pa - pb).
-    let q = quadric_add(
-        &quadrics[a as usize],
-        &quadric_shift(&quadrics[b as usize], sub(pa, pb)),
-    );
-    let mut slides = false;
-    let (keep, remove, y) = if fixed(fla) && fixed(flb) {
-        // Only a seam vertex sliding along its seam onto a seam neighbour; b first, as the
-        // greedy tries.
-        if fla & flb & flag::SEAM == 0 {
-            return Verdict::Invalid;
-        }
-        slides = true;
-        if corners.seam_slide(flags, b, a).is_some() {
-            (a, b, [0.0; 3])
-        } else if corners.seam_slide(flags, a, b).is_some() {
-            (b, a, dab)
-        } else {
-            return Verdict::Invalid;
-        }
-    } else if fixed(fla) {
-        (a, b, [0.0; 3])
-    } else if fixed(flb) {
-        (b, a, dab)
-    } else {
-        let y = match quadric_optimum(&q) {
-            Some(y) => y,
-            None => {
-                let mut best = [0.0f32; 3];
-                let mut best_e = quadric_eval(&q, best);
-                for c in [dab, scale(dab, 0.5)] {
-                    let e = quadric_eval(&q, c);
-                    if e < best_e {
-                        best = c;
-                        best_e = e;
-                    }
-                }
-                best
-            }
-        };
-        // The survivor is the endpoint nearer the new position.
-        if dot(y, y) <= dot(sub(y, dab), sub(y, dab)) {
-            (a, b, y)
-        } else {
-            (b, a, y)
-        }
-    };
-    if flags[keep as usize] & flag::SEAM != 0
-        && !slides
-        && corners.onto_seam(keep, remove).is_none()
-    {
-        return Verdict::Invalid;
-    }
-    let error = quadric_eval(&q, y);
-    // A survivor that keeps its position keeps it bit for bit (pa + (pb - pa) need not be pb):
-    // a seam vertex marked moved would leave its other attribute vertices behind.
-    let pos = if flags[keep as usize] & (flag::PINNED | flag::SEAM) != 0 {
-        xyz(positions[keep as usize])
-    } else {
-        add(pa, y)
-    };
-
+    c: &EdgeCandidate,
+) -> Option<f32> {
+    let (keep, remove) = (c.keep, c.remove);
+    let pos = xyz(c.pos);
+    let error = f32::from_bits(c.cost_bits);
     // Faces that move: normals may not turn past the limit (against the current and the input
     // normal), no needle may appear; the worst new quality scales the priority.
     let mut min_q = f32::INFINITY;
@@ -193,18 +50,18 @@ pub fn placement(
             let n_new = cross(sub(new[1], new[0]), sub(new[2], new[0]));
             let (l_old, l_new) = (length(n_old), length(n_new));
             if l_new.is_nan() || l_new <= 0.0 {
-                return Verdict::Invalid;
+                return None;
             }
             if l_old > 0.0 && dot(n_old, n_new) < params.cos_max_angle * l_old * l_new {
-                return Verdict::Invalid;
+                return None;
             }
             let fr = face_normals[f as usize];
             if fr[3] > 0.0 && dot(xyz(fr), n_new) < params.cos_max_angle * l_new {
-                return Verdict::Invalid;
+                return None;
             }
             let q_new = quality_from_area2(l_new, new[0], new[1], new[2]);
             if q_new < params.min_quality && q_new < triangle_quality(old[0], old[1], old[2]) {
-                return Verdict::Invalid;
+                return None;
             }
             min_q = min_q.min(q_new);
         }
@@ -215,75 +72,51 @@ pub fn placement(
     } else {
         error
     };
-    let weight = q.q[2][2];
-    let err2 = if weight > 0.0 { error / weight } else { 0.0 };
-    if !(priority.is_finite() && err2.is_finite() && pos.iter().all(|x| x.is_finite())) {
-        return Verdict::Invalid;
-    }
-    if err2 > params.max_error2 {
-        return Verdict::OverMaxError;
-    }
-    Verdict::Candidate(EdgeCandidate {
-        pos: [pos[0], pos[1], pos[2], err2],
-        keep,
-        remove,
-        cost_bits: priority.to_bits(),
-        faces: 0,
-    })
+    priority.is_finite().then_some(priority)
 }
 
-/// Per edge (`edge_capacity` invocations; those past the edge count stop at once).
+/// Per edge (`edge_capacity` invocations; those past the edge count stop at once): a candidate
+/// under the ceiling gets its priority or drops out as invalid; the others drop out.
 #[allow(clippy::too_many_arguments)]
 pub fn edge_costs(
     params: &Params,
     positions: &[[f32; 4]],           // per vertex
-    quadrics: &[Quadric],             // per vertex
-    flags: &[u32],                    // per vertex
     indices: &[u32],                  // per face × 3
     offsets: &[u32],                  // per vertex + 1
     vertex_faces: &[u32],             // per corner
     face_normals: &[[f32; 4]],        // per face
-    face_extra: &[FaceExtra],         // per face
-    edges: &[[u32; 2]],               // per edge
     edge_offsets: &[u32],             // per vertex + 1: the edge count at [vertex_count]
     candidates: &mut [EdgeCandidate], // per edge
     edge_state: &mut [u32],           // per edge
-    histogram: &[AtomicU32],          // HIST_BINS, cleared
-    counters: &[AtomicU32],           // Counters, cleared
+    counters: &[AtomicU32],           // Counters, with the ceiling
 ) {
     let ne = edge_offsets[params.vertex_count as usize] as usize;
+    let ceiling = counter(counters, CounterField::Ceiling).load(Relaxed);
     candidates[..ne]
         .par_iter_mut()
         .zip(&mut edge_state[..ne])
-        .enumerate()
         .with_min_len(256)
-        .for_each(|(e, (out, st))| {
-            let [a, b] = edges[e];
-            let verdict = placement(
+        .for_each(|(c, st)| {
+            if *st != state::CANDIDATE {
+                return;
+            }
+            if c.cost_bits >= ceiling {
+                *st = state::OUT;
+                return;
+            }
+            match moved_faces(
                 params,
                 positions,
-                quadrics,
-                flags,
                 indices,
                 offsets,
                 vertex_faces,
                 face_normals,
-                face_extra,
-                a,
-                b,
-            );
-            *st = state::OUT;
-            *out = EdgeCandidate::INVALID;
-            match verdict {
-                Verdict::Invalid => {}
-                Verdict::OverMaxError => {
-                    counter(counters, CounterField::OverMaxError).fetch_add(1, Relaxed);
-                }
-                Verdict::Candidate(c) => {
-                    histogram[(c.cost_bits >> HIST_SHIFT) as usize].fetch_add(1, Relaxed);
-                    counter(counters, CounterField::Candidates).fetch_add(1, Relaxed);
-                    *out = c;
-                    *st = state::CANDIDATE;
+                c,
+            ) {
+                Some(priority) => c.cost_bits = priority.to_bits(),
+                None => {
+                    *c = EdgeCandidate::INVALID;
+                    *st = state::OUT;
                 }
             }
         });

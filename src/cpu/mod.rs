@@ -14,6 +14,7 @@ pub mod compact;
 pub mod cost_ceiling;
 pub mod dispatch_args;
 pub mod edge_costs;
+pub mod edge_errors;
 pub mod edges;
 pub mod face_planes;
 pub mod prefix_sum;
@@ -158,7 +159,9 @@ pub struct CpuRounds {
     pub edges: Vec<[u32; 2]>,
     pub candidates: Vec<EdgeCandidate>,
     pub edge_state: Vec<u32>,
+    /// The edge errors' histogram, kept through the round (tests read it).
     pub histogram: Vec<u32>,
+    pub trim_histogram: Vec<u32>,
     pub face_best: Vec<u32>,
     pub face_id: Vec<u32>,
     pub face_lock: Vec<u32>,
@@ -290,12 +293,23 @@ impl CpuRounds {
         ne
     }
 
+    /// Edge errors, the round's cost ceiling from their histogram, and the costs of the edges
+    /// under it.
     pub fn costs(&mut self, p: &Params, ne: u32) {
-        self.time("edge_costs", |s| {
+        self.errors(p, ne);
+        self.time("cost_ceiling", |s| {
+            cost_ceiling::cost_ceiling(p, &s.histogram, atomics(&mut s.counters))
+        });
+        self.costs_under_ceiling(p);
+    }
+
+    /// `edge_errors`: placements, errors and their histogram.
+    pub fn errors(&mut self, p: &Params, ne: u32) {
+        self.time("edge_errors", |s| {
             s.candidates.resize(ne as usize, EdgeCandidate::default());
             s.edge_state.resize(ne as usize, 0);
             reset(&mut s.histogram, HIST_BINS as usize);
-            edge_costs::edge_costs(
+            edge_errors::edge_errors(
                 p,
                 &s.positions,
                 &s.quadrics,
@@ -303,18 +317,32 @@ impl CpuRounds {
                 &s.indices,
                 &s.offsets,
                 &s.vertex_faces,
-                &s.face_normals,
-                &s.face_extra,
                 &s.edges,
                 &s.edge_offsets,
                 &mut s.candidates,
                 &mut s.edge_state,
                 atomics(&mut s.histogram),
                 atomics(&mut s.counters),
+                &s.face_extra,
             );
         });
-        self.time("cost_ceiling", |s| {
-            cost_ceiling::cost_ceiling(p, &s.histogram, atomics(&mut s.counters))
+    }
+
+    /// `edge_costs`, with the ceiling in the counters.
+    pub fn costs_under_ceiling(&mut self, p: &Params) {
+        self.time("edge_costs", |s| {
+            edge_costs::edge_costs(
+                p,
+                &s.positions,
+                &s.indices,
+                &s.offsets,
+                &s.vertex_faces,
+                &s.face_normals,
+                &s.edge_offsets,
+                &mut s.candidates,
+                &mut s.edge_state,
+                atomics(&mut s.counters),
+            );
         });
     }
 
@@ -394,17 +422,17 @@ impl CpuRounds {
         }
         if p.trim != 0 {
             self.time("trim_histogram", |s| {
-                reset(&mut s.histogram, HIST_BINS as usize);
+                reset(&mut s.trim_histogram, HIST_BINS as usize);
                 trim::trim_histogram(
                     p,
                     &s.candidates,
                     &s.edge_state,
                     &s.edge_offsets,
-                    atomics(&mut s.histogram),
+                    atomics(&mut s.trim_histogram),
                 )
             });
             self.time("trim_ceiling", |s| {
-                trim::trim_ceiling(p, &s.histogram, atomics(&mut s.counters))
+                trim::trim_ceiling(p, &s.trim_histogram, atomics(&mut s.counters))
             });
             self.time("trim_mark", |s| {
                 reset(&mut s.marks, p.edge_capacity as usize + 1);

@@ -42,7 +42,6 @@ pub fn select_cost(
     edge_state: &[AtomicU32], // per edge
     face_best: &[AtomicU32],  // per face, cleared
 ) {
-    let ceiling = counter(counters, CounterField::Ceiling).load(Relaxed);
     let any_locked = counter(counters, CounterField::Winners).load(Relaxed) > 0;
     par_for(edge_count(params, edge_offsets), |e| {
         let e = e as usize;
@@ -51,10 +50,9 @@ pub fn select_cost(
         }
         let c = &candidates[e];
         // No face is locked before the first winner: skip the scan in the first pass.
-        if c.cost_bits >= ceiling
-            || (any_locked
-                && around(offsets, vertex_faces, edges[e])
-                    .any(|f| face_lock[f as usize].load(Relaxed) != 0))
+        if any_locked
+            && around(offsets, vertex_faces, edges[e])
+                .any(|f| face_lock[f as usize].load(Relaxed) != 0)
         {
             edge_state[e].store(state::OUT, Relaxed);
             return;

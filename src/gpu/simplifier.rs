@@ -172,7 +172,9 @@ pub struct GpuRounds<'a> {
     edges: wgpu::Buffer,
     candidates: wgpu::Buffer,
     edge_state: wgpu::Buffer,
+    /// The edge errors' histogram, kept through the round (tests read it).
     histogram: wgpu::Buffer,
+    trim_histogram: wgpu::Buffer,
     face_best: wgpu::Buffer,
     face_id: wgpu::Buffer,
     face_lock: wgpu::Buffer,
@@ -299,6 +301,7 @@ impl<'a> GpuRounds<'a> {
             )?,
             edge_state: mk("edge_state", cap * 4, SU)?,
             histogram: mk("histogram", HIST_BINS as u64 * 4, SU)?,
+            trim_histogram: mk("trim_histogram", HIST_BINS as u64 * 4, SU)?,
             face_best: mk("face_best", nf * 4, SU)?,
             face_id: mk("face_id", nf * 4, SU)?,
             face_lock: mk("face_lock", nf * 4, SU)?,
@@ -538,6 +541,7 @@ impl<'a> GpuRounds<'a> {
             "edges" => &self.edges,
             "candidates" => &self.candidates,
             "edge_state" => &self.edge_state,
+            "histogram" => &self.histogram,
             "remap" => &self.remap,
             "vertex_keep" => &self.vertex_keep,
             "face_keep" => &self.face_keep,
@@ -714,14 +718,22 @@ impl RoundRunner for GpuRounds<'_> {
         enc.clear_buffer(&hist, 0, None);
         self.pass(
             &mut enc,
-            "edge_costs",
+            "edge_errors",
             &[
-                &params, &pos, &quad, &flags, &idx, &offsets, &vf, &fnorm, &edges, &eoff, &cand,
-                &est, &hist, &counters, &fextra,
+                &params, &pos, &quad, &flags, &idx, &offsets, &vf, &edges, &eoff, &cand, &est,
+                &hist, &counters, &fextra,
             ],
             PER_EDGE,
         );
         self.pass(&mut enc, "cost_ceiling", &[&params, &hist, &counters], ONE);
+        self.pass(
+            &mut enc,
+            "edge_costs",
+            &[
+                &params, &pos, &idx, &offsets, &vf, &fnorm, &eoff, &cand, &est, &counters,
+            ],
+            PER_EDGE,
+        );
         enc.clear_buffer(&flock, 0, None);
         for _ in 0..self.selection_passes {
             enc.clear_buffer(&fbest, 0, None);
@@ -770,14 +782,15 @@ impl RoundRunner for GpuRounds<'_> {
             );
         }
         if p.trim != 0 {
-            enc.clear_buffer(&hist, 0, None);
+            let thist = c(&self.trim_histogram);
+            enc.clear_buffer(&thist, 0, None);
             self.pass(
                 &mut enc,
                 "trim_histogram",
-                &[&params, &cand, &est, &eoff, &hist],
+                &[&params, &cand, &est, &eoff, &thist],
                 PER_EDGE,
             );
-            self.pass(&mut enc, "trim_ceiling", &[&params, &hist, &counters], ONE);
+            self.pass(&mut enc, "trim_ceiling", &[&params, &thist, &counters], ONE);
             self.pass(
                 &mut enc,
                 "trim_mark",
