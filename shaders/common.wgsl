@@ -56,6 +56,7 @@ const C_TRIM_BUDGET: u32 = 7u;
 const C_VERTICES_OUT: u32 = 8u;
 const C_FACES_OUT: u32 = 9u;
 const C_TENTATIVE: u32 = 10u;
+const C_LIVE: u32 = 11u;
 const COUNTERS: u32 = 16u;
 
 struct Counters {
@@ -70,7 +71,8 @@ struct Counters {
     vertices_out: u32,
     faces_out: u32,
     tentative: u32,
-    _pad: array<u32, 5>,
+    live: u32,
+    _pad: array<u32, 4>,
 }
 
 // Relative to its vertex: [a00 a01 a02 a11] [a12 a22 b0 b1] [b2 c weight 0].

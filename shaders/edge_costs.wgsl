@@ -2,8 +2,8 @@
 // move: no normal may turn past the angle limit (against the current and the input normal), no
 // needle may appear, and the worst new quality scales the error up to the priority the selection
 // ranks by. The ceiling picks the edges that compete by their error; the priority orders them.
-// Edges over the ceiling drop out unchecked. The topological checks wait for validate. Relies on
-// edge_errors' candidates and cost_ceiling's ceiling.
+// Edges over the ceiling dropped out unchecked (live_list). The topological checks wait for
+// validate. One invocation per listed candidate; relies on edge_errors' candidates.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;        // per vertex
@@ -11,7 +11,7 @@
 @group(0) @binding(3) var<storage, read> offsets: array<u32>;                // per vertex + 1
 @group(0) @binding(4) var<storage, read> vertex_faces: array<u32>;           // per corner
 @group(0) @binding(5) var<storage, read> face_normals: array<vec4<f32>>;     // per face
-@group(0) @binding(6) var<storage, read> edge_offsets: array<u32>;           // per vertex + 1
+@group(0) @binding(6) var<storage, read> live: array<u32>;                   // per listed candidate
 @group(0) @binding(7) var<storage, read_write> candidates: array<EdgeCandidate>; // per edge
 @group(0) @binding(8) var<storage, read_write> edge_state: array<u32>;      // per edge
 @group(0) @binding(9) var<storage, read> counters: array<u32, 16>;
@@ -63,15 +63,12 @@ fn moved_faces(c: EdgeCandidate) -> f32 {
 
 @compute @workgroup_size(256)
 fn edge_costs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let e = gid.x + gid.y * nwg.x * WG;
-    if (e >= edge_offsets[params.vertex_count] || edge_state[e] != STATE_CANDIDATE) {
+    let i = gid.x + gid.y * nwg.x * WG;
+    if (i >= counters[C_LIVE]) {
         return;
     }
+    let e = live[i];
     let c = candidates[e];
-    if (c.cost_bits >= counters[C_CEILING]) {
-        edge_state[e] = STATE_OUT;
-        return;
-    }
     let priority = moved_faces(c);
     if (priority < 0.0) {
         candidates[e] = invalid_candidate();

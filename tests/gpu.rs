@@ -111,8 +111,8 @@ fn each_stage_matches_its_cpu_twin() {
             cpu.histogram.iter().sum::<u32>(),
             "{name}: edges with a placement"
         );
-        // cost_ceiling on the GPU's histogram must find the GPU's ceiling; edge_costs then runs
-        // on the CPU with it.
+        // cost_ceiling on the GPU's histogram must find the GPU's ceiling; live_list and
+        // edge_costs then run on the CPU with it.
         meshslim::cpu::cost_ceiling::cost_ceiling(
             &p,
             &g_hist,
@@ -120,6 +120,16 @@ fn each_stage_matches_its_cpu_twin() {
         );
         assert_eq!(cpu.counters[2], gc.ceiling, "{name}: cost_ceiling");
         cpu.costs_under_ceiling(&p);
+        // live_list: the same candidates, in the GPU's order of arrival.
+        let mut g_live: Vec<u32> = pod(rd("live", 4 * gc.live as usize));
+        g_live.sort_unstable();
+        let under = |c: &EdgeCandidate| c.cost_bits < gc.ceiling;
+        let cpu_under: Vec<u32> = (0..ne as u32)
+            .filter(|&e| under(&errors[e as usize]))
+            .collect();
+        assert_eq!(gc.live as usize, cpu.live.len(), "{name}: live count");
+        assert_eq!(g_live, cpu.live, "{name}: live list");
+        assert_eq!(cpu.live, cpu_under, "{name}: live list is the edges under the ceiling");
         // edge_costs, compared through the candidates. The GPU's candidates are read after its
         // whole round: validate has only added face counts.
         let g_cand: Vec<EdgeCandidate> = pod(rd("candidates", size_of::<EdgeCandidate>() * ne));
@@ -161,6 +171,7 @@ fn each_stage_matches_its_cpu_twin() {
             })
             .collect();
         cpu.candidates = g_cand;
+        cpu.live = g_live;
         // select_cost, select_id, select_win, validate, and the trim stages.
         cpu.select(&p, ne as u32);
         assert_eq!(
@@ -169,7 +180,7 @@ fn each_stage_matches_its_cpu_twin() {
             "{name}: edge_state after selection"
         );
         // dispatch_args, as it last ran: after the last pass's select_win.
-        let mut args = [0u32; 8];
+        let mut args = [0u32; 12];
         meshslim::cpu::dispatch_args::dispatch_args(
             &p,
             &cpu.edge_offsets,
@@ -177,7 +188,7 @@ fn each_stage_matches_its_cpu_twin() {
             &mut args,
         );
         assert_eq!(
-            pod::<u32>(rd("dispatch", 32)),
+            pod::<u32>(rd("dispatch", 48)),
             args,
             "{name}: dispatch_args"
         );

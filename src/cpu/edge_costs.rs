@@ -2,16 +2,15 @@
 //! round's cost ceiling, the faces that move: no normal may turn past the angle limit (against
 //! the current and the input normal), no needle may appear, and the worst new quality scales
 //! the error up to the priority the selection ranks by (MeshLab-style). The ceiling picks the
-//! edges that compete by their error; the priority orders them. Edges over the ceiling drop out
-//! unchecked: on the 1M scan at 1%, checking the moved faces of every edge was half the run.
+//! edges that compete by their error; the priority orders them. Edges over the ceiling dropped
+//! out unchecked (`live_list`): on the 1M scan at 1%, checking the moved faces of every edge was half the run.
 //! The topological checks (link condition, border pinch, lone triangle, tetrahedral fold) scan
 //! both endpoints' neighbourhoods and rarely fail on a manifold, so they run in `validate`,
 //! only for the edges that win a selection pass.
 
 use super::common::*;
-use super::{face_of, faces_of};
+use super::{Scatter, face_of, faces_of, par_for};
 use crate::gpu::types::{Counters, EdgeCandidate, Params, state};
-use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// The priority of collapsing `c` (its error, as `edge_errors` wrote it, scaled by the worst
@@ -75,51 +74,51 @@ pub fn moved_faces(
     priority.is_finite().then_some(priority)
 }
 
-/// Per edge (`edge_capacity` invocations; those past the edge count stop at once): a candidate
-/// under the ceiling gets its priority or drops out as invalid; the others drop out.
+/// Per listed candidate (`live_list`): its priority, or it drops out as invalid.
 #[allow(clippy::too_many_arguments)]
 pub fn edge_costs(
     params: &Params,
-    positions: &[[f32; 4]],           // per vertex
-    indices: &[u32],                  // per face × 3
-    offsets: &[u32],                  // per vertex + 1
-    vertex_faces: &[u32],             // per corner
-    face_normals: &[[f32; 4]],        // per face
-    edge_offsets: &[u32],             // per vertex + 1: the edge count at [vertex_count]
-    candidates: &mut [EdgeCandidate], // per edge
-    edge_state: &mut [u32],           // per edge
-    counters: &[AtomicU32],           // Counters, with the ceiling
+    positions: &[[f32; 4]],             // per vertex
+    indices: &[u32],                    // per face × 3
+    offsets: &[u32],                    // per vertex + 1
+    vertex_faces: &[u32],               // per corner
+    face_normals: &[[f32; 4]],          // per face
+    live: &[u32],                       // per listed candidate
+    candidates: Scatter<EdgeCandidate>, // per edge
+    edge_state: Scatter<u32>,           // per edge
+    counters: &[AtomicU32],
 ) {
-    let ne = edge_offsets[params.vertex_count as usize] as usize;
-    let ceiling = counter(counters, CounterField::Ceiling).load(Relaxed);
-    candidates[..ne]
-        .par_iter_mut()
-        .zip(&mut edge_state[..ne])
-        .with_min_len(256)
-        .for_each(|(c, st)| {
-            if *st != state::CANDIDATE {
-                return;
-            }
-            if c.cost_bits >= ceiling {
-                *st = state::OUT;
-                return;
-            }
-            match moved_faces(
-                params,
-                positions,
-                indices,
-                offsets,
-                vertex_faces,
-                face_normals,
-                c,
-            ) {
-                Some(priority) => c.cost_bits = priority.to_bits(),
-                None => {
-                    *c = EdgeCandidate::INVALID;
-                    *st = state::OUT;
-                }
-            }
-        });
+    let n = counter(counters, CounterField::Live).load(Relaxed);
+    par_for(n, |i| {
+        let e = live[i as usize] as usize;
+        // SAFETY: the live list holds each edge once, so this invocation alone touches slot e.
+        let c = unsafe { candidates.read(e) };
+        match moved_faces(
+            params,
+            positions,
+            indices,
+            offsets,
+            vertex_faces,
+            face_normals,
+            &c,
+        ) {
+            // SAFETY: as above.
+            Some(priority) => unsafe {
+                candidates.write(
+                    e,
+                    EdgeCandidate {
+                        cost_bits: priority.to_bits(),
+                        ..c
+                    },
+                )
+            },
+            // SAFETY: as above.
+            None => unsafe {
+                candidates.write(e, EdgeCandidate::INVALID);
+                edge_state.write(e, state::OUT);
+            },
+        }
+    });
 }
 
 /// Fields of [`Counters`] by position, for the atomic view of the buffer.
@@ -136,6 +135,7 @@ pub enum CounterField {
     VerticesOut = 8,
     FacesOut = 9,
     Tentative = 10,
+    Live = 11,
 }
 
 pub fn counter(counters: &[AtomicU32], f: CounterField) -> &AtomicU32 {

@@ -17,6 +17,7 @@ pub mod edge_costs;
 pub mod edge_errors;
 pub mod edges;
 pub mod face_planes;
+pub mod live_list;
 pub mod prefix_sum;
 pub mod select;
 pub mod trim;
@@ -162,6 +163,7 @@ pub struct CpuRounds {
     /// The edge errors' histogram, kept through the round (tests read it).
     pub histogram: Vec<u32>,
     pub trim_histogram: Vec<u32>,
+    pub live: Vec<u32>,
     pub face_best: Vec<u32>,
     pub face_id: Vec<u32>,
     pub face_lock: Vec<u32>,
@@ -303,6 +305,21 @@ impl CpuRounds {
         self.costs_under_ceiling(p);
     }
 
+    /// `live_list` then `edge_costs`, with the ceiling in the counters.
+    pub fn costs_under_ceiling(&mut self, p: &Params) {
+        self.time("live_list", |s| {
+            live_list::live_list(
+                p,
+                &s.edge_offsets,
+                &s.candidates,
+                &mut s.edge_state,
+                atomics(&mut s.counters),
+                &mut s.live,
+            )
+        });
+        self.listed_costs(p);
+    }
+
     /// `edge_errors`: placements, errors and their histogram.
     pub fn errors(&mut self, p: &Params, ne: u32) {
         self.time("edge_errors", |s| {
@@ -328,8 +345,8 @@ impl CpuRounds {
         });
     }
 
-    /// `edge_costs`, with the ceiling in the counters.
-    pub fn costs_under_ceiling(&mut self, p: &Params) {
+    /// `edge_costs` over the live list.
+    pub fn listed_costs(&mut self, p: &Params) {
         self.time("edge_costs", |s| {
             edge_costs::edge_costs(
                 p,
@@ -338,9 +355,9 @@ impl CpuRounds {
                 &s.offsets,
                 &s.vertex_faces,
                 &s.face_normals,
-                &s.edge_offsets,
-                &mut s.candidates,
-                &mut s.edge_state,
+                &s.live,
+                Scatter::new(&mut s.candidates),
+                Scatter::new(&mut s.edge_state),
                 atomics(&mut s.counters),
             );
         });
@@ -364,11 +381,10 @@ impl CpuRounds {
             );
             let (best, id) = (atomics(&mut s.face_best), atomics(&mut s.face_id));
             select::select_cost(
-                p,
                 &s.offsets,
                 &s.vertex_faces,
                 &s.edges,
-                &s.edge_offsets,
+                &s.live,
                 &s.candidates,
                 lock,
                 counters,
@@ -377,23 +393,22 @@ impl CpuRounds {
             );
             let t1 = Instant::now();
             select::select_id(
-                p,
                 &s.offsets,
                 &s.vertex_faces,
                 &s.edges,
-                &s.edge_offsets,
+                &s.live,
                 &s.candidates,
                 best,
                 st,
                 id,
+                counters,
             );
             let t2 = Instant::now();
             select::select_win(
-                p,
                 &s.offsets,
                 &s.vertex_faces,
                 &s.edges,
-                &s.edge_offsets,
+                &s.live,
                 &s.candidates,
                 best,
                 id,

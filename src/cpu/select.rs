@@ -1,5 +1,5 @@
 //! Twins of shaders/select_cost.wgsl, select_id.wgsl and select_win.wgsl: one pass of the
-//! independent-set selection. An edge wins when its key (cost bits, then edge id) is the
+//! independent-set selection, one invocation per candidate on the live list. An edge wins when its key (cost bits, then edge id) is the
 //! smallest over every candidate touching any face around either endpoint: 32-bit atomicMax of
 //! inverted keys per face, first on the cost, then on a hash of the id among equal costs (64-bit atomics
 //! are not portable). Two winners then share no face, so the checks each passed in
@@ -10,7 +10,7 @@
 use super::common::tie_rank;
 use super::edge_costs::{CounterField, counter};
 use super::{Scatter, faces_of, par_for};
-use crate::gpu::types::{EdgeCandidate, Params, state};
+use crate::gpu::types::{EdgeCandidate, state};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// Faces around either endpoint of edge `e` (those on the edge come twice, harmlessly).
@@ -24,18 +24,17 @@ fn around<'a>(
     la.iter().chain(lb).copied()
 }
 
-/// Invocations of the per-edge passes: the edge count, from the edge prefix sum.
-fn edge_count(params: &Params, edge_offsets: &[u32]) -> u32 {
-    edge_offsets[params.vertex_count as usize]
+/// Invocations of the passes: one per candidate on the live list.
+fn live_count(counters: &[AtomicU32]) -> u32 {
+    counter(counters, CounterField::Live).load(Relaxed)
 }
 
 #[allow(clippy::too_many_arguments)]
 pub fn select_cost(
-    params: &Params,
     offsets: &[u32],
     vertex_faces: &[u32],
     edges: &[[u32; 2]],
-    edge_offsets: &[u32],
+    live: &[u32], // per listed candidate
     candidates: &[EdgeCandidate],
     face_lock: &[AtomicU32], // per face
     counters: &[AtomicU32],
@@ -43,8 +42,8 @@ pub fn select_cost(
     face_best: &[AtomicU32],  // per face, cleared
 ) {
     let any_locked = counter(counters, CounterField::Winners).load(Relaxed) > 0;
-    par_for(edge_count(params, edge_offsets), |e| {
-        let e = e as usize;
+    par_for(live_count(counters), |i| {
+        let e = live[i as usize] as usize;
         if edge_state[e].load(Relaxed) != state::CANDIDATE {
             return;
         }
@@ -71,17 +70,18 @@ pub fn select_cost(
 
 #[allow(clippy::too_many_arguments)]
 pub fn select_id(
-    params: &Params,
     offsets: &[u32],
     vertex_faces: &[u32],
     edges: &[[u32; 2]],
-    edge_offsets: &[u32],
+    live: &[u32], // per listed candidate
     candidates: &[EdgeCandidate],
     face_best: &[AtomicU32],
     edge_state: &[AtomicU32],
     face_id: &[AtomicU32], // per face, cleared
+    counters: &[AtomicU32],
 ) {
-    par_for(edge_count(params, edge_offsets), |e| {
+    par_for(live_count(counters), |i| {
+        let e = live[i as usize];
         let eu = e as usize;
         if edge_state[eu].load(Relaxed) != state::CANDIDATE {
             return;
@@ -106,11 +106,10 @@ pub fn select_id(
 
 #[allow(clippy::too_many_arguments)]
 pub fn select_win(
-    params: &Params,
     offsets: &[u32],
     vertex_faces: &[u32],
     edges: &[[u32; 2]],
-    edge_offsets: &[u32],
+    live: &[u32], // per listed candidate
     candidates: &[EdgeCandidate],
     face_best: &[AtomicU32],
     face_id: &[AtomicU32],
@@ -118,7 +117,8 @@ pub fn select_win(
     tentative: Scatter<u32>, // per winner of the pass
     counters: &[AtomicU32],
 ) {
-    par_for(edge_count(params, edge_offsets), |e| {
+    par_for(live_count(counters), |i| {
+        let e = live[i as usize];
         let eu = e as usize;
         if edge_state[eu].load(Relaxed) != state::CANDIDATE {
             return;

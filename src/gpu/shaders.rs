@@ -57,6 +57,11 @@ pub const STAGES: &[(&str, &[&str], &str)] = &[
         include_str!("../../shaders/edge_errors.wgsl"),
     ),
     (
+        "live_list",
+        &["live_list"],
+        include_str!("../../shaders/live_list.wgsl"),
+    ),
+    (
         "edge_costs",
         &["edge_costs"],
         include_str!("../../shaders/edge_costs.wgsl"),

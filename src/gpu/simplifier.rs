@@ -175,6 +175,8 @@ pub struct GpuRounds<'a> {
     /// The edge errors' histogram, kept through the round (tests read it).
     histogram: wgpu::Buffer,
     trim_histogram: wgpu::Buffer,
+    /// Candidates under the ceiling (`live_list`), in an order that depends on timing.
+    live: wgpu::Buffer,
     face_best: wgpu::Buffer,
     face_id: wgpu::Buffer,
     face_lock: wgpu::Buffer,
@@ -214,9 +216,11 @@ fn wg(n: u32) -> Grid {
     Grid::Direct(n.div_ceil(WG).max(1))
 }
 
-/// Byte offsets in the `dispatch` buffer: one grid per edge, one per tentative winner.
+/// Byte offsets in the `dispatch` buffer: one grid per edge, one per tentative winner, one per
+/// candidate on the live list.
 const PER_EDGE: Grid = Grid::Indirect(0);
 const PER_TENTATIVE: Grid = Grid::Indirect(16);
+const PER_LIVE: Grid = Grid::Indirect(32);
 const ONE: Grid = Grid::Direct(1);
 
 impl<'a> GpuRounds<'a> {
@@ -310,7 +314,8 @@ impl<'a> GpuRounds<'a> {
             face_keep: mk("face_keep", (nf + 1) * 4, SU)?,
             marks: mk("marks", (cap + 1) * 4, SU)?,
             tentative: mk("tentative", cap * 4, SU)?,
-            dispatch: mk("dispatch", 32, SU | wgpu::BufferUsages::INDIRECT)?,
+            dispatch: mk("dispatch", 48, SU | wgpu::BufferUsages::INDIRECT)?,
+            live: mk("live", cap * 4, SU)?,
             neighbours: mk("neighbours", nf * 24, SU)?,
             block_sums: mk("block_sums", blocks * 4, SU)?,
             counters: mk("counters", 64, SU)?,
@@ -542,6 +547,7 @@ impl<'a> GpuRounds<'a> {
             "candidates" => &self.candidates,
             "edge_state" => &self.edge_state,
             "histogram" => &self.histogram,
+            "live" => &self.live,
             "remap" => &self.remap,
             "vertex_keep" => &self.vertex_keep,
             "face_keep" => &self.face_keep,
@@ -726,13 +732,26 @@ impl RoundRunner for GpuRounds<'_> {
             PER_EDGE,
         );
         self.pass(&mut enc, "cost_ceiling", &[&params, &hist, &counters], ONE);
+        let live = c(&self.live);
+        self.pass(
+            &mut enc,
+            "live_list",
+            &[&params, &eoff, &cand, &est, &counters, &live],
+            PER_EDGE,
+        );
+        self.pass(
+            &mut enc,
+            "dispatch_args",
+            &[&params, &eoff, &counters, &dispatch],
+            ONE,
+        );
         self.pass(
             &mut enc,
             "edge_costs",
             &[
-                &params, &pos, &idx, &offsets, &vf, &fnorm, &eoff, &cand, &est, &counters,
+                &params, &pos, &idx, &offsets, &vf, &fnorm, &live, &cand, &est, &counters,
             ],
-            PER_EDGE,
+            PER_LIVE,
         );
         enc.clear_buffer(&flock, 0, None);
         for _ in 0..self.selection_passes {
@@ -744,26 +763,25 @@ impl RoundRunner for GpuRounds<'_> {
                 &mut enc,
                 "select_cost",
                 &[
-                    &params, &offsets, &vf, &edges, &eoff, &cand, &flock, &counters, &est, &fbest,
+                    &offsets, &vf, &edges, &live, &cand, &flock, &counters, &est, &fbest,
                 ],
-                PER_EDGE,
+                PER_LIVE,
             );
             self.pass(
                 &mut enc,
                 "select_id",
                 &[
-                    &params, &offsets, &vf, &edges, &eoff, &cand, &fbest, &est, &fid,
+                    &offsets, &vf, &edges, &live, &cand, &fbest, &est, &fid, &counters,
                 ],
-                PER_EDGE,
+                PER_LIVE,
             );
             self.pass(
                 &mut enc,
                 "select_win",
                 &[
-                    &params, &offsets, &vf, &edges, &eoff, &cand, &fbest, &fid, &est, &tent,
-                    &counters,
+                    &offsets, &vf, &edges, &live, &cand, &fbest, &fid, &est, &tent, &counters,
                 ],
-                PER_EDGE,
+                PER_LIVE,
             );
             self.pass(
                 &mut enc,

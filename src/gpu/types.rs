@@ -109,7 +109,9 @@ pub struct Counters {
     pub faces_out: u32,
     /// Tentative winners listed by `select_win` in this pass (reset before each pass).
     pub tentative: u32,
-    pub _pad: [u32; 5],
+    /// Candidates under the ceiling, listed by `live_list` for the per-candidate stages.
+    pub live: u32,
+    pub _pad: [u32; 4],
 }
 
 /// A vertex's quadric in f32, relative to the vertex's own position: `E(y) = yᵀAy + 2bᵀy + c`
