@@ -1,7 +1,7 @@
 // Each winner moves its survivor to the new position with both quadrics re-centred there and
 // summed, carries the border bit, and points the removed vertex at the survivor; when the
 // survivor is a seam vertex, the removed vertex's corners take their attribute vertices by the
-// seam rule edge_costs checked. Winners share no face, hence no vertex, so these writes never
+// seam rule edge_errors checked. Winners share no face, hence no vertex, so these writes never
 // meet.
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -26,7 +26,7 @@ fn mapped(m: vec4<u32>, a: u32) -> u32 {
 }
 
 // The removed vertex r's corners onto seam vertex k: the map from the faces on the edge (locked
-// since edge_costs checked it): each side's pair for a seam vertex sliding along its seam, k's
+// since edge_errors checked it): each side's pair for a seam vertex sliding along its seam, k's
 // attribute vertex for all corners of a free one.
 fn onto_seam_corners(k: u32, r: u32) {
     let slides = (flags[r] & FLAG_SEAM) != 0u;

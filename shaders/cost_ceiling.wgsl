@@ -1,5 +1,5 @@
 // One invocation: the cost ceiling of this round, the smallest histogram bin boundary below
-// which at least ceiling_wanted candidates lie. Relies on the histogram of edge_costs.
+// which at least ceiling_wanted candidates lie. Relies on the histogram of edge_errors.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> histogram: array<u32>;               // HIST_BINS

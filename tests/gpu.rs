@@ -129,7 +129,10 @@ fn each_stage_matches_its_cpu_twin() {
             .collect();
         assert_eq!(gc.live as usize, cpu.live.len(), "{name}: live count");
         assert_eq!(g_live, cpu.live, "{name}: live list");
-        assert_eq!(cpu.live, cpu_under, "{name}: live list is the edges under the ceiling");
+        assert_eq!(
+            cpu.live, cpu_under,
+            "{name}: live list is the edges under the ceiling"
+        );
         // edge_costs, compared through the candidates. The GPU's candidates are read after its
         // whole round: validate has only added face counts.
         let g_cand: Vec<EdgeCandidate> = pod(rd("candidates", size_of::<EdgeCandidate>() * ne));

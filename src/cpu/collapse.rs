@@ -1,7 +1,7 @@
 //! Twin of shaders/collapse.wgsl: each winner moves its survivor to the new position, gives it
 //! the sum of both quadrics (re-centred on the new position) and the removed vertex's border
 //! bit, and points the removed vertex at the survivor; when the survivor is a seam vertex, the
-//! removed vertex's corners take their attribute vertices by the seam rule `edge_costs`
+//! removed vertex's corners take their attribute vertices by the seam rule `edge_errors`
 //! checked. Winners share no face, hence no vertex, so these writes never meet.
 
 use super::common::{quadric_add, quadric_shift, sub, xyz};
@@ -39,7 +39,7 @@ impl Corners<'_> {
     }
 
     /// The removed vertex `r`'s corners onto seam vertex `k`: the map from the faces on the
-    /// edge (locked since `edge_costs` checked it): each side's pair for a seam vertex sliding
+    /// edge (locked since `edge_errors` checked it): each side's pair for a seam vertex sliding
     /// along its seam, `k`'s attribute vertex for all corners of a free one.
     ///
     /// # Safety

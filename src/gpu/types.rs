@@ -89,11 +89,11 @@ pub struct ScanParams {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct Counters {
-    /// Valid edges after `edge_costs`.
+    /// Edges with a placement under the maximum error, after `edge_errors`.
     pub candidates: u32,
     /// Edges refused only because their error exceeds the maximum.
     pub over_max_error: u32,
-    /// Cost bits below which candidates compete (from `cost_ceiling`).
+    /// Error bits below which candidates compete (from `cost_ceiling`, on the errors).
     pub ceiling: u32,
     /// Winners confirmed by `validate`, summed over the passes.
     pub winners: u32,
@@ -133,8 +133,8 @@ pub struct EdgeCandidate {
     pub pos: [f32; 4],
     pub keep: u32,
     pub remove: u32,
-    /// f32 bits of the quadric error from `edge_costs`, raised to the full priority (error
-    /// scaled by triangle quality) by `validate`; INVALID_COST if invalid.
+    /// f32 bits of the quadric error from `edge_errors`, raised to the full priority (error
+    /// scaled by triangle quality) by `edge_costs` under the ceiling; INVALID_COST if invalid.
     pub cost_bits: u32,
     /// Faces on the edge, 1 (border) or 2, what the collapse removes; set by `validate`.
     pub faces: u32,
@@ -154,7 +154,7 @@ impl EdgeCandidate {
 /// No attribute vertex, in the seam rules' attribute maps: (from, to) pairs for the removed
 /// vertex's corners when the survivor is a seam vertex, `[NO_ATTR, to, NO_ATTR, NO_ATTR]` for a
 /// free vertex moving onto the seam (all its corners take `to`), `[from₁, to₁, from₂, to₂]` for
-/// a seam vertex sliding along its seam (one pair per side). `edge_costs` checks that the map
+/// a seam vertex sliding along its seam (one pair per side). `edge_errors` checks that the map
 /// exists, `collapse` makes it again from the faces on the edge (locked and unchanged in
 /// between): 16 more bytes per candidate would put the 1M scan's candidate buffer over
 /// lavapipe's 128 MiB binding limit.
