@@ -3,7 +3,7 @@
 //! the result becomes a [`Mesh`] again. The backends only run the stages ([`RoundRunner`]).
 
 use crate::error::Result;
-use crate::gpu::types::{Counters, FaceExtra, Params, flag};
+use crate::gpu::types::{Counters, FaceExtra, INVALID_COST, Params, flag};
 use crate::mesh::{Mesh, weld, weld::position_classes};
 use crate::simplify::{SimplifyOptions, SimplifyReport, StopReason};
 use rayon::prelude::*;
@@ -353,7 +353,7 @@ impl Driver {
             }
             self.cancel.check()?;
             let needed = nf - target;
-            let params = Params {
+            let mut params = Params {
                 vertex_count: nv,
                 face_count: nf,
                 target_faces: target,
@@ -367,8 +367,16 @@ impl Driver {
                 trim: ((needed as f64) < TRIM_SHARE * nf as f64) as u32,
                 ..self.base
             };
-            let c = runner.round(&params, self.first)?;
+            let mut c = runner.round(&params, self.first)?;
             self.first = false;
+            if c.faces_out == nf && c.ceiling != INVALID_COST {
+                // The ceiling is picked from the edges' errors, lower bounds of their priorities
+                // that know nothing of flips: every candidate under it may have failed while
+                // valid edges wait above it. Let every edge compete before concluding that none
+                // can go (the round changed nothing, so it runs again on the same mesh).
+                params.ceiling_wanted = u32::MAX;
+                c = runner.round(&params, false)?;
+            }
             if c.faces_out > nf || c.vertices_out > nv {
                 return Err(crate::error::Error::Internal(format!(
                     "round {} grew the mesh: {nf} -> {} faces",
@@ -442,4 +450,54 @@ pub fn simplify_rounds(
         rounds: Some(rounds_report),
     };
     Ok((out, report))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::grid;
+
+    /// A runner whose rounds find nothing under a finite ceiling (every candidate there fails)
+    /// and collapse one interior edge when every edge competes.
+    struct FailsUnderCeiling {
+        calls: Vec<u32>,
+    }
+
+    impl RoundRunner for FailsUnderCeiling {
+        fn round(&mut self, p: &Params, _first: bool) -> Result<Counters> {
+            self.calls.push(p.ceiling_wanted);
+            let all = p.ceiling_wanted == u32::MAX;
+            Ok(Counters {
+                candidates: 10,
+                ceiling: if all { INVALID_COST } else { 5 << 20 },
+                winners: all as u32,
+                vertices_out: p.vertex_count - all as u32,
+                faces_out: p.face_count - 2 * all as u32,
+                ..Default::default()
+            })
+        }
+        fn download(&mut self) -> Result<Download> {
+            unreachable!("the test reads the driver only")
+        }
+        fn stage_times(&self) -> &StageTimes {
+            unreachable!("the test reads the driver only")
+        }
+    }
+
+    #[test]
+    fn a_round_without_winners_under_its_ceiling_runs_again_without_it() {
+        let mesh = grid(8);
+        let up = Upload::new(&mesh);
+        let faces = mesh.triangles.len();
+        let opts = SimplifyOptions::with_faces(faces - 4);
+        let mut driver = Driver::new(&up, &opts);
+        let mut runner = FailsUnderCeiling { calls: Vec::new() };
+        let reason = driver.run_to(&mut runner, faces - 4, &mut |_| {}).unwrap();
+        assert_eq!(reason, StopReason::TargetReached);
+        assert_eq!(driver.faces, faces - 4);
+        // Two rounds, each tried under its ceiling first.
+        assert_eq!(runner.calls.len(), 4);
+        assert!(runner.calls[0] < u32::MAX && runner.calls[1] == u32::MAX);
+        assert!(runner.calls[2] < u32::MAX && runner.calls[3] == u32::MAX);
+    }
 }
