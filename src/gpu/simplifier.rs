@@ -440,6 +440,18 @@ impl<'a> GpuRounds<'a> {
         self.pass(enc, "prefix_sum_apply", &[&s, &d, &b], Grid::Direct(blocks));
     }
 
+    /// `dispatch_args`: the indirect grids from the current counts (edges, the pass's tentative
+    /// winners, the live list), before the stages that dispatch from them.
+    fn dispatch_args(&mut self, enc: &mut wgpu::CommandEncoder) {
+        let (p, e, c, d) = (
+            self.params.clone(),
+            self.edge_offsets.clone(),
+            self.counters.clone(),
+            self.dispatch.clone(),
+        );
+        self.pass(enc, "dispatch_args", &[&p, &e, &c, &d], ONE);
+    }
+
     fn buf(&self, name: &str) -> wgpu::Buffer {
         match name {
             "scan_v" => self.scan_v.clone(),
@@ -714,13 +726,7 @@ impl RoundRunner for GpuRounds<'_> {
             &[&params, &offsets, &nbrs, &eoff, &edges],
             wg(nv),
         );
-        let dispatch = c(&self.dispatch);
-        self.pass(
-            &mut enc,
-            "dispatch_args",
-            &[&params, &eoff, &counters, &dispatch],
-            ONE,
-        );
+        self.dispatch_args(&mut enc);
         enc.clear_buffer(&hist, 0, None);
         self.pass(
             &mut enc,
@@ -739,12 +745,7 @@ impl RoundRunner for GpuRounds<'_> {
             &[&params, &eoff, &cand, &est, &counters, &live],
             PER_EDGE,
         );
-        self.pass(
-            &mut enc,
-            "dispatch_args",
-            &[&params, &eoff, &counters, &dispatch],
-            ONE,
-        );
+        self.dispatch_args(&mut enc);
         self.pass(
             &mut enc,
             "edge_costs",
@@ -783,12 +784,7 @@ impl RoundRunner for GpuRounds<'_> {
                 ],
                 PER_LIVE,
             );
-            self.pass(
-                &mut enc,
-                "dispatch_args",
-                &[&params, &eoff, &counters, &dispatch],
-                ONE,
-            );
+            self.dispatch_args(&mut enc);
             self.pass(
                 &mut enc,
                 "validate",
