@@ -905,8 +905,9 @@ fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     }
     let t = Instant::now();
     progress
-        .spinner(format!("writing {}", output.display()), || {
-            crate::io::write(&output, &simplified)
+        .spinner(format!("writing {}", output.display()), || match &input {
+            Input::File(from) => crate::io::write_from(&output, &simplified, from),
+            Input::Builtin { .. } => crate::io::write(&output, &simplified),
         })
         .map_err(lib)
         .context("cannot write the output")?;

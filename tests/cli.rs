@@ -556,3 +556,30 @@ fn writing_a_poorer_format_says_what_it_drops() {
         assert!(!stderr(&o).contains("note:"), "-q: {}", stderr(&o));
     }
 }
+
+#[test]
+fn an_obj_written_to_another_folder_still_finds_its_material_library() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("scan")).unwrap();
+    std::fs::create_dir_all(dir.path().join("out")).unwrap();
+    let mut m = meshslim::mesh::noisy_sphere(3, 0.001, 2);
+    m.material_libs = vec!["scan.mtl".into()];
+    m.materials = vec![meshslim::Material::named("skin")];
+    m.face_materials = Some(vec![0; m.triangles.len()]);
+    meshslim::io::write(&dir.path().join("scan/scan.obj"), &m).unwrap();
+    std::fs::write(dir.path().join("scan/scan.mtl"), "newmtl skin\nKd 1 0 0\n").unwrap();
+    let o = meshslim(
+        &[
+            "simplify",
+            "scan/scan.obj",
+            "out/small.obj",
+            "--ratio",
+            "0.5",
+        ],
+        dir.path(),
+    );
+    expect_code(&o, 0);
+    let text = std::fs::read_to_string(dir.path().join("out/small.obj")).unwrap();
+    assert!(text.contains("\nmtllib ../scan/scan.mtl\n"), "{text:.200}");
+    assert!(!stderr(&o).contains("does not keep"), "{}", stderr(&o));
+}

@@ -631,6 +631,51 @@ fn obj_groups_materials_and_missing_mtl() {
     assert_eq!(m.face_materials, Some(vec![2, 0, 0, 1, 1]));
 }
 
+/// The `mtllib` lines of an OBJ file.
+fn mtllibs(path: &Path) -> Vec<String> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("mtllib "))
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn obj_material_libraries_are_found_from_another_folder() {
+    let dir = tmp();
+    for sub in ["scans/raw", "out", "lib"] {
+        std::fs::create_dir_all(dir.path().join(sub)).unwrap();
+    }
+    write_text(
+        &dir.path().join("scans/raw"),
+        "skin.mtl",
+        "newmtl skin\nKd 1 0 0\n",
+    );
+    write_text(&dir.path().join("lib"), "shared.mtl", "newmtl metal\n");
+    let text = "mtllib skin.mtl\nmtllib ../../lib/shared.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n\
+                usemtl skin\nf 1 2 3\n";
+    let input = write_text(&dir.path().join("scans/raw"), "a.obj", text);
+    let m = io::read(&input).unwrap();
+
+    // Written elsewhere, each name leads from the output's folder to the same library.
+    let out = dir.path().join("out/a-small.obj");
+    io::write_from(&out, &m, &input).unwrap();
+    let libs = mtllibs(&out);
+    assert_eq!(libs, ["../scans/raw/skin.mtl", "../lib/shared.mtl"]);
+    for lib in &libs {
+        assert!(out.parent().unwrap().join(lib).is_file(), "{lib}");
+    }
+    assert_eq!(io::read(&out).unwrap().material_libs, libs);
+
+    // Beside the input, the names stay as they were read, bit for bit.
+    let beside = dir.path().join("scans/raw/a-small.obj");
+    io::write_from(&beside, &m, &input).unwrap();
+    assert_eq!(mtllibs(&beside), ["skin.mtl", "../../lib/shared.mtl"]);
+    // Other formats have no mtllib to move.
+    io::write_from(&dir.path().join("out/a.ply"), &m, &input).unwrap();
+}
+
 #[test]
 fn obj_agrees_with_tobj() {
     let dir = tmp();

@@ -171,6 +171,56 @@ pub fn not_kept(mesh: &Mesh, format: Format) -> Vec<String> {
     lost
 }
 
+/// Writes `mesh`, read from the file `input`, to `path` as [`write`] does, with an OBJ's
+/// material libraries named from the output's folder: `mtllib` names are relative to the OBJ
+/// that names them, so a simplified scan written to another folder would lose its colours and
+/// textures with the names kept verbatim.
+pub fn write_from(path: &Path, mesh: &Mesh, input: &Path) -> Result<()> {
+    let format = Format::from_path(path)?;
+    if format != Format::Obj || mesh.material_libs.is_empty() {
+        return write_format(path, mesh, format, &WriteOptions::default());
+    }
+    let libs = relocate_material_libs(&mesh.material_libs, input, path);
+    mesh.validate()?;
+    write_atomic(path, |w| obj::write_obj_libs(w, mesh, &libs))
+}
+
+/// `libs`, named relative to the folder of `input`, named relative to the folder of `output`:
+/// unchanged when both are the same folder (or a name is absolute), else a `/`-separated path
+/// from the output's folder (absolute when there is none, as between Windows drives).
+pub fn relocate_material_libs(libs: &[String], input: &Path, output: &Path) -> Vec<String> {
+    let folder = |p: &Path| {
+        let d = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        std::fs::canonicalize(d)
+            .or_else(|_| std::path::absolute(d))
+            .unwrap_or_else(|_| d.to_path_buf())
+    };
+    let (from, to) = (folder(input), folder(output));
+    if from == to {
+        return libs.to_vec();
+    }
+    libs.iter()
+        .map(|lib| {
+            if Path::new(lib).is_absolute() {
+                return lib.clone();
+            }
+            // Canonical when it exists, so `../` in the name does not come back twice.
+            let target = std::fs::canonicalize(from.join(lib)).unwrap_or_else(|_| from.join(lib));
+            match pathdiff::diff_paths(&target, &to) {
+                Some(rel) => rel
+                    .components()
+                    .map(|c| c.as_os_str().to_string_lossy())
+                    .collect::<Vec<_>>()
+                    .join("/"),
+                None => target.to_string_lossy().into_owned(),
+            }
+        })
+        .collect()
+}
+
 /// Writes a mesh, the format chosen by the file extension.
 pub fn write_with(path: &Path, mesh: &Mesh, options: &WriteOptions) -> Result<()> {
     write_format(path, mesh, Format::from_path(path)?, options)

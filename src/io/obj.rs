@@ -397,6 +397,11 @@ fn in_first_use_order(per_face: &[u32], count: usize) -> bool {
 /// in the same order from first appearance, all names are declared once up front.
 /// Every number is written with Rust's `{}`, which reads back bit-exact.
 pub fn write_obj<W: Write>(w: &mut W, mesh: &Mesh) -> io::Result<()> {
+    write_obj_libs(w, mesh, &mesh.material_libs)
+}
+
+/// [`write_obj`] with `libs` as the `mtllib` names (the mesh's, relocated for another folder).
+pub fn write_obj_libs<W: Write>(w: &mut W, mesh: &Mesh, libs: &[String]) -> io::Result<()> {
     use std::fmt::Write as _;
     let mut out = String::with_capacity(1 << 16);
     let flush = |out: &mut String, w: &mut W| -> io::Result<()> {
@@ -405,7 +410,7 @@ pub fn write_obj<W: Write>(w: &mut W, mesh: &Mesh) -> io::Result<()> {
         Ok(())
     };
     out.push_str("# written by meshslim\n");
-    for lib in &mesh.material_libs {
+    for lib in libs {
         let _ = writeln!(out, "mtllib {}", one_line(lib));
     }
     for (i, p) in mesh.positions.iter().enumerate() {

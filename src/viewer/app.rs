@@ -553,7 +553,12 @@ impl ViewerApp {
         self.status = if same_as_input {
             format!("{}: that is the input; choose another file", out.display())
         } else {
-            match crate::io::write(&out, &s.mesh) {
+            let input = self.model.as_ref().and_then(|m| m.path.as_ref());
+            let written = match input {
+                Some(from) => crate::io::write_from(&out, &s.mesh, from),
+                None => crate::io::write(&out, &s.mesh),
+            };
+            match written {
                 Ok(()) => {
                     let mut msg =
                         format!("saved {} ({} faces)", out.display(), s.mesh.triangles.len());
