@@ -14,7 +14,7 @@
 @group(0) @binding(6) var<storage, read> live: array<u32>;                   // per listed candidate
 @group(0) @binding(7) var<storage, read_write> candidates: array<EdgeCandidate>; // per edge
 @group(0) @binding(8) var<storage, read_write> edge_state: array<u32>;      // per edge
-@group(0) @binding(9) var<storage, read> counters: array<u32, 16>;
+@group(0) @binding(9) var<storage, read_write> counters: array<atomic<u32>, 16>;
 
 // The priority of collapsing c (its error scaled by the worst quality of the faces that move),
 // or -1 when a moving face would flip or become a needle.
@@ -64,7 +64,7 @@ fn moved_faces(c: EdgeCandidate) -> f32 {
 @compute @workgroup_size(256)
 fn edge_costs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * WG;
-    if (i >= counters[C_LIVE]) {
+    if (i >= atomicLoad(&counters[C_LIVE])) {
         return;
     }
     let e = live[i];
@@ -73,6 +73,9 @@ fn edge_costs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     if (priority < 0.0) {
         candidates[e] = invalid_candidate();
         edge_state[e] = STATE_OUT;
+        // No longer a valid collapse: with every edge competing (the round the driver stops
+        // on) the count is exactly the valid edges under the maximum error.
+        atomicSub(&counters[C_CANDIDATES], 1u);
     } else {
         candidates[e].cost_bits = bitcast<u32>(priority);
     }

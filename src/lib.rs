@@ -11,7 +11,7 @@
 //!
 //! ```text
 //! adjacency (count, prefix sum, fill, sort) -> [face planes, vertex flags, quadrics]
-//!   -> unique edges -> edge costs -> cost ceiling
+//!   -> unique edges -> edge errors -> cost ceiling -> live list -> edge costs
 //!   -> passes of (select cost, select id, select win, validate) -> [trim] -> collapse -> compact
 //! ```
 //!

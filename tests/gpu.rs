@@ -120,18 +120,32 @@ fn each_stage_matches_its_cpu_twin() {
         );
         assert_eq!(cpu.counters[2], gc.ceiling, "{name}: cost_ceiling");
         cpu.costs_under_ceiling(&p);
-        // live_list: the same candidates, in the GPU's order of arrival.
+        // live_list: the same candidates, in the GPU's order of arrival. An edge whose error
+        // is within rounding of the ceiling may be listed on one side only, as in the histogram.
         let mut g_live: Vec<u32> = pod(rd("live", 4 * gc.live as usize));
         g_live.sort_unstable();
-        let under = |c: &EdgeCandidate| c.cost_bits < gc.ceiling;
-        let cpu_under: Vec<u32> = (0..ne as u32)
-            .filter(|&e| under(&errors[e as usize]))
-            .collect();
-        assert_eq!(gc.live as usize, cpu.live.len(), "{name}: live count");
-        assert_eq!(g_live, cpu.live, "{name}: live list");
-        assert_eq!(
-            cpu.live, cpu_under,
-            "{name}: live list is the edges under the ceiling"
+        assert!(
+            g_live.windows(2).all(|w| w[0] < w[1]),
+            "{name}: an edge listed twice"
+        );
+        let listed_once = g_live
+            .iter()
+            .filter(|e| cpu.live.binary_search(e).is_err())
+            .count()
+            + cpu
+                .live
+                .iter()
+                .filter(|e| g_live.binary_search(e).is_err())
+                .count();
+        assert!(
+            listed_once <= moved_bins as usize,
+            "{name}: {listed_once} edges listed on one side only"
+        );
+        assert!(
+            g_live
+                .iter()
+                .all(|&e| errors[e as usize].cost_bits != INVALID_COST),
+            "{name}: the GPU listed an edge without a placement"
         );
         // edge_costs, compared through the candidates. The GPU's candidates are read after its
         // whole round: validate has only added face counts.
@@ -161,18 +175,13 @@ fn each_stage_matches_its_cpu_twin() {
             "{name}: {mismatched} of {ne} edges differ in validity"
         );
         // select_*, trim_*: the CPU twin on the GPU's candidates must pick the same winners.
-        // Those that compete: valid after edge_costs, with an error under the ceiling.
-        cpu.edge_state = g_cand
-            .iter()
-            .zip(&errors)
-            .map(|(g, err)| {
-                if g.cost_bits != INVALID_COST && err.cost_bits < gc.ceiling {
-                    state::CANDIDATE
-                } else {
-                    state::OUT
-                }
-            })
-            .collect();
+        // Those that compete: listed by the GPU and still valid after its edge_costs.
+        cpu.edge_state = vec![state::OUT; ne];
+        for &e in &g_live {
+            if g_cand[e as usize].cost_bits != INVALID_COST {
+                cpu.edge_state[e as usize] = state::CANDIDATE;
+            }
+        }
         cpu.candidates = g_cand;
         cpu.live = g_live;
         // select_cost, select_id, select_win, validate, and the trim stages.

@@ -653,8 +653,10 @@ fn obj_material_libraries_are_found_from_another_folder() {
         "newmtl skin\nKd 1 0 0\n",
     );
     write_text(&dir.path().join("lib"), "shared.mtl", "newmtl metal\n");
-    let text = "mtllib skin.mtl\nmtllib ../../lib/shared.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n\
-                usemtl skin\nf 1 2 3\n";
+    write_text(&dir.path().join("scans/raw"), "extra.mtl", "newmtl bone\n");
+    // The third line lists two libraries.
+    let text = "mtllib skin.mtl\nmtllib ../../lib/shared.mtl\nmtllib skin.mtl extra.mtl\n\
+                v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl skin\nf 1 2 3\n";
     let input = write_text(&dir.path().join("scans/raw"), "a.obj", text);
     let m = io::read(&input).unwrap();
 
@@ -662,8 +664,15 @@ fn obj_material_libraries_are_found_from_another_folder() {
     let out = dir.path().join("out/a-small.obj");
     io::write_from(&out, &m, &input).unwrap();
     let libs = mtllibs(&out);
-    assert_eq!(libs, ["../scans/raw/skin.mtl", "../lib/shared.mtl"]);
-    for lib in &libs {
+    assert_eq!(
+        libs,
+        [
+            "../scans/raw/skin.mtl",
+            "../lib/shared.mtl",
+            "../scans/raw/skin.mtl ../scans/raw/extra.mtl"
+        ]
+    );
+    for lib in libs.iter().flat_map(|l| l.split(' ')) {
         assert!(out.parent().unwrap().join(lib).is_file(), "{lib}");
     }
     assert_eq!(io::read(&out).unwrap().material_libs, libs);
@@ -671,7 +680,10 @@ fn obj_material_libraries_are_found_from_another_folder() {
     // Beside the input, the names stay as they were read, bit for bit.
     let beside = dir.path().join("scans/raw/a-small.obj");
     io::write_from(&beside, &m, &input).unwrap();
-    assert_eq!(mtllibs(&beside), ["skin.mtl", "../../lib/shared.mtl"]);
+    assert_eq!(
+        mtllibs(&beside),
+        ["skin.mtl", "../../lib/shared.mtl", "skin.mtl extra.mtl"]
+    );
     // Other formats have no mtllib to move.
     io::write_from(&dir.path().join("out/a.ply"), &m, &input).unwrap();
 }

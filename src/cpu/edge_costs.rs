@@ -112,11 +112,17 @@ pub fn edge_costs(
                     },
                 )
             },
-            // SAFETY: as above.
-            None => unsafe {
-                candidates.write(e, EdgeCandidate::INVALID);
-                edge_state.write(e, state::OUT);
-            },
+            None => {
+                // SAFETY: as above.
+                unsafe {
+                    candidates.write(e, EdgeCandidate::INVALID);
+                    edge_state.write(e, state::OUT);
+                }
+                // No longer a valid collapse: when every edge competes (the ceiling is
+                // INVALID_COST, as in the round the driver stops on) the count is then exactly
+                // the valid edges under the maximum error, which tells MaxError apart.
+                counter(counters, CounterField::Candidates).fetch_sub(1, Relaxed);
+            }
         }
     });
 }

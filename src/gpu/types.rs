@@ -89,9 +89,12 @@ pub struct ScanParams {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct Counters {
-    /// Edges with a placement under the maximum error, after `edge_errors`.
+    /// Edges with a placement under the maximum error (`edge_errors`), less those `edge_costs`
+    /// found a flip or needle in: the valid edges under the maximum error when every edge
+    /// competes (an INVALID_COST ceiling), an upper bound of them otherwise.
     pub candidates: u32,
-    /// Edges refused only because their error exceeds the maximum.
+    /// Edges refused because their error exceeds the maximum (`edge_errors`; their moved faces
+    /// are not checked).
     pub over_max_error: u32,
     /// Error bits below which candidates compete (from `cost_ceiling`, on the errors).
     pub ceiling: u32,

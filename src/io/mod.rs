@@ -16,7 +16,7 @@ pub mod ply;
 pub mod stl;
 
 use std::io::{BufWriter, Write};
-use std::path::Path;
+use std::path::{Component, Path};
 
 use crate::error::{Error, Location, Result};
 use crate::mesh::Mesh;
@@ -187,7 +187,10 @@ pub fn write_from(path: &Path, mesh: &Mesh, input: &Path) -> Result<()> {
 
 /// `libs`, named relative to the folder of `input`, named relative to the folder of `output`:
 /// unchanged when both are the same folder (or a name is absolute), else a `/`-separated path
-/// from the output's folder (absolute when there is none, as between Windows drives).
+/// from the output's folder (absolute when there is none, as between Windows drives). A name
+/// that is no file but whose space-separated words are (`mtllib a.mtl b.mtl` lists two) has
+/// each word moved. A folder name with spaces puts spaces in the result, which readers that
+/// split `mtllib` lines on whitespace misread; this one keeps the line whole.
 pub fn relocate_material_libs(libs: &[String], input: &Path, output: &Path) -> Vec<String> {
     let folder = |p: &Path| {
         let d = match p.parent() {
@@ -202,20 +205,37 @@ pub fn relocate_material_libs(libs: &[String], input: &Path, output: &Path) -> V
     if from == to {
         return libs.to_vec();
     }
-    libs.iter()
-        .map(|lib| {
-            if Path::new(lib).is_absolute() {
-                return lib.clone();
-            }
-            // Canonical when it exists, so `../` in the name does not come back twice.
-            let target = std::fs::canonicalize(from.join(lib)).unwrap_or_else(|_| from.join(lib));
-            match pathdiff::diff_paths(&target, &to) {
-                Some(rel) => rel
+    let moved = |lib: &str| -> String {
+        if Path::new(lib).is_absolute() {
+            return lib.to_string();
+        }
+        // Canonical when it exists, so `../` in the name does not come back twice.
+        let target = std::fs::canonicalize(from.join(lib)).unwrap_or_else(|_| from.join(lib));
+        match pathdiff::diff_paths(&target, &to) {
+            // Between Windows drives the "relative" path still holds a drive or root.
+            Some(rel)
+                if rel
                     .components()
+                    .all(|c| matches!(c, Component::Normal(_) | Component::ParentDir)) =>
+            {
+                rel.components()
                     .map(|c| c.as_os_str().to_string_lossy())
                     .collect::<Vec<_>>()
-                    .join("/"),
-                None => target.to_string_lossy().into_owned(),
+                    .join("/")
+            }
+            _ => target.to_string_lossy().into_owned(),
+        }
+    };
+    libs.iter()
+        .map(|lib| {
+            let words: Vec<&str> = lib.split_whitespace().collect();
+            if words.len() > 1
+                && !from.join(lib).is_file()
+                && words.iter().all(|w| from.join(w).is_file())
+            {
+                words.iter().map(|w| moved(w)).collect::<Vec<_>>().join(" ")
+            } else {
+                moved(lib)
             }
         })
         .collect()
