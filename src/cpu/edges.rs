@@ -8,15 +8,21 @@
 use super::{Scatter, face_of, faces_of, par_for};
 use crate::gpu::types::Params;
 
-/// Calls `each(u)` for every neighbour `u > v` of `v`, once, in face-list order.
-fn higher_neighbours(indices: &[u32], list: &[u32], v: u32, mut each: impl FnMut(u32)) {
-    for (i, &f) in list.iter().enumerate() {
+/// Lists every neighbour `u > v` of `v` once, in face-list order, into `slots` (two per face of
+/// `list`: a face adds at most two), and returns how many. A neighbour is new when the listed
+/// ones lack it, as in the shader (which reads them back for want of a private array).
+fn higher_neighbours(indices: &[u32], list: &[u32], v: u32, slots: &mut [u32]) -> usize {
+    debug_assert_eq!(slots.len(), 2 * list.len());
+    let mut n = 0;
+    for &f in list {
         for u in face_of(indices, f) {
-            if u > v && !list[..i].iter().any(|&g| face_of(indices, g).contains(&u)) {
-                each(u);
+            if u > v && !slots[..n].contains(&u) {
+                slots[n] = u;
+                n += 1;
             }
         }
     }
+    n
 }
 
 /// Per vertex: its higher neighbours into `neighbours[2 · offsets[v]..]` and their count; also
@@ -32,14 +38,13 @@ pub fn edges_count(
     neighbours: Scatter<u32>,  // 2 per corner
 ) {
     par_for(params.vertex_count, |v| {
-        let base = 2 * offsets[v as usize] as usize;
-        let mut n = 0;
-        higher_neighbours(indices, faces_of(offsets, vertex_faces, v), v, |u| {
-            // SAFETY: vertex v owns slots [2·offsets[v], 2·offsets[v+1]); a face adds at most two
-            // neighbours, so n stays inside them.
-            unsafe { neighbours.write(base + n, u) };
-            n += 1;
-        });
+        let (lo, hi) = (
+            offsets[v as usize] as usize,
+            offsets[v as usize + 1] as usize,
+        );
+        // SAFETY: vertex v alone owns slots [2·offsets[v], 2·offsets[v+1]).
+        let slots = unsafe { neighbours.range_mut(2 * lo, 2 * hi) };
+        let n = higher_neighbours(indices, faces_of(offsets, vertex_faces, v), v, slots);
         // SAFETY: each invocation writes only index v.
         unsafe {
             edge_counts.write(v as usize, n as u32);
