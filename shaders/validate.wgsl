@@ -1,7 +1,9 @@
 // The edges a selection pass picked (listed by select_win, so that SIMD lanes are not spent on
 // the other edges) get the topological checks of the greedy reference: link
 // condition, no border pinch, no lone triangle, no tetrahedral fold. Those that pass win and lock
-// the faces around them; the rest drop out. Relies on tentative winners sharing no face.
+// every vertex of the faces around them (select_cost then keeps out the edges at such a vertex:
+// those that touch a winner's face); the rest drop out. Relies on tentative winners sharing no
+// face; two of them may share a locked vertex, hence the atomic stores.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> flags: array<u32>;                  // per vertex
@@ -12,7 +14,7 @@
 @group(0) @binding(6) var<storage, read> tentative: array<u32>;              // per winner of the pass
 @group(0) @binding(7) var<storage, read_write> candidates: array<EdgeCandidate>; // per edge
 @group(0) @binding(8) var<storage, read_write> edge_state: array<u32>;       // per edge
-@group(0) @binding(9) var<storage, read_write> face_lock: array<u32>;        // per face
+@group(0) @binding(9) var<storage, read_write> vertex_lock: array<atomic<u32>>; // per vertex
 @group(0) @binding(10) var<storage, read_write> counters: array<atomic<u32>, 16>;
 
 // Faces on the edge (1 or 2), or 0 when the collapse would break the topology.
@@ -93,7 +95,8 @@ fn validate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     for (var s = 0u; s < 2u; s = s + 1u) {
         let v = ab[s];
         for (var i = offsets[v]; i < offsets[v + 1u]; i = i + 1u) {
-            face_lock[vertex_faces[i]] = 1u;
+            let t = face_of(vertex_faces[i]);
+            for (var k = 0u; k < 3u; k = k + 1u) { atomicStore(&vertex_lock[t[k]], 1u); }
         }
     }
     atomicAdd(&counters[C_WINNERS], 1u);

@@ -166,7 +166,7 @@ pub struct CpuRounds {
     pub live: Vec<u32>,
     pub face_best: Vec<u32>,
     pub face_id: Vec<u32>,
-    pub face_lock: Vec<u32>,
+    pub vertex_lock: Vec<u32>,
     pub remap: Vec<u32>,
     pub vertex_keep: Vec<u32>,
     pub face_keep: Vec<u32>,
@@ -366,7 +366,7 @@ impl CpuRounds {
     /// The selection passes, then trimming when the round would overshoot.
     pub fn select(&mut self, p: &Params, ne: u32) {
         let nf = p.face_count as usize;
-        reset(&mut self.face_lock, nf);
+        reset(&mut self.vertex_lock, p.vertex_count as usize);
         self.tentative.resize(ne as usize, 0);
         for _ in 0..self.selection_passes {
             reset(&mut self.face_best, nf);
@@ -375,7 +375,7 @@ impl CpuRounds {
             let s = &mut *self;
             let t = Instant::now();
             let (lock, st, counters) = (
-                atomics(&mut s.face_lock),
+                atomics(&mut s.vertex_lock),
                 atomics(&mut s.edge_state),
                 atomics(&mut s.counters),
             );

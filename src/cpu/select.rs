@@ -36,22 +36,21 @@ pub fn select_cost(
     edges: &[[u32; 2]],
     live: &[u32], // per listed candidate
     candidates: &[EdgeCandidate],
-    face_lock: &[AtomicU32], // per face
+    vertex_lock: &[AtomicU32], // per vertex
     counters: &[AtomicU32],
     edge_state: &[AtomicU32], // per edge
     face_best: &[AtomicU32],  // per face, cleared
 ) {
-    let any_locked = counter(counters, CounterField::Winners).load(Relaxed) > 0;
     par_for(live_count(counters), |i| {
         let e = live[i as usize] as usize;
         if edge_state[e].load(Relaxed) != state::CANDIDATE {
             return;
         }
         let c = &candidates[e];
-        // No face is locked before the first winner: skip the scan in the first pass.
-        if any_locked
-            && around(offsets, vertex_faces, edges[e])
-                .any(|f| face_lock[f as usize].load(Relaxed) != 0)
+        // At a vertex of a face around an earlier winner: it touches that face.
+        if edges[e]
+            .iter()
+            .any(|&v| vertex_lock[v as usize].load(Relaxed) != 0)
         {
             edge_state[e].store(state::OUT, Relaxed);
             return;

@@ -98,7 +98,7 @@ pub fn validate(
     tentative: &[u32], // per winner of the pass
     candidates: Scatter<EdgeCandidate>,
     edge_state: &[AtomicU32],
-    face_lock: &[AtomicU32],
+    vertex_lock: &[AtomicU32], // per vertex
     counters: &[AtomicU32],
 ) {
     let n = counter(counters, CounterField::Tentative).load(Relaxed);
@@ -117,7 +117,9 @@ pub fn validate(
         edge_state[eu].store(state::WON, Relaxed);
         for v in edges[eu] {
             for &f in faces_of(offsets, vertex_faces, v) {
-                face_lock[f as usize].store(1, Relaxed);
+                for u in face_of(indices, f) {
+                    vertex_lock[u as usize].store(1, Relaxed);
+                }
             }
         }
         counter(counters, CounterField::Winners).fetch_add(1, Relaxed);
