@@ -6,7 +6,6 @@
 //! sums do not depend on thread timing. Quadrics are relative to the vertex.
 
 use super::common::{cross, dot, length, quadric_add, quadric_from_plane, scale, sub, xyz};
-use super::vertex_flags::count_containing;
 use super::{corner_attr, face_of, faces_of, par_for_mut};
 use crate::gpu::types::{FaceExtra, Params, Quadric};
 
@@ -20,6 +19,22 @@ fn edge_plane(params: &Params, e: [f32; 3], surface: [f32; 3]) -> Quadric {
     } else {
         Quadric::default()
     }
+}
+
+/// The faces of `list` containing `u`: how many, and the first other than `f` (`f` when none),
+/// from one scan as in the shader.
+fn edge_faces(indices: &[u32], list: &[u32], f: u32, u: u32) -> (u32, u32) {
+    let mut n = 0;
+    let mut other = f;
+    for &g in list {
+        if face_of(indices, g).contains(&u) {
+            n += 1;
+            if other == f && g != f {
+                other = g;
+            }
+        }
+    }
+    (n, other)
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -52,17 +67,12 @@ pub fn vertex_quadrics(
                         continue;
                     }
                     let e = sub(xyz(positions[u as usize]), pv);
-                    match count_containing(indices, list, u) {
-                        1 => q = quadric_add(&q, &edge_plane(params, e, xyz(fnrm))),
-                        2 => {
+                    match edge_faces(indices, list, f, u) {
+                        (1, _) => q = quadric_add(&q, &edge_plane(params, e, xyz(fnrm))),
+                        (2, g) => {
                             // Once per edge: from the first of its two faces in the (sorted)
                             // list. In the first round every corner still has its input
                             // attribute vertex.
-                            let g = list
-                                .iter()
-                                .copied()
-                                .find(|&g| g != f && face_of(indices, g).contains(&u))
-                                .unwrap_or(f);
                             if g > f
                                 && (corner_attr(f, v) != corner_attr(g, v)
                                     || corner_attr(f, u) != corner_attr(g, u))
