@@ -435,6 +435,16 @@ impl CpuRounds {
             s.times.add("select_win", (t3 - t2).as_secs_f64());
             s.times.add("validate", t3.elapsed().as_secs_f64());
         }
+        debug_assert!(
+            select::winners_share_no_face(
+                &self.offsets,
+                &self.vertex_faces,
+                &self.edges[..ne as usize],
+                &self.edge_state,
+                nf,
+            ),
+            "two winners of a round share a face"
+        );
         if p.trim != 0 {
             self.time("trim_histogram", |s| {
                 reset(&mut s.trim_histogram, HIST_BINS as usize);

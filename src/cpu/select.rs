@@ -4,8 +4,9 @@
 //! inverted keys per face, first on the cost, then on a hash of the id among equal costs (64-bit atomics
 //! are not portable). Two winners then share no face, so the checks each passed in
 //! `validate` stay true when both collapse. The pass's winners are TENTATIVE until `validate`
-//! checks them; confirmed winners lock their faces; a candidate touching a locked face drops out
-//! at the next pass, and the others compete again (Luby-style).
+//! checks them; confirmed winners lock the vertices of their faces (`validate`); a candidate at a
+//! locked vertex touches a winner's face and drops out at the next pass, and the others compete
+//! again (Luby-style).
 
 use super::common::tie_rank;
 use super::edge_costs::{CounterField, counter};
@@ -136,4 +137,100 @@ pub fn select_win(
         // SAFETY: the atomic counter hands out each slot once.
         unsafe { tentative.write(slot as usize, e) };
     });
+}
+
+/// Whether the round's winners (`state::WON`) share no face: each face is around at most one
+/// winner's endpoints. `collapse` writes every winner's vertices and faces without
+/// synchronisation on this promise, so the rounds assert it in debug builds (tests included).
+pub fn winners_share_no_face(
+    offsets: &[u32],
+    vertex_faces: &[u32],
+    edges: &[[u32; 2]],
+    edge_state: &[u32],
+    face_count: usize,
+) -> bool {
+    let mut owner = vec![u32::MAX; face_count];
+    for (e, &ab) in edges.iter().enumerate() {
+        if edge_state[e] != state::WON {
+            continue;
+        }
+        for f in around(offsets, vertex_faces, ab) {
+            match owner[f as usize] {
+                u32::MAX => owner[f as usize] = e as u32,
+                o if o == e as u32 => {}
+                _ => return false,
+            }
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A strip of four triangles over vertices 0..6:
+    ///
+    /// ```text
+    ///   1 --- 3 --- 5
+    ///   | \   | \   |
+    ///   |  \  |  \  |
+    ///   0 --- 2 --- 4
+    /// ```
+    /// faces (0,2,1) (1,2,3) (2,4,3) (3,4,5); vertex→face lists by vertex.
+    fn strip() -> (Vec<u32>, Vec<u32>) {
+        let faces = [[0u32, 2, 1], [1, 2, 3], [2, 4, 3], [3, 4, 5]];
+        let mut lists = vec![Vec::new(); 6];
+        for (f, t) in faces.iter().enumerate() {
+            for &v in t {
+                lists[v as usize].push(f as u32);
+            }
+        }
+        let mut offsets = vec![0u32];
+        let mut vertex_faces = Vec::new();
+        for l in lists {
+            vertex_faces.extend(l);
+            offsets.push(vertex_faces.len() as u32);
+        }
+        (offsets, vertex_faces)
+    }
+
+    #[test]
+    fn winners_apart_share_no_face_and_neighbours_do() {
+        let (offsets, vf) = strip();
+        let edges = [[0u32, 1], [4, 5], [2, 3]];
+        let won = |w: &[usize]| {
+            let mut st = vec![state::CANDIDATE; edges.len()];
+            for &e in w {
+                st[e] = state::WON;
+            }
+            st
+        };
+        // (0,1) holds faces 0 and 1; (4,5) holds faces 2 and 3: disjoint.
+        assert!(winners_share_no_face(
+            &offsets,
+            &vf,
+            &edges,
+            &won(&[0, 1]),
+            4
+        ));
+        // (2,3) holds all four faces, so it meets either.
+        assert!(!winners_share_no_face(
+            &offsets,
+            &vf,
+            &edges,
+            &won(&[0, 2]),
+            4
+        ));
+        assert!(!winners_share_no_face(
+            &offsets,
+            &vf,
+            &edges,
+            &won(&[1, 2]),
+            4
+        ));
+        // A lone winner, or none, trivially.
+        assert!(winners_share_no_face(&offsets, &vf, &edges, &won(&[2]), 4));
+        assert!(winners_share_no_face(&offsets, &vf, &edges, &won(&[]), 4));
+    }
 }
