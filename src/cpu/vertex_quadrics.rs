@@ -69,18 +69,17 @@ pub fn vertex_quadrics(
                     let e = sub(xyz(positions[u as usize]), pv);
                     match edge_faces(indices, list, f, u) {
                         (1, _) => q = quadric_add(&q, &edge_plane(params, e, xyz(fnrm))),
-                        (2, g) => {
-                            // Once per edge: from the first of its two faces in the (sorted)
-                            // list. In the first round every corner still has its input
-                            // attribute vertex.
+                        // A seam: once per edge, from the first of its two faces in the (sorted)
+                        // list. In the first round every corner still has its input attribute
+                        // vertex.
+                        (2, g)
                             if g > f
                                 && (corner_attr(f, v) != corner_attr(g, v)
-                                    || corner_attr(f, u) != corner_attr(g, u))
-                            {
-                                let gn = xyz(face_normals[g as usize]);
-                                let avg = [fnrm[0] + gn[0], fnrm[1] + gn[1], fnrm[2] + gn[2]];
-                                q = quadric_add(&q, &edge_plane(params, e, avg));
-                            }
+                                    || corner_attr(f, u) != corner_attr(g, u)) =>
+                        {
+                            let gn = xyz(face_normals[g as usize]);
+                            let avg = [fnrm[0] + gn[0], fnrm[1] + gn[1], fnrm[2] + gn[2]];
+                            q = quadric_add(&q, &edge_plane(params, e, avg));
                         }
                         _ => {}
                     }
