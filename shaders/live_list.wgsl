@@ -10,16 +10,35 @@
 @group(0) @binding(4) var<storage, read_write> counters: array<atomic<u32>, 16>;
 @group(0) @binding(5) var<storage, read_write> live: array<u32>;            // per listed candidate
 
+// The workgroup reads the ceiling once and reserves its slots of the list with one global
+// atomic: an atomic per edge on the same word serializes every invocation.
+var<workgroup> wg_ceiling: u32;
+var<workgroup> wg_count: atomic<u32>;
+var<workgroup> wg_base: u32;
+
 @compute @workgroup_size(256)
-fn live_list(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+fn live_list(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    if (li == 0u) { wg_ceiling = atomicLoad(&counters[C_CEILING]); }
+    workgroupBarrier();
     let e = gid.x + gid.y * nwg.x * WG;
-    if (e >= edge_offsets[params.vertex_count] || edge_state[e] != STATE_CANDIDATE) {
-        return;
+    // No early return: the barriers need every invocation of the workgroup.
+    var listed = false;
+    var slot = 0u;
+    if (e < edge_offsets[params.vertex_count] && edge_state[e] == STATE_CANDIDATE) {
+        if (candidates[e].cost_bits >= wg_ceiling) {
+            edge_state[e] = STATE_OUT;
+        } else {
+            listed = true;
+            slot = atomicAdd(&wg_count, 1u);
+        }
     }
-    if (candidates[e].cost_bits >= atomicLoad(&counters[C_CEILING])) {
-        edge_state[e] = STATE_OUT;
-        return;
-    }
+    workgroupBarrier();
+    if (li == 0u) { wg_base = atomicAdd(&counters[C_LIVE], atomicLoad(&wg_count)); }
+    workgroupBarrier();
     // The list's order depends on timing; no stage's result does (each writes its own edge).
-    live[atomicAdd(&counters[C_LIVE], 1u)] = e;
+    if (listed) { live[wg_base + slot] = e; }
 }
