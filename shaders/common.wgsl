@@ -17,6 +17,7 @@ const STATE_OUT: u32 = 0u;
 const STATE_CANDIDATE: u32 = 1u;
 const STATE_WON: u32 = 2u;
 const STATE_TENTATIVE: u32 = 3u;
+const STATE_POSTED: u32 = 4u;
 
 struct Params {
     vertex_count: u32,

@@ -409,8 +409,6 @@ impl CpuRounds {
                 &s.vertex_faces,
                 &s.edges,
                 &s.live,
-                &s.candidates,
-                best,
                 id,
                 st,
                 Scatter::new(&mut s.tentative),

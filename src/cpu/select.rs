@@ -101,6 +101,7 @@ pub fn select_id(
                 slot.fetch_max(rank, Relaxed);
             }
         }
+        edge_state[eu].store(state::POSTED, Relaxed);
     });
 }
 
@@ -109,10 +110,8 @@ pub fn select_win(
     offsets: &[u32],
     vertex_faces: &[u32],
     edges: &[[u32; 2]],
-    live: &[u32], // per listed candidate
-    candidates: &[EdgeCandidate],
-    face_best: &[AtomicU32],
-    face_id: &[AtomicU32],
+    live: &[u32],          // per listed candidate
+    face_id: &[AtomicU32], // per face
     edge_state: &[AtomicU32],
     tentative: Scatter<u32>, // per winner of the pass
     counters: &[AtomicU32],
@@ -120,16 +119,15 @@ pub fn select_win(
     par_for(live_count(counters), |i| {
         let e = live[i as usize];
         let eu = e as usize;
-        if edge_state[eu].load(Relaxed) != state::CANDIDATE {
+        // Posters alone: every other candidate failed select_id's cost test already.
+        if edge_state[eu].load(Relaxed) != state::POSTED {
             return;
         }
-        let c = &candidates[eu];
-        let inv = !c.cost_bits;
-        let wins = around(offsets, vertex_faces, edges[eu]).all(|f| {
-            face_best[f as usize].load(Relaxed) == inv
-                && face_id[f as usize].load(Relaxed) == !tie_rank(e)
-        });
+        let rank = !tie_rank(e);
+        let wins = around(offsets, vertex_faces, edges[eu])
+            .all(|f| face_id[f as usize].load(Relaxed) == rank);
         if !wins {
+            edge_state[eu].store(state::CANDIDATE, Relaxed);
             return;
         }
         edge_state[eu].store(state::TENTATIVE, Relaxed);

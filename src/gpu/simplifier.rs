@@ -658,7 +658,7 @@ impl RoundRunner for GpuRounds<'_> {
             c(&self.edge_state),
             c(&self.histogram),
         );
-        let (fbest, fid, flock, remap, vkeep, fkeep, marks) = (
+        let (fbest, fid, vlock, remap, vkeep, fkeep, marks) = (
             c(&self.face_best),
             c(&self.face_id),
             c(&self.vertex_lock),
@@ -754,7 +754,7 @@ impl RoundRunner for GpuRounds<'_> {
             ],
             PER_LIVE,
         );
-        enc.clear_buffer(&flock, 0, None);
+        enc.clear_buffer(&vlock, 0, None);
         for _ in 0..self.selection_passes {
             enc.clear_buffer(&fbest, 0, None);
             enc.clear_buffer(&fid, 0, None);
@@ -764,7 +764,7 @@ impl RoundRunner for GpuRounds<'_> {
                 &mut enc,
                 "select_cost",
                 &[
-                    &offsets, &vf, &edges, &live, &cand, &flock, &counters, &est, &fbest,
+                    &offsets, &vf, &edges, &live, &cand, &vlock, &counters, &est, &fbest,
                 ],
                 PER_LIVE,
             );
@@ -779,9 +779,7 @@ impl RoundRunner for GpuRounds<'_> {
             self.pass(
                 &mut enc,
                 "select_win",
-                &[
-                    &offsets, &vf, &edges, &live, &cand, &fbest, &fid, &est, &tent, &counters,
-                ],
+                &[&offsets, &vf, &edges, &live, &fid, &est, &tent, &counters],
                 PER_LIVE,
             );
             self.dispatch_args(&mut enc);
@@ -789,7 +787,7 @@ impl RoundRunner for GpuRounds<'_> {
                 &mut enc,
                 "validate",
                 &[
-                    &params, &flags, &idx, &offsets, &vf, &edges, &tent, &cand, &est, &flock,
+                    &params, &flags, &idx, &offsets, &vf, &edges, &tent, &cand, &est, &vlock,
                     &counters,
                 ],
                 PER_TENTATIVE,

@@ -47,6 +47,9 @@ pub mod state {
     pub const WON: u32 = 2;
     /// Picked by a selection pass, waiting for `validate`'s checks.
     pub const TENTATIVE: u32 = 3;
+    /// Had the best cost at every face around it in this pass and posted its tie rank
+    /// (`select_id`); `select_win` makes it TENTATIVE or a CANDIDATE again.
+    pub const POSTED: u32 = 4;
 }
 
 /// Per-round constants, a uniform. Keep in sync with `Params` in shaders/common.wgsl.
