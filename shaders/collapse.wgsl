@@ -47,7 +47,8 @@ fn onto_seam_corners(k: u32, r: u32) {
             n = n + 1u;
         }
     }
-    // The faces that stay (those on the edge go); they are locked by this winner alone.
+    // The faces that stay (those on the edge go); no other winner touches them (winners share
+    // no face).
     for (var i = offsets[r]; i < offsets[r + 1u]; i = i + 1u) {
         let f = vertex_faces[i];
         let t = face_of(f);

@@ -22,7 +22,10 @@ fn live_list(
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) li: u32,
 ) {
-    if (li == 0u) { wg_ceiling = atomicLoad(&counters[C_CEILING]); }
+    if (li == 0u) {
+        wg_ceiling = atomicLoad(&counters[C_CEILING]);
+        atomicStore(&wg_count, 0u);
+    }
     workgroupBarrier();
     let e = gid.x + gid.y * nwg.x * WG;
     // No early return: the barriers need every invocation of the workgroup.
@@ -37,7 +40,10 @@ fn live_list(
         }
     }
     workgroupBarrier();
-    if (li == 0u) { wg_base = atomicAdd(&counters[C_LIVE], atomicLoad(&wg_count)); }
+    if (li == 0u) {
+        let n = atomicLoad(&wg_count);
+        if (n > 0u) { wg_base = atomicAdd(&counters[C_LIVE], n); }
+    }
     workgroupBarrier();
     // The list's order depends on timing; no stage's result does (each writes its own edge).
     if (listed) { live[wg_base + slot] = e; }

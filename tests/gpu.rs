@@ -186,10 +186,25 @@ fn each_stage_matches_its_cpu_twin() {
         cpu.live = g_live;
         // select_cost, select_id, select_win, validate, and the trim stages.
         cpu.select(&p, ne as u32);
+        let g_state = pod::<u32>(rd("edge_state", 4 * ne));
         assert_eq!(
-            pod::<u32>(rd("edge_state", 4 * ne)),
-            cpu.edge_state,
+            g_state, cpu.edge_state,
             "{name}: edge_state after selection"
+        );
+        // collapse relies on it (the CPU rounds assert it on their own state in debug builds).
+        assert!(
+            meshslim::cpu::select::winners_share_no_face(
+                &cpu.offsets,
+                &cpu.vertex_faces,
+                &cpu.edges[..ne],
+                &g_state,
+                p.face_count as usize,
+            ),
+            "{name}: two of the GPU's winners share a face"
+        );
+        assert!(
+            g_state.contains(&state::WON),
+            "{name}: the GPU's selection picked no winner"
         );
         // dispatch_args, as it last ran: after the last pass's select_win.
         let mut args = [0u32; 12];

@@ -43,7 +43,7 @@ impl Corners<'_> {
     /// along its seam, `k`'s attribute vertex for all corners of a free one.
     ///
     /// # Safety
-    /// The faces around `r` are this thread's alone (the winner's face locks).
+    /// The faces around `r` are this thread's alone (winners share no face: the selection).
     unsafe fn onto_seam(&self, flags: &Scatter<u32>, k: u32, r: u32) {
         let faces = faces_of(self.offsets, self.vertex_faces, r);
         // SAFETY: the caller's: r's faces and flags are this winner's alone.
@@ -108,9 +108,9 @@ pub fn collapse(
         }
         let c = &candidates[e as usize];
         let (k, r) = (c.keep as usize, c.remove as usize);
-        // SAFETY: winners share no face and so no vertex (select_win); each winner reads and
-        // writes only its own two vertices and the faces around the removed one, which the
-        // face locks of `validate` give to this winner alone.
+        // SAFETY: winners share no face and so no vertex (the selection; asserted in debug
+        // builds by `select::winners_share_no_face`); each winner reads and writes only its own
+        // two vertices and the faces around the removed one, which no other winner touches.
         unsafe {
             if flags.read(k) & flag::SEAM != 0 {
                 corners.onto_seam(&flags, c.keep, c.remove);

@@ -1,7 +1,7 @@
 //! Twin of shaders/validate.wgsl: the edges a selection pass picked (TENTATIVE) get the
 //! topological checks of the greedy reference — link condition, no border pinch, no lone
-//! triangle, no tetrahedral fold. Those that fail drop out; the rest win and lock the faces
-//! around them. Tentative winners share no face, so their checks cannot interfere. Checking only
+//! triangle, no tetrahedral fold. Those that fail drop out; the rest win and lock every vertex of
+//! the faces around them (see `select`). Tentative winners share no face, so their checks cannot interfere. Checking only
 //! the winners instead of every edge every round saves the costliest scans of `edge_costs`.
 
 use super::edge_costs::{CounterField, counter};
@@ -86,7 +86,7 @@ pub fn check(
     Some(edge_faces)
 }
 
-/// Per listed tentative winner: it wins (and locks its faces) or drops out.
+/// Per listed tentative winner: it wins (and locks the vertices of its faces) or drops out.
 #[allow(clippy::too_many_arguments)]
 pub fn validate(
     params: &Params,
