@@ -235,6 +235,61 @@ mod tests {
         }
     }
 
+    /// The constants of shaders/common.wgsl against their Rust twins: a state, flag or counter
+    /// index out of step would not fail to compile, only make the backends disagree.
+    #[test]
+    fn wgsl_constants_match_their_rust_twins() {
+        use crate::cpu::edge_costs::CounterField as C;
+        let module = parse(
+            "draw_args",
+            STAGES.iter().find(|s| s.0 == "draw_args").unwrap().2,
+        );
+        let value = |name: &str| -> u32 {
+            let (_, c) = module
+                .constants
+                .iter()
+                .find(|(_, c)| c.name.as_deref() == Some(name))
+                .unwrap_or_else(|| panic!("no const {name} in common.wgsl"));
+            match module.global_expressions[c.init] {
+                naga::Expression::Literal(naga::Literal::U32(v)) => v,
+                ref e => panic!("const {name} is not a u32 literal: {e:?}"),
+            }
+        };
+        let pairs = [
+            ("WG", WG),
+            ("SCAN_BLOCK", SCAN_BLOCK),
+            ("HIST_BINS", HIST_BINS),
+            ("HIST_SHIFT", HIST_SHIFT),
+            ("INVALID_COST", INVALID_COST),
+            ("NO_ATTR", NO_ATTR),
+            ("FLAG_BORDER", flag::BORDER),
+            ("FLAG_PINNED", flag::PINNED),
+            ("FLAG_SEAM", flag::SEAM),
+            ("FLAG_MOVED", flag::MOVED),
+            ("STATE_OUT", state::OUT),
+            ("STATE_CANDIDATE", state::CANDIDATE),
+            ("STATE_WON", state::WON),
+            ("STATE_TENTATIVE", state::TENTATIVE),
+            ("STATE_POSTED", state::POSTED),
+            ("C_CANDIDATES", C::Candidates as u32),
+            ("C_OVER_MAX_ERROR", C::OverMaxError as u32),
+            ("C_CEILING", C::Ceiling as u32),
+            ("C_WINNERS", C::Winners as u32),
+            ("C_REMOVED", C::Removed as u32),
+            ("C_MAX_ERR2_BITS", C::MaxErr2Bits as u32),
+            ("C_TRIM_BIN", C::TrimBin as u32),
+            ("C_TRIM_BUDGET", C::TrimBudget as u32),
+            ("C_VERTICES_OUT", C::VerticesOut as u32),
+            ("C_FACES_OUT", C::FacesOut as u32),
+            ("C_TENTATIVE", C::Tentative as u32),
+            ("C_LIVE", C::Live as u32),
+            ("COUNTERS", (std::mem::size_of::<Counters>() / 4) as u32),
+        ];
+        for (name, rust) in pairs {
+            assert_eq!(value(name), rust, "const {name}: WGSL against Rust");
+        }
+    }
+
     #[test]
     fn wgsl_structs_match_their_rust_twins() {
         let module = parse(
