@@ -11,7 +11,7 @@ pub struct GpuContext {
     pub adapter_name: String,
     /// The adapter is a software rasterizer (llvmpipe, WARP, SwiftShader): it runs the WGSL on
     /// the CPU's cores, several times slower than the CPU backends (measured on the 1M scan on
-    /// lavapipe at 1%: 9.8 s against 3.3 s for cpu-parallel and 1.1 s for cpu), so `auto` passes
+    /// lavapipe at 1%: 9.5 s against 3.2 s for cpu-parallel and 1.1 s for cpu), so `auto` passes
     /// it over.
     pub software: bool,
 }
