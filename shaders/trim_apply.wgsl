@@ -1,5 +1,6 @@
-// Trimming, step 4: winners above the trim bin, or in it beyond the budget in edge-id order, lose;
-// the face count then lands on the target or one above it.
+// Trimming, step 4: winners above the trim bin lose, and in it those whose edge-id-order
+// predecessors already remove the budget; the count then lands on the target or one below it
+// (the last winner kept may remove two faces where one was left), never above.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> candidates: array<EdgeCandidate>; // per edge
@@ -17,7 +18,7 @@ fn trim_apply(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     let c = candidates[e];
     let bin = c.cost_bits >> HIST_SHIFT;
     let trim_bin = counters[C_TRIM_BIN];
-    if (bin > trim_bin || (bin == trim_bin && marks[e] + c.faces > counters[C_TRIM_BUDGET])) {
+    if (bin > trim_bin || (bin == trim_bin && marks[e] >= counters[C_TRIM_BUDGET])) {
         edge_state[e] = STATE_OUT;
     }
 }

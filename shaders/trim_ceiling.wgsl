@@ -1,5 +1,6 @@
-// Trimming, step 2 (one invocation): the bin where the winners' removals pass the budget and what
+// Trimming, step 2 (one invocation): the bin where the winners' removals reach the budget and what
 // is left of the budget in it; HIST_BINS when every winner fits.
+// Invariant: the bins below the one returned remove fewer faces than the budget, so `left` >= 1.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> histogram: array<u32>;               // HIST_BINS
@@ -14,7 +15,7 @@ fn trim_ceiling() {
         var cum = 0u;
         for (var bin = 0u; bin < HIST_BINS; bin = bin + 1u) {
             let h = histogram[bin];
-            if (cum + h > budget) {
+            if (cum + h >= budget) {
                 bin_out = bin;
                 left = budget - cum;
                 break;

@@ -293,6 +293,9 @@ pub struct Row {
     /// What ran it: the CPU model for CPU backends, the adapter for GPU ones.
     pub device: String,
     pub output_faces: usize,
+    /// The run stopped above its target (the error columns then compare a larger mesh);
+    /// the table marks it with `*`.
+    pub missed_target: bool,
     /// Median wall time of the simplify call over the repeats, seconds.
     pub median_s: f64,
     /// Every repeat's wall time, seconds, in run order.
@@ -398,6 +401,7 @@ pub fn run(
                     backend: backend.name.to_string(),
                     device: (backend.device)(),
                     output_faces: out.face_count(),
+                    missed_target: out.face_count() > target,
                     median_s,
                     times_s: times,
                     mtri_per_s: faces as f64 / median_s.max(1e-9) / 1e6,
@@ -474,7 +478,11 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
             r.input_faces,
             r.ratio,
             r.backend,
-            r.output_faces,
+            if r.missed_target {
+                format!("{}*", r.output_faces)
+            } else {
+                r.output_faces.to_string()
+            },
             r.median_s,
             r.mtri_per_s,
             opt(r.peak_mib, 1, false),
@@ -496,6 +504,15 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
          memory is not counted)",
         report.repeat
     )?;
+    if let Some(r) = report.rows.iter().find(|r| r.missed_target) {
+        writeln!(
+            out,
+            "* stopped above its target (e.g. {} {} at {}: {} faces for {}): no collapse was \
+             left that keeps the topology and the constraints (`meshslim simplify` says why); \
+             its errors are those of a larger mesh",
+            r.mesh, r.backend, r.ratio, r.output_faces, r.target_faces
+        )?;
+    }
     writeln!(
         out,
         "device: {} ({} cores)",

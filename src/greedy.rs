@@ -1389,6 +1389,7 @@ pub fn simplify_greedy(
         dropped_degenerate_faces: s.p.dropped_degenerate,
         pinned_vertices,
         rounds: None,
+        blocked: None,
     };
     Ok((out, report))
 }

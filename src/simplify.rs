@@ -171,6 +171,45 @@ impl StopReason {
     }
 }
 
+/// Why no collapse was left where a run stopped above its target: the result's edges, counted
+/// by the first of the rounds' checks each fails (see [`crate::cpu::blocked_edges`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Blocked {
+    pub edges: usize,
+    /// Their collapse would exceed `--max-error`.
+    pub over_max_error: usize,
+    /// A face would flip, turn past the normal limit or become a needle, or the edge has no
+    /// allowed placement (a locked border, a seam junction, a non-manifold vertex).
+    pub geometry: usize,
+    /// The collapse would break the topology: the link condition (it would pinch the surface),
+    /// a border pinch, a lone triangle or a tetrahedron folding flat — what is left are the
+    /// smallest shapes each component and hole can have.
+    pub topology: usize,
+    /// Collapses these checks allow when the result is taken as a new input: the run itself
+    /// also compared normals with the original's and carried its quadrics, so a few more may
+    /// pass here than it could take.
+    pub allowed: usize,
+}
+
+impl Blocked {
+    /// One sentence: the reason that holds most of the edges, with the counts.
+    pub fn explain(&self) -> String {
+        let main = if self.topology >= self.geometry.max(self.over_max_error) {
+            "most would break the topology (pinch the surface, or close a hole or a component \
+             already at its smallest)"
+        } else if self.geometry >= self.over_max_error {
+            "most would flip or crush a face, or move a locked, seam or non-manifold vertex"
+        } else {
+            "most would exceed the maximum error"
+        };
+        format!(
+            "{main}: of {} edges, {} topology, {} flip/shape/locked, {} over the error bound, {} \
+             allowed when the result is taken as a new input",
+            self.edges, self.topology, self.geometry, self.over_max_error, self.allowed
+        )
+    }
+}
+
 /// What a simplification did.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SimplifyReport {
@@ -193,6 +232,8 @@ pub struct SimplifyReport {
     /// Rounds, per-round removals and stage times of the round-based backends.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rounds: Option<crate::parallel::RoundsReport>,
+    /// Where the run stopped above its target: why no collapse was left.
+    pub blocked: Option<Blocked>,
 }
 
 /// Simplifies `mesh` with the backend and targets in `opts`.
@@ -208,7 +249,13 @@ pub fn simplify_with_progress(
 ) -> Result<(Mesh, SimplifyReport)> {
     opts.check()?;
     mesh.validate()?;
-    match opts.backend {
+    if mesh.triangles.is_empty() {
+        return Err(Error::InvalidMesh(format!(
+            "the mesh has no faces ({} vertices: a point cloud?), so there is nothing to simplify",
+            mesh.positions.len()
+        )));
+    }
+    let (out, mut report) = match opts.backend {
         Backend::Cpu => crate::greedy::simplify_greedy(mesh, opts, progress),
         Backend::CpuParallel => {
             let up = crate::parallel::Upload::new(mesh);
@@ -223,5 +270,9 @@ pub fn simplify_with_progress(
             )
         }
         Backend::Gpu => crate::gpu::simplify_gpu(mesh, opts, progress),
+    }?;
+    if report.output_faces > opts.target_faces && report.stop_reason != StopReason::TargetReached {
+        report.blocked = Some(crate::cpu::blocked_edges(&out, opts)?);
     }
+    Ok((out, report))
 }

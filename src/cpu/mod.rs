@@ -27,7 +27,8 @@ pub mod vertex_quadrics;
 
 use crate::error::Result;
 use crate::gpu::types::*;
-use crate::parallel::{Download, RoundRunner, StageTimes, Upload};
+use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
+use crate::simplify::{Blocked, SimplifyOptions};
 use rayon::prelude::*;
 use std::marker::PhantomData;
 use std::sync::atomic::AtomicU32;
@@ -364,11 +365,17 @@ impl CpuRounds {
     }
 
     /// The selection passes, then trimming when the round would overshoot.
-    pub fn select(&mut self, p: &Params, ne: u32) {
+    pub fn select(&mut self, p: &Params, ne: u32, selection: Selection) {
         let nf = p.face_count as usize;
         reset(&mut self.vertex_lock, p.vertex_count as usize);
         self.tentative.resize(ne as usize, 0);
-        for _ in 0..self.selection_passes {
+        let tentative = edge_costs::CounterField::Tentative as usize;
+        for pass in 0.. {
+            match selection {
+                Selection::Ordinary if pass == self.selection_passes => break,
+                Selection::Exhaustive if pass > 0 && self.counters[tentative] == 0 => break,
+                _ => {}
+            }
             reset(&mut self.face_best, nf);
             reset(&mut self.face_id, nf);
             self.counters[edge_costs::CounterField::Tentative as usize] = 0;
@@ -433,7 +440,10 @@ impl CpuRounds {
             s.times.add("select_win", (t3 - t2).as_secs_f64());
             s.times.add("validate", t3.elapsed().as_secs_f64());
         }
-        debug_assert!(
+        // On in debug builds and in the tests (which run in release: the `invariants` feature
+        // their self-dev-dependency turns on); off for users, where it costs a scan per round.
+        #[cfg(any(debug_assertions, feature = "invariants"))]
+        assert!(
             select::winners_share_no_face(
                 &self.offsets,
                 &self.vertex_faces,
@@ -575,7 +585,7 @@ impl CpuRounds {
 }
 
 impl RoundRunner for CpuRounds {
-    fn round(&mut self, p: &Params, first: bool) -> Result<Counters> {
+    fn round(&mut self, p: &Params, first: bool, selection: Selection) -> Result<Counters> {
         reset(&mut self.counters, std::mem::size_of::<Counters>() / 4);
         self.build_adjacency(p);
         if first {
@@ -583,7 +593,7 @@ impl RoundRunner for CpuRounds {
         }
         let ne = self.build_edges(p);
         self.costs(p, ne);
-        self.select(p, ne);
+        self.select(p, ne, selection);
         self.apply_and_compact(p);
         Ok(*bytemuck::from_bytes::<Counters>(bytemuck::cast_slice(
             &self.counters,
@@ -605,4 +615,36 @@ impl RoundRunner for CpuRounds {
     fn stage_times(&self) -> &StageTimes {
         &self.times
     }
+}
+
+/// Why no collapse is left on `mesh` (a backend's result that stopped above its target): one
+/// round of the rounds' checks over every edge, every edge competing through exhaustive
+/// selection, counted by the first check each edge fails. The same checks judge every backend's
+/// result, so a stop is explained in one vocabulary whichever backend stopped.
+pub fn blocked_edges(mesh: &crate::mesh::Mesh, opts: &SimplifyOptions) -> Result<Blocked> {
+    let up = Upload::new(mesh);
+    let nf = up.face_count() as u32;
+    let mut runner = CpuRounds::new(&up, crate::parallel::SELECTION_PASSES);
+    let needed = nf.saturating_sub(opts.target_faces as u32).max(1);
+    let params = Params {
+        edge_capacity: 3 * nf,
+        needed_faces: needed,
+        ceiling_wanted: u32::MAX,
+        trim: 0,
+        ..up.base_params(opts)
+    };
+    let c = runner.round(&params, true, Selection::Exhaustive)?;
+    let edges = runner
+        .edge_offsets
+        .get(up.positions.len())
+        .copied()
+        .unwrap_or(0);
+    let geometry = edges.saturating_sub(c.over_max_error + c.candidates);
+    Ok(Blocked {
+        edges: edges as usize,
+        over_max_error: c.over_max_error as usize,
+        geometry: geometry as usize,
+        topology: c.candidates.saturating_sub(c.winners) as usize,
+        allowed: c.winners as usize,
+    })
 }

@@ -1,8 +1,9 @@
 //! Twins of shaders/trim_histogram.wgsl, trim_ceiling.wgsl, trim_mark.wgsl and trim_apply.wgsl:
 //! in a round that would overshoot the target, the winners are cut back cheapest first so the
-//! face count lands on the target (or one above: a collapse removes one or two faces). Bins of
-//! the winners' costs find the bin where the budget runs out; within that bin, winners are taken
-//! in edge-id order (a prefix sum of the faces they remove) while they fit.
+//! face count lands on the target or one below it (a collapse removes one or two faces: the last
+//! winner kept may take two where one was left), never above, as the greedy reference does. Bins
+//! of the winners' costs find the bin where the budget runs out; within that bin, winners are
+//! taken in edge-id order (a prefix sum of the faces they remove) while the budget is not met.
 
 use super::edge_costs::{CounterField, counter};
 use super::{par_for, par_for_mut};
@@ -26,8 +27,8 @@ pub fn trim_histogram(
     });
 }
 
-/// One invocation: the bin where the winners' removals pass `needed_faces`, and what is left of
-/// the budget in it; `HIST_BINS` (nothing trimmed) when all winners fit.
+/// One invocation: the bin where the winners' removals reach `needed_faces`, and what is left of
+/// the budget in it (at least 1); `HIST_BINS` (nothing trimmed) when all winners fit.
 pub fn trim_ceiling(params: &Params, histogram: &[u32], counters: &[AtomicU32]) {
     let budget = params.needed_faces;
     let (mut bin_out, mut left) = (HIST_BINS, 0);
@@ -35,7 +36,7 @@ pub fn trim_ceiling(params: &Params, histogram: &[u32], counters: &[AtomicU32]) 
         let mut cum = 0u32;
         for bin in 0..HIST_BINS {
             let h = histogram[bin as usize];
-            if cum + h > budget {
+            if cum + h >= budget {
                 bin_out = bin;
                 left = budget - cum;
                 break;
@@ -72,7 +73,8 @@ pub fn trim_mark(
     });
 }
 
-/// Per edge: winners above the trim bin, or in it past the budget, lose.
+/// Per edge: winners above the trim bin lose, and in it those whose predecessors in edge-id
+/// order already remove the budget.
 pub fn trim_apply(
     params: &Params,
     candidates: &[EdgeCandidate],
@@ -87,8 +89,7 @@ pub fn trim_apply(
     par_for_mut(&mut edge_state[..edge_count as usize], |e, st| {
         let c = &candidates[e as usize];
         let bin = c.cost_bits >> HIST_SHIFT;
-        if *st == state::WON
-            && (bin > trim_bin || (bin == trim_bin && marks[e as usize] + c.faces > budget))
+        if *st == state::WON && (bin > trim_bin || (bin == trim_bin && marks[e as usize] >= budget))
         {
             *st = state::OUT;
         }

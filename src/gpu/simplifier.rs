@@ -6,7 +6,7 @@ use super::context::{ErrorSink, checked_buffer, checked_buffer_init};
 use super::shaders::{MAX_STORAGE_BUFFERS, STAGES, source};
 use super::types::*;
 use crate::error::{Error, Result};
-use crate::parallel::{Download, RoundRunner, StageTimes, Upload};
+use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -16,6 +16,10 @@ const SU: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
 
 /// Timestamp slots per round: two per compute pass.
 const QUERY_CAP: u32 = 512;
+
+/// Selection passes recorded between two read-backs in an exhaustive round: a pass with nothing
+/// left to select costs a few empty dispatches, a read-back a round trip.
+const EXHAUSTIVE_CHUNK: u32 = 8;
 
 /// Compute pipelines of every stage, made once for a device and reused for every mesh.
 pub struct GpuSimplifier {
@@ -160,6 +164,10 @@ pub struct GpuRounds<'a> {
     sim: &'a GpuSimplifier,
     half: [Half; 2],
     cur: usize,
+    /// Vertices and faces of the mesh in the current half: the upload's until a round has run,
+    /// then that round's counters. Download reads these, not the counters buffer, which holds
+    /// nothing before the first round (a target at or above the input ran none).
+    live_counts: (u32, u32),
     draw_args: wgpu::Buffer,
     params: wgpu::Buffer,
     scan_v: wgpu::Buffer,
@@ -284,6 +292,7 @@ impl<'a> GpuRounds<'a> {
             sim,
             half: [half0, half1],
             cur: 0,
+            live_counts: (up.positions.len() as u32, up.face_count() as u32),
             draw_args: mk(
                 "draw_args",
                 std::mem::size_of::<DrawArgs>() as u64,
@@ -571,6 +580,9 @@ impl<'a> GpuRounds<'a> {
     }
 
     fn read(&self, src: &wgpu::Buffer, bytes: u64) -> Result<Vec<u8>> {
+        if bytes == 0 {
+            return Ok(Vec::new());
+        }
         let dev = &self.sim.device;
         let size = bytes.max(4).next_multiple_of(4);
         let staging = dev.create_buffer(&wgpu::BufferDescriptor {
@@ -606,7 +618,7 @@ fn map_wait(dev: &wgpu::Device, buf: &wgpu::Buffer) -> Result<()> {
 }
 
 impl RoundRunner for GpuRounds<'_> {
-    fn round(&mut self, p: &Params, first: bool) -> Result<Counters> {
+    fn round(&mut self, p: &Params, first: bool, selection: Selection) -> Result<Counters> {
         let sim = self.sim;
         let (q, dev) = (&sim.queue, &sim.device);
         q.write_buffer(&self.params, 0, bytemuck::bytes_of(p));
@@ -755,7 +767,26 @@ impl RoundRunner for GpuRounds<'_> {
             PER_LIVE,
         );
         enc.clear_buffer(&vlock, 0, None);
-        for _ in 0..self.selection_passes {
+        for pass in 0u32.. {
+            match selection {
+                Selection::Ordinary if pass == self.selection_passes => break,
+                // Exhaustive: every EXHAUSTIVE_CHUNK passes, submit what is recorded and read
+                // the last pass's tentative count; none means no candidate is left to settle.
+                Selection::Exhaustive if pass > 0 && pass % EXHAUSTIVE_CHUNK == 0 => {
+                    let done = std::mem::replace(
+                        &mut enc,
+                        dev.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                            label: Some("meshslim.round"),
+                        }),
+                    );
+                    q.submit([done.finish()]);
+                    let now: Counters = *bytemuck::from_bytes(&self.read(&counters, 64)?);
+                    if now.tentative == 0 {
+                        break;
+                    }
+                }
+                _ => {}
+            }
             enc.clear_buffer(&fbest, 0, None);
             enc.clear_buffer(&fid, 0, None);
             // counters.tentative: the list select_win fills is per pass.
@@ -891,16 +922,13 @@ impl RoundRunner for GpuRounds<'_> {
             self.times.add("round (wall, no timestamps)", wall);
         }
         self.cur = o;
+        self.live_counts = (counters_out.vertices_out, counters_out.faces_out);
         Ok(counters_out)
     }
 
     fn download(&mut self) -> Result<Download> {
         let t = Instant::now();
-        // Counts from the last round's draw arguments (the buffers are sized for the input).
-        let args: DrawArgs = *bytemuck::from_bytes(&self.read(&self.draw_args, 20)?);
-        let nf = (args.index_count / 3) as u64;
-        let vk = self.read(&self.counters, 64)?;
-        let nv = bytemuck::from_bytes::<Counters>(&vk).vertices_out as u64;
+        let (nv, nf) = (self.live_counts.0 as u64, self.live_counts.1 as u64);
         let h = &self.half[self.cur];
         let d = Download {
             positions: bytemuck::pod_collect_to_vec(&self.read(&h.positions, nv * 16)?),
