@@ -155,7 +155,7 @@ pub struct ViewArgs {
 
     /// With --screenshot: simplify to this fraction of the faces on the GPU first, in (0, 1]
     /// (default 1: the mesh as is). In the window: the starting target (default 0.1)
-    #[arg(long, value_name = "R", value_parser = parse_ratio)]
+    #[arg(long, value_name = "R", value_parser = parse_ratio, allow_negative_numbers = true)]
     pub ratio: Option<f64>,
 
     /// What the surface shows
@@ -174,6 +174,11 @@ pub struct ViewArgs {
     /// WIDTHxHEIGHT
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
+
+    /// The mesh's axis drawn up: x, y, z, -x, -y, -z, or auto (the largest silhouette).
+    /// Default: the file's convention, +Y (OBJ, PLY, glTF, generated meshes) or +Z (STL)
+    #[arg(long, value_enum, value_name = "AXIS", allow_hyphen_values = true)]
+    pub up: Option<crate::viewer::camera::Up>,
 }
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
@@ -182,6 +187,7 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     let (w, h) = (w.trim().parse::<u32>(), h.trim().parse::<u32>());
     match (w, h) {
         (Ok(w), Ok(h)) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => Ok((w, h)),
+        (Ok(w), Ok(h)) => Err(format!("{w}x{h}: each side must be 1 to 16384 pixels")),
         _ => Err(bad()),
     }
 }
@@ -200,11 +206,16 @@ fn run_view(args: ViewArgs) -> Result<ExitCode> {
                 .spinner(format!("reading {}", path.display()), || {
                     crate::viewer::Model::open(path, args.texture.as_deref())
                 })
+                .map(|mut m| {
+                    m.up_axis = args.up.unwrap_or(m.up_axis);
+                    m
+                })
                 .map_err(lib)
                 .context("cannot read the input"),
             Input::Builtin { .. } => {
                 let mesh = load(input, &progress)?;
                 let mut m = crate::viewer::Model::from_mesh(input.display(), mesh).map_err(lib)?;
+                m.up_axis = args.up.unwrap_or(m.up_axis);
                 if let Some(t) = &args.texture {
                     m.texture = Some(crate::viewer::scene::read_texture(t).map_err(lib)?);
                 }
@@ -230,7 +241,8 @@ fn run_view(args: ViewArgs) -> Result<ExitCode> {
             None => crate::viewer::Start::Nothing,
         };
         let size = args.size.unwrap_or((1280, 800));
-        crate::viewer::run_window(start, args.ratio.unwrap_or(0.1), style, size).map_err(lib)?;
+        crate::viewer::run_window(start, args.ratio.unwrap_or(0.1), style, size, args.up)
+            .map_err(lib)?;
         return Ok(ExitCode::SUCCESS);
     };
     let Some(input) = &args.input else {
@@ -245,6 +257,16 @@ fn run_view(args: ViewArgs) -> Result<ExitCode> {
             png.display()
         ))
         .into());
+    }
+    // Before any reading or rendering: a screenshot with nowhere to go fails at once.
+    if let Some(dir) = png.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        anyhow::bail!(
+            "{}: the screenshot's directory {} does not exist",
+            png.display(),
+            dir.display()
+        );
     }
     let model = model(input)?;
     let size = args.size.unwrap_or((1024, 768));
@@ -325,17 +347,17 @@ pub struct SimplifyArgs {
     pub output: Option<PathBuf>,
 
     /// Keep this fraction of the faces, in (0, 1] [default: 0.1 unless --faces is given]
-    #[arg(short, long, value_name = "R", value_parser = parse_ratio, conflicts_with = "faces")]
+    #[arg(short, long, value_name = "R", value_parser = parse_ratio, allow_negative_numbers = true, conflicts_with = "faces")]
     pub ratio: Option<f64>,
 
     /// Keep this many faces (reached exactly or one below: an interior collapse removes two).
     /// 0 simplifies until --max-error or the constraints stop it
-    #[arg(short, long, value_name = "N")]
+    #[arg(short, long, value_name = "N", value_parser = parse_face_count, allow_negative_numbers = true)]
     pub faces: Option<usize>,
 
     /// Stop before a collapse whose error exceeds E, relative to the bounding-box diagonal
     /// (0.001 = 0.1% of the diagonal), even if the face target is not reached [default: no limit]
-    #[arg(short = 'e', long, value_name = "E", value_parser = parse_non_negative)]
+    #[arg(short = 'e', long, value_name = "E", value_parser = parse_non_negative, allow_negative_numbers = true)]
     pub max_error: Option<f64>,
 
     /// Keep the border (the outline of an open mesh) exactly: border vertices never move, and one
@@ -345,18 +367,18 @@ pub struct SimplifyArgs {
 
     /// Weight of the border and attribute-seam constraint planes relative to the face planes
     /// (Hoppe's boundary quadrics); larger keeps open borders and seams closer to where they were
-    #[arg(long, value_name = "W", default_value_t = 1.0, value_parser = parse_non_negative)]
+    #[arg(long, value_name = "W", default_value_t = 1.0, value_parser = parse_non_negative, allow_negative_numbers = true)]
     pub border_weight: f64,
 
     /// Refuse a collapse that turns any surrounding face's normal by more than DEG degrees,
     /// in (0, 180]
-    #[arg(long = "max-normal-angle", value_name = "DEG", default_value_t = 90.0, value_parser = parse_angle)]
+    #[arg(long = "max-normal-angle", value_name = "DEG", default_value_t = 90.0, value_parser = parse_angle, allow_negative_numbers = true)]
     pub max_normal_angle: f64,
 
     /// Collapses creating faces of quality below Q cost proportionally more (MeshLab's
     /// QualityThr; quality is 0.866 for an equilateral triangle, 0 for a sliver), in [0, 1].
     /// 0 turns the term off, giving textbook QEM order
-    #[arg(long, value_name = "Q", default_value_t = 0.3, value_parser = parse_unit)]
+    #[arg(long, value_name = "Q", default_value_t = 0.3, value_parser = parse_unit, allow_negative_numbers = true)]
     pub quality_threshold: f64,
 
     /// Which implementation simplifies
@@ -421,7 +443,7 @@ pub struct BenchArgs {
     pub meshes: Vec<Input>,
 
     /// Fractions of the faces to keep, comma-separated, each in (0, 1]
-    #[arg(long, value_name = "R,...", value_delimiter = ',', value_parser = parse_bench_ratio,
+    #[arg(long, value_name = "R,...", value_delimiter = ',', value_parser = parse_bench_ratio, allow_negative_numbers = true,
           default_values_t = crate::bench::DEFAULT_RATIOS)]
     pub ratios: Vec<f64>,
 
@@ -515,6 +537,12 @@ fn parse_f64(s: &str) -> std::result::Result<f64, String> {
     } else {
         Err(format!("{s:?} is not a finite number"))
     }
+}
+
+fn parse_face_count(s: &str) -> std::result::Result<usize, String> {
+    s.trim()
+        .parse::<usize>()
+        .map_err(|_| format!("{s:?}: the face count is a whole number, 0 or more"))
 }
 
 fn parse_ratio(s: &str) -> std::result::Result<f64, String> {
@@ -890,7 +918,9 @@ fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
             crate::simplify_with_progress(&mesh, &opts, &mut |f| set(f))
         });
     }
-    let (simplified, report) = result.map_err(lib)?;
+    let (simplified, report) = result
+        .map_err(lib)
+        .with_context(|| format!("cannot simplify {}", input.display()))?;
     let simplify_s = t.elapsed().as_secs_f64();
     drop(mesh);
 
@@ -996,6 +1026,9 @@ fn write_summary(
             r.target_faces,
             reason.explain()
         )?,
+    }
+    if let Some(b) = &r.blocked {
+        writeln!(out, "why      {}", b.explain())?;
     }
     writeln!(
         out,

@@ -583,3 +583,172 @@ fn an_obj_written_to_another_folder_still_finds_its_material_library() {
     assert!(text.contains("\nmtllib ../scan/scan.mtl\n"), "{text:.200}");
     assert!(!stderr(&o).contains("does not keep"), "{}", stderr(&o));
 }
+
+/// The new user's panic cases: a target at or above the input, a lone triangle, a bench at
+/// ratio 1, a screenshot of a lone triangle — every backend exits 0 (gpu where an adapter is;
+/// with CI=true a missing adapter fails the run).
+#[test]
+fn targets_at_or_above_the_input_exit_cleanly_on_every_backend() {
+    let dir = tempfile::tempdir().unwrap();
+    let single = dir.path().join("single.obj");
+    std::fs::write(&single, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let mut backends = vec!["cpu", "cpu-parallel"];
+    if common::gpu_context().is_some() {
+        backends.push("gpu");
+    }
+    for backend in &backends {
+        for args in [
+            vec!["simplify", SMALL_SPHERE, "a.obj", "--ratio", "1"],
+            vec!["simplify", SMALL_SPHERE, "b.obj", "--faces", "5000"],
+            vec!["simplify", "single.obj", "c.obj", "--ratio", "0.5"],
+        ] {
+            let mut args = args.clone();
+            args.extend(["--backend", backend]);
+            let o = meshslim(&args, dir.path());
+            expect_code(&o, 0);
+            assert!(stdout(&o).contains("reached the face target"), "{args:?}");
+        }
+        let o = meshslim(
+            &[
+                "bench",
+                SMALL_SPHERE,
+                "--ratios",
+                "1",
+                "--backends",
+                backend,
+                "--repeat",
+                "1",
+            ],
+            dir.path(),
+        );
+        expect_code(&o, 0);
+    }
+    if backends.contains(&"gpu") {
+        let o = meshslim(
+            &[
+                "view",
+                "single.obj",
+                "--screenshot",
+                "s.png",
+                "--ratio",
+                "0.5",
+                "--size",
+                "64x48",
+            ],
+            dir.path(),
+        );
+        expect_code(&o, 0);
+        assert!(dir.path().join("s.png").is_file());
+    }
+}
+
+/// Misleading or late messages a new user met, each now early and to the point.
+#[test]
+fn bad_inputs_get_early_messages_that_say_what_is_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("cloud.ply"),
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n\
+         property float z\nend_header\n0 0 0\n1 0 0\n",
+    )
+    .unwrap();
+    std::fs::create_dir(d.join("folder.obj")).unwrap();
+    std::fs::write(d.join("single.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    // (arguments, exit code, what stderr says)
+    let cases: &[(&[&str], i32, &str)] = &[
+        (&["simplify", "cloud.ply", "out.ply"], 1, "no faces"),
+        (
+            &["simplify", "folder.obj", "out.ply"],
+            1,
+            "a directory, not a mesh file",
+        ),
+        (
+            &["simplify", "single.obj", "o.ply", "--ratio", "-1"],
+            2,
+            "the ratio must be in (0, 1]",
+        ),
+        (
+            &["simplify", "single.obj", "o.ply", "--faces", "-3"],
+            2,
+            "whole number",
+        ),
+        (
+            &[
+                "view",
+                "single.obj",
+                "--screenshot",
+                "s.png",
+                "--size",
+                "0x0",
+            ],
+            2,
+            "1 to 16384 pixels",
+        ),
+        (
+            &["view", "single.obj", "--screenshot", "nowhere/s.png"],
+            1,
+            "does not exist",
+        ),
+    ];
+    for (args, code, says) in cases {
+        let o = meshslim(args, d);
+        expect_code(&o, *code);
+        assert!(stderr(&o).contains(says), "{args:?}:\n{}", stderr(&o));
+        assert!(
+            !stderr(&o).contains("-- -1"),
+            "{args:?}: clap's tip for negative numbers"
+        );
+    }
+    assert!(
+        !d.join("out.ply").exists(),
+        "nothing is written for a point cloud"
+    );
+    if common::gpu_context().is_some() {
+        // Refused before simplifying: no spinner or GPU work comes first.
+        let o = meshslim(
+            &[
+                "view",
+                "single.obj",
+                "--screenshot",
+                "t.png",
+                "--mode",
+                "texture",
+                "--ratio",
+                "0.5",
+            ],
+            d,
+        );
+        expect_code(&o, 1);
+        assert!(
+            stderr(&o).contains("no UVs or no texture"),
+            "{}",
+            stderr(&o)
+        );
+        assert!(!d.join("t.png").exists());
+    }
+}
+
+/// Mesa's device-select layer makes libwayland print "XDG_RUNTIME_DIR is invalid or not set"
+/// on a headless machine; the binary gives the probe an empty runtime directory of its own.
+#[test]
+fn gpu_commands_print_no_wayland_noise_without_a_runtime_dir() {
+    if common::gpu_context().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_meshslim"))
+        .args(["simplify", SMALL_SPHERE, "o.ply", "--backend", "gpu"])
+        .current_dir(dir.path())
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .output()
+        .unwrap();
+    expect_code(&o, 0);
+    assert!(
+        !stderr(&o).contains("XDG_RUNTIME_DIR"),
+        "stderr:\n{}",
+        stderr(&o)
+    );
+}

@@ -78,6 +78,15 @@ pub struct WriteOptions {
 
 /// Reads a mesh, the format chosen by the file extension.
 pub fn read(path: &Path) -> Result<Mesh> {
+    if path.is_dir() {
+        return Err(Error::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                "a directory, not a mesh file (.obj, .ply, .stl, .gltf or .glb)",
+            ),
+        });
+    }
     read_format(path, Format::from_path(path)?)
 }
 

@@ -5,7 +5,7 @@
 //! simplifying and making levels of detail run on worker threads; the UI keeps drawing frames
 //! (their time is shown) and can cancel them.
 
-use super::camera::Camera;
+use super::camera::{Camera, Up};
 use super::render::{Mode, Renderer, SceneMesh, Style, Target};
 use super::scene::{self, Model, Simplified};
 use crate::error::{Error, Result};
@@ -154,6 +154,8 @@ pub struct ViewerApp {
     pub save_path: String,
     pub shot_path: String,
     pub texture_note: Option<String>,
+    /// The axis drawn up for every mesh, when the user chose one; else each file's convention.
+    pub up: Option<Up>,
     ctx: egui::Context,
 }
 
@@ -224,6 +226,7 @@ impl ViewerApp {
             save_path: String::new(),
             shot_path: "meshslim-view.png".into(),
             texture_note: None,
+            up: None,
             ctx: cc.egui_ctx.clone(),
         };
         match start {
@@ -323,7 +326,7 @@ impl ViewerApp {
                 .display()
                 .to_string()
         });
-        self.camera = home_camera(&m, self.aspect());
+        self.camera = home_camera(&m, self.aspect(), self.up);
         self.faces_text = ((m.faces() as f64 * self.ratio).round() as usize)
             .max(1)
             .to_string();
@@ -982,9 +985,15 @@ impl ViewerApp {
         }
     }
 
+    /// Draws every mesh with `up` up (None: each file's convention) and resets the view.
+    pub fn set_up(&mut self, up: Option<Up>) {
+        self.up = up;
+        self.reset_view();
+    }
+
     pub fn reset_view(&mut self) {
         if let Some(m) = &self.model {
-            self.camera = home_camera(m, self.aspect());
+            self.camera = home_camera(m, self.aspect(), self.up);
         }
         if self.lod_scene && self.lod.is_some() {
             self.camera = self.lod_home();
@@ -1099,6 +1108,23 @@ impl ViewerApp {
         ui.checkbox(&mut self.side_by_side, "side by side (B)");
         ui.add_enabled_ui(self.simplified.is_some() && !self.side_by_side, |ui| {
             ui.checkbox(&mut self.show_original, "show the original (O)");
+        });
+        ui.horizontal(|ui| {
+            let file_up = self.model.as_ref().map_or(Up::Y, |m| m.up_axis);
+            let current = self.up.unwrap_or(file_up);
+            let mut chosen = current;
+            egui::ComboBox::from_label("up")
+                .selected_text(current.label())
+                .show_ui(ui, |ui| {
+                    for u in Up::ALL {
+                        ui.selectable_value(&mut chosen, u, u.label());
+                    }
+                })
+                .response
+                .on_hover_text("the mesh's axis drawn up (default: its file's convention)");
+            if chosen != current {
+                self.set_up(Some(chosen));
+            }
         });
         ui.horizontal(|ui| {
             if ui.button("Fit").on_hover_text("F").clicked() {
@@ -1316,10 +1342,10 @@ impl eframe::App for ViewerApp {
     }
 }
 
-/// The camera a model opens with: turned to its largest silhouette, framed.
-fn home_camera(m: &Model, aspect: f32) -> Camera {
+/// The camera a model opens with: its up axis (`up`, else its file's) up, framed.
+fn home_camera(m: &Model, aspect: f32, up: Option<Up>) -> Camera {
     let mut cam = Camera {
-        model: Camera::upright(m.extent()),
+        model: up.unwrap_or(m.up_axis).model(m.extent()),
         yaw: 0.35,
         pitch: 0.2,
         ..Camera::default()

@@ -113,8 +113,7 @@ impl Camera {
     }
 
     /// A rotation that shows a box of these `extent`s by its largest silhouette: the longest
-    /// axis across the screen, the middle one up, the shortest toward the viewer — a scan of a
-    /// horse or a statue is seen from the side whichever axis its file calls up.
+    /// axis across the screen, the middle one up, the shortest toward the viewer ([`Up::Auto`]).
     pub fn upright(extent: Vec3) -> Mat4 {
         let mut axes = [
             (extent.x, Vec3::X),
@@ -123,14 +122,85 @@ impl Camera {
         ];
         axes.sort_by(|a, b| b.0.total_cmp(&a.0));
         let (across, up) = (axes[0].1, axes[1].1);
-        let toward = across.cross(up);
-        // Rows map the mesh's axes onto screen x, y, z.
-        Mat4::from_cols(
-            Vec3::new(across.x, up.x, toward.x).extend(0.0),
-            Vec3::new(across.y, up.y, toward.y).extend(0.0),
-            Vec3::new(across.z, up.z, toward.z).extend(0.0),
-            glam::Vec4::W,
-        )
+        rotation_onto_screen(across, up)
+    }
+}
+
+/// The rotation whose rows map the mesh's `across` and `up` axes onto screen x and y (and
+/// their cross product toward the viewer): a rotation, never a mirror.
+fn rotation_onto_screen(across: Vec3, up: Vec3) -> Mat4 {
+    let toward = across.cross(up);
+    Mat4::from_cols(
+        Vec3::new(across.x, up.x, toward.x).extend(0.0),
+        Vec3::new(across.y, up.y, toward.y).extend(0.0),
+        Vec3::new(across.z, up.z, toward.z).extend(0.0),
+        glam::Vec4::W,
+    )
+}
+
+/// Which of the mesh's axes points up on screen. Files carry a convention, not a tag: OBJ and
+/// most PLY scans are +Y up and glTF is +Y up by its specification, while STL (CAD, 3D printing)
+/// is +Z up — so a standing figure stands when drawn with its file's axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Up {
+    #[value(name = "x", alias = "+x")]
+    X,
+    #[value(name = "-x")]
+    NegX,
+    #[default]
+    #[value(name = "y", alias = "+y")]
+    Y,
+    #[value(name = "-y")]
+    NegY,
+    #[value(name = "z", alias = "+z")]
+    Z,
+    #[value(name = "-z")]
+    NegZ,
+    /// The largest silhouette: the longest axis across, the middle one up, whatever the file
+    /// calls up (a lying scan is seen from the side).
+    Auto,
+}
+
+impl Up {
+    pub const ALL: [Up; 7] = [Up::Y, Up::Z, Up::X, Up::NegY, Up::NegZ, Up::NegX, Up::Auto];
+
+    /// The convention of the file's format: +Z for STL, +Y for the rest (and generated meshes).
+    pub fn of_file(path: Option<&std::path::Path>) -> Up {
+        let ext = path
+            .and_then(|p| p.extension())
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("stl") => Up::Z,
+            _ => Up::Y,
+        }
+    }
+
+    pub fn label(self) -> &'static str {
+        match self {
+            Up::X => "+X",
+            Up::NegX => "-X",
+            Up::Y => "+Y",
+            Up::NegY => "-Y",
+            Up::Z => "+Z",
+            Up::NegZ => "-Z",
+            Up::Auto => "auto",
+        }
+    }
+
+    /// The turn that puts this axis up on screen; its front faces the viewer (for +Z up, the
+    /// -Y side, as CAD front views have it). `extent` is used by [`Up::Auto`] alone.
+    pub fn model(self, extent: Vec3) -> Mat4 {
+        let (across, up) = match self {
+            Up::Y => (Vec3::X, Vec3::Y),
+            Up::NegY => (Vec3::X, Vec3::NEG_Y),
+            Up::Z => (Vec3::X, Vec3::Z),
+            Up::NegZ => (Vec3::X, Vec3::NEG_Z),
+            Up::X => (Vec3::NEG_Y, Vec3::X),
+            Up::NegX => (Vec3::Y, Vec3::NEG_X),
+            Up::Auto => return Camera::upright(extent),
+        };
+        rotation_onto_screen(across, up)
     }
 }
 
@@ -190,6 +260,41 @@ mod tests {
             (m.determinant() - 1.0).abs() < 1e-6,
             "a rotation, not a mirror"
         );
+    }
+
+    #[test]
+    fn every_up_axis_turns_onto_screen_up_without_a_mirror() {
+        let extent = Vec3::new(0.3, 0.9, 0.2);
+        for (up, axis) in [
+            (Up::X, Vec3::X),
+            (Up::NegX, Vec3::NEG_X),
+            (Up::Y, Vec3::Y),
+            (Up::NegY, Vec3::NEG_Y),
+            (Up::Z, Vec3::Z),
+            (Up::NegZ, Vec3::NEG_Z),
+        ] {
+            let m = up.model(extent);
+            assert!(
+                (m.transform_vector3(axis) - Vec3::Y).length() < 1e-6,
+                "{up:?}"
+            );
+            assert!((m.determinant() - 1.0).abs() < 1e-6, "{up:?} mirrors");
+        }
+        // +Y is the file's own frame; +Z up shows the -Y side to the viewer.
+        assert_eq!(Up::Y.model(extent), Mat4::IDENTITY);
+        assert!((Up::Z.model(extent).transform_vector3(Vec3::NEG_Y) - Vec3::Z).length() < 1e-6);
+        // A standing figure (tall in y) drawn by its largest silhouette would lie on its side.
+        assert!((Up::Auto.model(extent).transform_vector3(Vec3::Y) - Vec3::X).length() < 1e-6);
+    }
+
+    #[test]
+    fn up_follows_the_file_format() {
+        use std::path::Path;
+        assert_eq!(Up::of_file(Some(Path::new("part.STL"))), Up::Z);
+        for f in ["a.obj", "b.ply", "c.glb", "d.gltf"] {
+            assert_eq!(Up::of_file(Some(Path::new(f))), Up::Y, "{f}");
+        }
+        assert_eq!(Up::of_file(None), Up::Y);
     }
 
     #[test]

@@ -30,6 +30,15 @@ pub struct Frame {
 /// Simplifies `model` to `ratio` on the GPU (1 = as is) and renders one `size` frame of the
 /// result in `style`, framed to fit, straight from the simplifier's buffers; returns a PNG.
 pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> Result<Frame> {
+    // Checked before the GPU work: a texture mode without a texture fails at once.
+    if style.mode == Mode::Texture && !(model.mesh.uvs.is_some() && model.texture.is_some()) {
+        return Err(Error::InvalidOption(format!(
+            "--mode texture: {}",
+            model.texture_note.clone().unwrap_or_else(|| {
+                "the mesh has no UVs or no texture (give one with --texture)".into()
+            })
+        )));
+    }
     let (ctx, sim) = crate::gpu::shared()?;
     let mut style = style;
     let (scene, faces) = if ratio < 1.0 {
@@ -49,14 +58,6 @@ pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> 
     } else {
         (model.original(&ctx.device)?, model.faces())
     };
-    if style.mode == Mode::Texture && !(scene.has_uvs && model.texture.is_some()) {
-        return Err(Error::InvalidOption(format!(
-            "--mode texture: {}",
-            model.texture_note.clone().unwrap_or_else(|| {
-                "the mesh has no UVs or no texture (give one with --texture)".into()
-            })
-        )));
-    }
     style.error_scale = scene.max_error;
     let mut renderer = Renderer::new(&ctx.device, &ctx.queue);
     let max = ctx.device.limits().max_texture_dimension_2d;
@@ -79,7 +80,7 @@ pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> 
         renderer.set_texture(&ctx.device, &ctx.queue, Some((&t.rgba, t.size)));
     }
     let mut cam = Camera {
-        model: Camera::upright(model.extent()),
+        model: model.up_axis.model(model.extent()),
         yaw: 0.35,
         pitch: 0.2,
         ..Camera::default()
@@ -108,7 +109,13 @@ pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> 
 
 /// Opens the interactive window with `ratio` as the starting target, drawn in `style`, of
 /// `size` points (blocks until it is closed).
-pub fn run_window(start: Start, ratio: f64, style: Style, size: (u32, u32)) -> Result<()> {
+pub fn run_window(
+    start: Start,
+    ratio: f64,
+    style: Style,
+    size: (u32, u32),
+    up: Option<camera::Up>,
+) -> Result<()> {
     let options = eframe::NativeOptions {
         viewport: eframe::egui::ViewportBuilder::default()
             .with_title("meshslim")
@@ -133,6 +140,7 @@ pub fn run_window(start: Start, ratio: f64, style: Style, size: (u32, u32)) -> R
             let mut app = ViewerApp::new(cc, start)?;
             app.set_ratio(ratio);
             app.set_style(style);
+            app.set_up(up);
             Ok(Box::new(app))
         }),
     )

@@ -2,6 +2,7 @@
 //! a BVH for distances, its texture), the original and simplified [`SceneMesh`]es, and levels of
 //! detail. Nothing here touches egui; the window (`app.rs`) and the tests drive it alike.
 
+use super::camera::Up;
 use super::render::{Extras, SceneMesh, vertex_normals};
 use crate::error::{Error, Result};
 use crate::gpu::{GpuMesh, GpuRounds, GpuSimplifier};
@@ -38,6 +39,8 @@ pub struct Model {
     /// A texture that was named but could not be used, and why.
     pub texture_note: Option<String>,
     pub load_seconds: f64,
+    /// The axis drawn up: its file format's convention ([`Up::of_file`]), +Y when generated.
+    pub up_axis: Up,
 }
 
 impl Model {
@@ -52,6 +55,7 @@ impl Model {
         };
         let mut m = Model::from_mesh(path.display().to_string(), mesh)?;
         m.path = Some(path.to_path_buf());
+        m.up_axis = Up::of_file(Some(path));
         m.texture = texture;
         m.texture_note = note;
         m.load_seconds = t.elapsed().as_secs_f64();
@@ -81,6 +85,7 @@ impl Model {
             texture: None,
             texture_note: None,
             load_seconds: t.elapsed().as_secs_f64(),
+            up_axis: Up::Y,
         })
     }
 
