@@ -11,6 +11,13 @@ use meshslim::cli::{self, Cli};
 static ALLOC: meshslim::bench::alloc::CountingAlloc = meshslim::bench::alloc::CountingAlloc;
 
 fn main() -> ExitCode {
+    let _runtime_dir = meshslim::gpu::context::quiet_wayland_probe().map(|(dir, value)| {
+        // SAFETY: set_var races only with other threads reading or writing the environment, and
+        // none exists yet: this is the first statement of main, before clap, rayon or wgpu
+        // start anything, and no dependency spawns a thread before main.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", value) };
+        dir
+    });
     // clap prints its own usage errors and exits with 2.
     let args = Cli::parse();
     match cli::run(args) {

@@ -48,6 +48,32 @@ impl GpuContext {
     }
 }
 
+/// The runtime directory that keeps Mesa's device-select layer quiet, when one is needed.
+///
+/// Mesa 22.3's implicit `VK_LAYER_MESA_device_select` connects to Wayland whenever an application
+/// enables `VK_KHR_wayland_surface` (wgpu does), and libwayland prints `error: XDG_RUNTIME_DIR is
+/// invalid or not set in the environment.` when there is no runtime directory: twice per device
+/// on every headless machine, though nothing failed. With neither `WAYLAND_DISPLAY` nor
+/// `WAYLAND_SOCKET` set and no valid `XDG_RUNTIME_DIR`, no compositor can be found either way, so
+/// pointing the probe at an empty private directory changes nothing but that line; with any of
+/// them set, nothing is touched and every message gets through. Returns the directory (removed
+/// when dropped) and the value to give `XDG_RUNTIME_DIR`, or `None` when nothing is needed.
+pub fn quiet_wayland_probe() -> Option<(tempfile::TempDir, std::ffi::OsString)> {
+    let set = |k: &str| std::env::var_os(k).is_some_and(|v| !v.is_empty());
+    let valid_runtime_dir =
+        std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_absolute());
+    if set("WAYLAND_DISPLAY") || set("WAYLAND_SOCKET") || valid_runtime_dir {
+        return None;
+    }
+    // tempfile makes the directory 0700, as the XDG spec asks of a runtime directory.
+    let dir = tempfile::Builder::new()
+        .prefix("meshslim-runtime-")
+        .tempdir()
+        .ok()?;
+    let value = dir.path().as_os_str().to_owned();
+    Some((dir, value))
+}
+
 /// A buffer of `size` bytes (at least 16 and a multiple of 4: wgpu refuses empty buffers),
 /// checked against the device's limits before it is allocated.
 pub fn checked_buffer(
