@@ -259,15 +259,7 @@ fn run_view(args: ViewArgs) -> Result<ExitCode> {
         .into());
     }
     // Before any reading or rendering: a screenshot with nowhere to go fails at once.
-    if let Some(dir) = png.parent().filter(|d| !d.as_os_str().is_empty())
-        && !dir.is_dir()
-    {
-        anyhow::bail!(
-            "{}: the screenshot's directory {} does not exist",
-            png.display(),
-            dir.display()
-        );
-    }
+    check_directory(&png, "the screenshot's directory")?;
     let model = model(input)?;
     let size = args.size.unwrap_or((1024, 768));
     let frame = progress
@@ -784,18 +776,24 @@ fn load(input: &Input, progress: &Progress) -> Result<Mesh> {
     }
 }
 
-/// The checks that need no mesh, so that a wrong output path fails before any work.
-fn check_output(input: &Input, output: &Path) -> Result<()> {
-    Format::from_path(output).map_err(lib)?;
-    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty())
+/// Fails when the folder `file` is to be written into does not exist (`what` names it).
+fn check_directory(file: &Path, what: &str) -> Result<()> {
+    if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty())
         && !dir.is_dir()
     {
         anyhow::bail!(
-            "{}: the output directory {} does not exist",
-            output.display(),
+            "{}: {what} {} does not exist",
+            file.display(),
             dir.display()
         );
     }
+    Ok(())
+}
+
+/// The checks that need no mesh, so that a wrong output path fails before any work.
+fn check_output(input: &Input, output: &Path) -> Result<()> {
+    Format::from_path(output).map_err(lib)?;
+    check_directory(output, "the output directory")?;
     if let Input::File(input) = input
         && output.exists()
         && same_file(input, output)
