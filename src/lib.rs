@@ -29,7 +29,9 @@
 //!   2015 (independent-set collapses on the GPU; our rounds remove 13–18% per round where its
 //!   single local-minimum pass removed 8–9%).
 
+#[cfg(feature = "bench")]
 pub mod bench;
+#[cfg(feature = "cli")]
 pub mod cli;
 pub mod cpu;
 pub mod error;
@@ -41,6 +43,7 @@ pub mod metrics;
 pub mod parallel;
 pub mod quadric;
 pub mod simplify;
+#[cfg(feature = "viewer")]
 pub mod viewer;
 
 pub use error::{Error, Location, Result};

@@ -141,20 +141,21 @@ fn rotation_onto_screen(across: Vec3, up: Vec3) -> Mat4 {
 /// Which of the mesh's axes points up on screen. Files carry a convention, not a tag: OBJ and
 /// most PLY scans are +Y up and glTF is +Y up by its specification, while STL (CAD, 3D printing)
 /// is +Z up — so a standing figure stands when drawn with its file's axis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Up {
-    #[value(name = "x", alias = "+x")]
+    #[cfg_attr(feature = "cli", value(name = "x", alias = "+x"))]
     X,
-    #[value(name = "-x")]
+    #[cfg_attr(feature = "cli", value(name = "-x"))]
     NegX,
     #[default]
-    #[value(name = "y", alias = "+y")]
+    #[cfg_attr(feature = "cli", value(name = "y", alias = "+y"))]
     Y,
-    #[value(name = "-y")]
+    #[cfg_attr(feature = "cli", value(name = "-y"))]
     NegY,
-    #[value(name = "z", alias = "+z")]
+    #[cfg_attr(feature = "cli", value(name = "z", alias = "+z"))]
     Z,
-    #[value(name = "-z")]
+    #[cfg_attr(feature = "cli", value(name = "-z"))]
     NegZ,
     /// The largest silhouette: the longest axis across, the middle one up, whatever the file
     /// calls up (a lying scan is seen from the side).

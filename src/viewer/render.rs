@@ -10,7 +10,8 @@ use glam::Mat4;
 use wgpu::util::DeviceExt;
 
 /// What the fragments show.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Mode {
     /// Lit from the camera (flat, or smooth with per-vertex normals).
     Shaded,
