@@ -185,21 +185,23 @@ fn each_stage_matches_its_cpu_twin() {
         cpu.candidates = g_cand;
         cpu.live = g_live;
         // select_cost, select_id, select_win, validate, and the trim stages.
-        cpu.select(&p, ne as u32, Selection::Ordinary);
+        cpu.select(&p, ne as u32, Selection::Ordinary).unwrap();
         let g_state = pod::<u32>(rd("edge_state", 4 * ne));
         assert_eq!(
             g_state, cpu.edge_state,
             "{name}: edge_state after selection"
         );
-        // collapse relies on it (the CPU rounds assert it on their own state in debug builds).
-        assert!(
-            meshslim::cpu::select::winners_share_no_face(
-                &cpu.offsets,
-                &cpu.vertex_faces,
-                &cpu.edges[..ne],
-                &g_state,
-                p.face_count as usize,
-            ),
+        // collapse relies on it (the CPU rounds check it on their own state every round).
+        let shared = meshslim::cpu::select::shared_face(
+            &cpu.offsets,
+            &cpu.vertex_faces,
+            &cpu.edges[..ne],
+            &g_state,
+            &mut Vec::new(),
+            p.face_count as usize,
+        );
+        assert_eq!(
+            shared, None,
             "{name}: two of the GPU's winners share a face"
         );
         assert!(

@@ -108,8 +108,9 @@ pub fn collapse(
         }
         let c = &candidates[e as usize];
         let (k, r) = (c.keep as usize, c.remove as usize);
-        // SAFETY: winners share no face and so no vertex (the selection; asserted in debug
-        // builds by `select::winners_share_no_face`); each winner reads and writes only its own
+        // SAFETY: winners share no face and so no vertex (the selection; checked every round,
+        // release builds included, by `select::shared_face`, after which `CpuRounds::select`
+        // stops with an error instead of reaching this stage); each winner reads and writes only its own
         // two vertices and the faces around the removed one, which no other winner touches.
         unsafe {
             if flags.read(k) & flag::SEAM != 0 {

@@ -25,7 +25,7 @@ pub mod validate;
 pub mod vertex_flags;
 pub mod vertex_quadrics;
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gpu::types::*;
 use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
 use crate::simplify::{Blocked, SimplifyOptions};
@@ -186,6 +186,10 @@ pub struct CpuRounds {
     out_face_extra: Vec<FaceExtra>,
     times: StageTimes,
     selection_passes: u32,
+    /// Per face, the winner that reaches it: `select::shared_face`'s scratch, kept between rounds.
+    face_owner: Vec<u32>,
+    /// Rounds run so far, to name the round in an internal error.
+    rounds_run: u32,
 }
 
 fn reset(v: &mut Vec<u32>, n: usize) {
@@ -365,7 +369,7 @@ impl CpuRounds {
     }
 
     /// The selection passes, then trimming when the round would overshoot.
-    pub fn select(&mut self, p: &Params, ne: u32, selection: Selection) {
+    pub fn select(&mut self, p: &Params, ne: u32, selection: Selection) -> Result<()> {
         let nf = p.face_count as usize;
         reset(&mut self.vertex_lock, p.vertex_count as usize);
         self.tentative.resize(ne as usize, 0);
@@ -440,19 +444,24 @@ impl CpuRounds {
             s.times.add("select_win", (t3 - t2).as_secs_f64());
             s.times.add("validate", t3.elapsed().as_secs_f64());
         }
-        // On in debug builds and in the tests (which run in release: the `invariants` feature
-        // their self-dev-dependency turns on); off for users, where it costs a scan per round.
-        #[cfg(any(debug_assertions, feature = "invariants"))]
-        assert!(
-            select::winners_share_no_face(
-                &self.offsets,
-                &self.vertex_faces,
-                &self.edges[..ne as usize],
-                &self.edge_state,
+        // Always on, release builds included: `collapse` below writes through Scatters on this
+        // promise, and a selection bug must be an error, not a data race.
+        let shared = self.time("check_winners", |s| {
+            select::shared_face(
+                &s.offsets,
+                &s.vertex_faces,
+                &s.edges[..ne as usize],
+                &s.edge_state,
+                &mut s.face_owner,
                 nf,
-            ),
-            "two winners of a round share a face"
-        );
+            )
+        });
+        if let Some(shared) = shared {
+            return Err(Error::Internal(format!(
+                "round {}: winners {} and {} both reach face {}; the independent set is broken",
+                self.rounds_run, shared.winners[0], shared.winners[1], shared.face
+            )));
+        }
         if p.trim != 0 {
             self.time("trim_histogram", |s| {
                 reset(&mut s.trim_histogram, HIST_BINS as usize);
@@ -492,6 +501,7 @@ impl CpuRounds {
                 )
             });
         }
+        Ok(())
     }
 
     pub fn apply_and_compact(&mut self, p: &Params) {
@@ -593,8 +603,9 @@ impl RoundRunner for CpuRounds {
         }
         let ne = self.build_edges(p);
         self.costs(p, ne);
-        self.select(p, ne, selection);
+        self.select(p, ne, selection)?;
         self.apply_and_compact(p);
+        self.rounds_run += 1;
         Ok(*bytemuck::from_bytes::<Counters>(bytemuck::cast_slice(
             &self.counters,
         )))

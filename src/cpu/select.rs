@@ -137,30 +137,63 @@ pub fn select_win(
     });
 }
 
-/// Whether the round's winners (`state::WON`) share no face: each face is around at most one
-/// winner's endpoints. `collapse` writes every winner's vertices and faces without
-/// synchronisation on this promise, so the rounds assert it in debug builds (tests included).
-pub fn winners_share_no_face(
+/// A face two of the round's winners (`state::WON`) both reach, with those two winners: the
+/// promise `collapse` rests on broken. `collapse` writes every winner's vertices and faces
+/// through a [`Scatter`] without synchronisation, which is sound only if each face is around
+/// at most one winner's endpoints; so every round checks it, in release builds too, before
+/// `collapse` runs (parallel, into `owner`, one word per face; the cost is measured in
+/// docs/PERFORMANCE.md). `None` when the winners share no face.
+pub fn shared_face(
     offsets: &[u32],
     vertex_faces: &[u32],
     edges: &[[u32; 2]],
     edge_state: &[u32],
+    owner: &mut Vec<u32>,
     face_count: usize,
-) -> bool {
-    let mut owner = vec![u32::MAX; face_count];
-    for (e, &ab) in edges.iter().enumerate() {
-        if edge_state[e] != state::WON {
-            continue;
-        }
-        for f in around(offsets, vertex_faces, ab) {
-            match owner[f as usize] {
-                u32::MAX => owner[f as usize] = e as u32,
-                o if o == e as u32 => {}
-                _ => return false,
+) -> Option<SharedFace> {
+    owner.clear();
+    owner.resize(face_count, u32::MAX);
+    let first = AtomicU32::new(u32::MAX);
+    {
+        let owner = super::atomics(owner);
+        par_for(edges.len() as u32, |e| {
+            if edge_state[e as usize] != state::WON {
+                return;
             }
-        }
+            for f in around(offsets, vertex_faces, edges[e as usize]) {
+                match owner[f as usize].compare_exchange(u32::MAX, e, Relaxed, Relaxed) {
+                    Ok(_) => {}
+                    Err(o) if o == e => {}
+                    Err(_) => {
+                        first.fetch_min(f, Relaxed);
+                    }
+                }
+            }
+        });
     }
-    true
+    let face = first.into_inner();
+    if face == u32::MAX {
+        return None;
+    }
+    // Rare and fatal: name the lowest shared face's first two winners, serially, so the report
+    // is the same whatever the threads did.
+    let mut winners = (0..edges.len() as u32).filter(|&e| {
+        edge_state[e as usize] == state::WON
+            && around(offsets, vertex_faces, edges[e as usize]).any(|f| f == face)
+    });
+    let a = winners.next().unwrap_or(u32::MAX);
+    let b = winners.next().unwrap_or(u32::MAX);
+    Some(SharedFace {
+        face,
+        winners: [a, b],
+    })
+}
+
+/// What [`shared_face`] found: a face and two winners around it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SharedFace {
+    pub face: u32,
+    pub winners: [u32; 2],
 }
 
 #[cfg(test)]
@@ -197,38 +230,32 @@ mod tests {
     fn winners_apart_share_no_face_and_neighbours_do() {
         let (offsets, vf) = strip();
         let edges = [[0u32, 1], [4, 5], [2, 3]];
-        let won = |w: &[usize]| {
+        let mut owner = Vec::new();
+        let mut check = |w: &[usize]| {
             let mut st = vec![state::CANDIDATE; edges.len()];
             for &e in w {
                 st[e] = state::WON;
             }
-            st
+            shared_face(&offsets, &vf, &edges, &st, &mut owner, 4)
         };
         // (0,1) holds faces 0 and 1; (4,5) holds faces 2 and 3: disjoint.
-        assert!(winners_share_no_face(
-            &offsets,
-            &vf,
-            &edges,
-            &won(&[0, 1]),
-            4
-        ));
-        // (2,3) holds all four faces, so it meets either.
-        assert!(!winners_share_no_face(
-            &offsets,
-            &vf,
-            &edges,
-            &won(&[0, 2]),
-            4
-        ));
-        assert!(!winners_share_no_face(
-            &offsets,
-            &vf,
-            &edges,
-            &won(&[1, 2]),
-            4
-        ));
-        // A lone winner, or none, trivially.
-        assert!(winners_share_no_face(&offsets, &vf, &edges, &won(&[2]), 4));
-        assert!(winners_share_no_face(&offsets, &vf, &edges, &won(&[]), 4));
+        assert_eq!(check(&[0, 1]), None);
+        // (2,3) holds all four faces, so it meets either, first at the lowest face they share.
+        assert_eq!(
+            check(&[0, 2]),
+            Some(SharedFace {
+                face: 0,
+                winners: [0, 2]
+            })
+        );
+        assert_eq!(
+            check(&[1, 2]),
+            Some(SharedFace {
+                face: 2,
+                winners: [1, 2]
+            })
+        );
+        assert_eq!(check(&[2]), None);
+        assert_eq!(check(&[]), None);
     }
 }
