@@ -21,6 +21,11 @@ const QUERY_CAP: u32 = 512;
 /// left to select costs a few empty dispatches, a read-back a round trip.
 const EXHAUSTIVE_CHUNK: u32 = 8;
 
+/// Bytes of the counters block, the round's one read-back.
+const COUNTERS_BYTES: u64 = std::mem::size_of::<Counters>() as u64;
+/// `Counters::tentative`, cleared before each selection pass.
+const TENTATIVE_OFFSET: u64 = std::mem::offset_of!(Counters, tentative) as u64;
+
 /// Compute pipelines of every stage, made once for a device and reused for every mesh.
 pub struct GpuSimplifier {
     device: wgpu::Device,
@@ -327,10 +332,10 @@ impl<'a> GpuRounds<'a> {
             live: mk("live", cap * 4, SU)?,
             neighbours: mk("neighbours", nf * 24, SU)?,
             block_sums: mk("block_sums", blocks * 4, SU)?,
-            counters: mk("counters", 64, SU)?,
+            counters: mk("counters", COUNTERS_BYTES, SU)?,
             readback: mk(
                 "readback",
-                64 + QUERY_CAP as u64 * 8,
+                COUNTERS_BYTES + QUERY_CAP as u64 * 8,
                 wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             )?,
             queries,
@@ -780,7 +785,7 @@ impl RoundRunner for GpuRounds<'_> {
                         }),
                     );
                     q.submit([done.finish()]);
-                    let now: Counters = *bytemuck::from_bytes(&self.read(&counters, 64)?);
+                    let now: Counters = *bytemuck::from_bytes(&self.read(&counters, COUNTERS_BYTES)?);
                     if now.tentative == 0 {
                         break;
                     }
@@ -790,7 +795,7 @@ impl RoundRunner for GpuRounds<'_> {
             enc.clear_buffer(&fbest, 0, None);
             enc.clear_buffer(&fid, 0, None);
             // counters.tentative: the list select_win fills is per pass.
-            enc.clear_buffer(&counters, 40, Some(4));
+            enc.clear_buffer(&counters, TENTATIVE_OFFSET, Some(4));
             self.pass(
                 &mut enc,
                 "select_cost",
@@ -888,13 +893,13 @@ impl RoundRunner for GpuRounds<'_> {
             ONE,
         );
 
-        enc.copy_buffer_to_buffer(&counters, 0, &self.readback, 0, 64);
+        enc.copy_buffer_to_buffer(&counters, 0, &self.readback, 0, COUNTERS_BYTES);
         let used = self.query_stages.len() as u32 * 2;
         if let Some((set, resolve)) = &self.queries
             && used > 0
         {
             enc.resolve_query_set(set, 0..used, resolve, 0);
-            enc.copy_buffer_to_buffer(resolve, 0, &self.readback, 64, used as u64 * 8);
+            enc.copy_buffer_to_buffer(resolve, 0, &self.readback, COUNTERS_BYTES, used as u64 * 8);
         }
         let t = Instant::now();
         q.submit([enc.finish()]);
@@ -905,9 +910,10 @@ impl RoundRunner for GpuRounds<'_> {
                 .readback
                 .get_mapped_range(..)
                 .map_err(|e| Error::Gpu(format!("reading the round counters: {e}")))?;
-            let c: Counters = *bytemuck::from_bytes(&view[..64]);
+            let n = COUNTERS_BYTES as usize;
+            let c: Counters = *bytemuck::from_bytes(&view[..n]);
             let stamps: Vec<u64> =
-                bytemuck::cast_slice::<u8, u64>(&view[64..64 + used as usize * 8]).to_vec();
+                bytemuck::cast_slice::<u8, u64>(&view[n..n + used as usize * 8]).to_vec();
             (c, stamps)
         };
         self.readback.unmap();
