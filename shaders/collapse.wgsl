@@ -8,13 +8,13 @@
 @group(0) @binding(1) var<storage, read> candidates: array<EdgeCandidate>; // per edge
 @group(0) @binding(2) var<storage, read> edge_state: array<u32>;          // per edge
 @group(0) @binding(3) var<storage, read> edge_offsets: array<u32>;        // per vertex + 1
-@group(0) @binding(4) var<storage, read_write> positions: array<vec4<f32>>; // per vertex
-@group(0) @binding(5) var<storage, read_write> quadrics: array<Quadric>;   // per vertex
-@group(0) @binding(6) var<storage, read_write> flags: array<u32>;          // per vertex
-@group(0) @binding(7) var<storage, read_write> remap: array<u32>;          // per vertex
-@group(0) @binding(8) var<storage, read> indices: array<u32>;             // per face × 3
-@group(0) @binding(9) var<storage, read> offsets: array<u32>;             // per vertex + 1
-@group(0) @binding(10) var<storage, read> vertex_faces: array<u32>;       // per corner
+@group(0) @binding(4) var<storage, read> indices: array<u32>;             // per face × 3
+@group(0) @binding(5) var<storage, read> offsets: array<u32>;             // per vertex + 1
+@group(0) @binding(6) var<storage, read> vertex_faces: array<u32>;       // per corner
+@group(0) @binding(7) var<storage, read_write> positions: array<vec4<f32>>; // per vertex
+@group(0) @binding(8) var<storage, read_write> quadrics: array<Quadric>;   // per vertex
+@group(0) @binding(9) var<storage, read_write> flags: array<u32>;          // per vertex
+@group(0) @binding(10) var<storage, read_write> remap: array<u32>;          // per vertex
 @group(0) @binding(11) var<storage, read_write> face_extra: array<FaceExtra>; // per face
 
 // The attribute vertex a corner of the removed vertex takes under map m (see NO_ATTR in

@@ -14,11 +14,11 @@
 @group(0) @binding(6) var<storage, read> vertex_faces: array<u32>;           // per corner
 @group(0) @binding(7) var<storage, read> edges: array<vec2<u32>>;            // per edge
 @group(0) @binding(8) var<storage, read> edge_offsets: array<u32>;           // per vertex + 1
-@group(0) @binding(9) var<storage, read_write> candidates: array<EdgeCandidate>; // per edge
-@group(0) @binding(10) var<storage, read_write> edge_state: array<u32>;      // per edge
-@group(0) @binding(11) var<storage, read_write> histogram: array<atomic<u32>>; // HIST_BINS
-@group(0) @binding(12) var<storage, read_write> counters: array<atomic<u32>, 16>;
-@group(0) @binding(13) var<storage, read> face_extra: array<FaceExtra>;      // per face
+@group(0) @binding(9) var<storage, read> face_extra: array<FaceExtra>;      // per face
+@group(0) @binding(10) var<storage, read_write> candidates: array<EdgeCandidate>; // per edge
+@group(0) @binding(11) var<storage, read_write> edge_state: array<u32>;      // per edge
+@group(0) @binding(12) var<storage, read_write> histogram: array<atomic<u32>>; // HIST_BINS
+@group(0) @binding(13) var<storage, read_write> counters: array<atomic<u32>, 16>;
 
 const VERDICT_INVALID: u32 = 0u;
 const VERDICT_OVER: u32 = 1u;

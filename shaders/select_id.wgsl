@@ -9,9 +9,9 @@
 @group(0) @binding(3) var<storage, read> live: array<u32>;                // per listed candidate
 @group(0) @binding(4) var<storage, read> candidates: array<EdgeCandidate>; // per edge
 @group(0) @binding(5) var<storage, read> face_best: array<u32>;           // per face
-@group(0) @binding(6) var<storage, read_write> edge_state: array<u32>;    // per edge
-@group(0) @binding(7) var<storage, read_write> face_id: array<atomic<u32>>; // per face
-@group(0) @binding(8) var<storage, read> counters: array<u32, 16>;
+@group(0) @binding(6) var<storage, read> counters: array<u32, 16>;
+@group(0) @binding(7) var<storage, read_write> edge_state: array<u32>;    // per edge
+@group(0) @binding(8) var<storage, read_write> face_id: array<atomic<u32>>; // per face
 
 @compute @workgroup_size(256)
 fn select_id(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {

@@ -10,8 +10,8 @@
 @group(0) @binding(3) var<storage, read> offsets: array<u32>;            // per vertex + 1
 @group(0) @binding(4) var<storage, read> vertex_faces: array<u32>;       // per corner
 @group(0) @binding(5) var<storage, read> face_normals: array<vec4<f32>>; // per face
-@group(0) @binding(6) var<storage, read_write> quadrics: array<Quadric>; // per vertex
-@group(0) @binding(7) var<storage, read> face_extra: array<FaceExtra>;   // per face
+@group(0) @binding(6) var<storage, read> face_extra: array<FaceExtra>;   // per face
+@group(0) @binding(7) var<storage, read_write> quadrics: array<Quadric>; // per vertex
 
 // The faces of the list range [lo, hi) containing u: how many, and the first other than f (f
 // when none). One scan for both: counting and then looking for the other face took two, and

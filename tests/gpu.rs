@@ -52,7 +52,7 @@ fn each_stage_matches_its_cpu_twin() {
 
         cpu.counters = vec![0; 16];
         // adjacency_count, prefix_sum, adjacency_fill, adjacency_sort
-        cpu.build_adjacency(&p);
+        cpu.build_adjacency(&p).unwrap();
         assert_eq!(
             pod::<u32>(rd("offsets", 4 * (nv + 1))),
             cpu.offsets,
@@ -64,7 +64,7 @@ fn each_stage_matches_its_cpu_twin() {
             "{name}: vertex_faces"
         );
         // face_planes, vertex_flags, vertex_quadrics
-        cpu.setup(&p);
+        cpu.setup(&p).unwrap();
         let g_norm: Vec<[f32; 4]> = pod(rd("face_normals_before", 16 * nf));
         for (f, (g, c)) in g_norm.iter().zip(&cpu.face_normals).enumerate() {
             assert!(
@@ -81,7 +81,7 @@ fn each_stage_matches_its_cpu_twin() {
             "{name}: flags"
         );
         // edges_count, prefix_sum, edges_fill
-        let ne = cpu.build_edges(&p) as usize;
+        let ne = cpu.build_edges(&p).unwrap() as usize;
         assert_eq!(
             pod::<u32>(rd("edge_offsets", 4 * (nv + 1))),
             cpu.edge_offsets,
@@ -94,7 +94,7 @@ fn each_stage_matches_its_cpu_twin() {
         );
         // edge_errors (quadrics feed it), compared through the histogram it fills: GPU and CPU
         // errors agree to rounding, so only an edge on a bin's boundary may land in another bin.
-        cpu.errors(&p, ne as u32);
+        cpu.errors(&p).unwrap();
         let errors = cpu.candidates.clone();
         let g_hist: Vec<u32> = pod(rd("histogram", 4 * HIST_BINS as usize));
         let moved_bins: u32 = g_hist
@@ -119,7 +119,7 @@ fn each_stage_matches_its_cpu_twin() {
             meshslim::cpu::atomics(&mut cpu.counters),
         );
         assert_eq!(cpu.counters[2], gc.ceiling, "{name}: cost_ceiling");
-        cpu.costs_under_ceiling(&p);
+        cpu.costs_under_ceiling(&p).unwrap();
         // live_list: the same candidates, in the GPU's order of arrival. An edge whose error
         // is within rounding of the ceiling may be listed on one side only, as in the histogram.
         let mut g_live: Vec<u32> = pod(rd("live", 4 * gc.live as usize));
@@ -185,7 +185,7 @@ fn each_stage_matches_its_cpu_twin() {
         cpu.candidates = g_cand;
         cpu.live = g_live;
         // select_cost, select_id, select_win, validate, and the trim stages.
-        cpu.select(&p, ne as u32, Selection::Ordinary).unwrap();
+        cpu.select(&p, Selection::Ordinary).unwrap();
         let g_state = pod::<u32>(rd("edge_state", 4 * ne));
         assert_eq!(
             g_state, cpu.edge_state,
@@ -229,7 +229,7 @@ fn each_stage_matches_its_cpu_twin() {
             "{name}: faces on each validated edge"
         );
         // collapse, compact_*, draw_args
-        cpu.apply_and_compact(&p);
+        cpu.apply_and_compact(&p).unwrap();
         assert_eq!(pod::<u32>(rd("remap", 4 * nv)), cpu.remap, "{name}: remap");
         assert_eq!(
             gc.faces_out as usize * 3,

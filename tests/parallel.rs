@@ -169,8 +169,8 @@ fn seam_bends_cost_to_slide_away() {
     let opts = SimplifyOptions::with_ratio(m.triangles.len(), 0.5).unwrap();
     let p = up.base_params(&opts);
     let mut cpu = CpuRounds::new(&up, SELECTION_PASSES);
-    cpu.build_adjacency(&p);
-    cpu.setup(&p);
+    cpu.build_adjacency(&p).unwrap();
+    cpu.setup(&p).unwrap();
     // Vertices by their grid position, through the upload's normalized frame.
     let id = |x: f32, y: f32| {
         let q = [0, 1].map(|i| (([x, y][i] as f64 - up.center[i]) * up.scale) as f32);

@@ -86,13 +86,13 @@ pub fn collapse(
     candidates: &[EdgeCandidate],   // per edge
     edge_state: &[u32],             // per edge
     edge_offsets: &[u32],           // per vertex + 1: the edge count at [vertex_count]
+    indices: &[u32],                // per face × 3
+    offsets: &[u32],                // per vertex + 1
+    vertex_faces: &[u32],           // per corner
     positions: Scatter<[f32; 4]>,   // per vertex
     quadrics: Scatter<Quadric>,     // per vertex
     flags: Scatter<u32>,            // per vertex
     remap: Scatter<u32>,            // per vertex
-    indices: &[u32],                // per face × 3
-    offsets: &[u32],                // per vertex + 1
-    vertex_faces: &[u32],           // per corner
     face_extra: Scatter<FaceExtra>, // per face
 ) {
     let edge_count = edge_offsets[params.vertex_count as usize];

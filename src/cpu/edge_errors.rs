@@ -201,11 +201,11 @@ pub fn edge_errors(
     vertex_faces: &[u32],             // per corner
     edges: &[[u32; 2]],               // per edge
     edge_offsets: &[u32],             // per vertex + 1: the edge count at [vertex_count]
+    face_extra: &[FaceExtra],         // per face
     candidates: &mut [EdgeCandidate], // per edge
     edge_state: &mut [u32],           // per edge
     histogram: &[AtomicU32],          // HIST_BINS, cleared
     counters: &[AtomicU32],           // Counters, cleared
-    face_extra: &[FaceExtra],         // per face
 ) {
     let ne = edge_offsets[params.vertex_count as usize] as usize;
     // Each chunk counts into its own histogram and adds it to the shared one at its end, as a

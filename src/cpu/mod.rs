@@ -27,8 +27,10 @@ pub mod vertex_quadrics;
 
 use crate::error::{Error, Result};
 use crate::gpu::types::*;
+use crate::parallel::schedule::{self, Buf, Stage, Step, When};
 use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
 use crate::simplify::{Blocked, SimplifyOptions};
+use edge_costs::CounterField;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 use std::sync::atomic::AtomicU32;
@@ -177,6 +179,8 @@ pub struct CpuRounds {
     pub block_sums: Vec<u32>,
     pub counters: Vec<u32>,
     pub draw: DrawArgs,
+    /// The indirect grids `dispatch_args` computes (three `(x, y, z, _)`), as the GPU's.
+    pub dispatch: [u32; 12],
     out_positions: Vec<[f32; 4]>,
     out_quadrics: Vec<Quadric>,
     out_flags: Vec<u32>,
@@ -219,141 +223,146 @@ impl CpuRounds {
         r
     }
 
-    /// Vertex→face lists of the current faces (three stages and a prefix sum).
-    pub fn build_adjacency(&mut self, p: &Params) {
-        let (nv, nf) = (p.vertex_count as usize, p.face_count as usize);
-        self.time("adjacency_count", |s| {
-            reset(&mut s.offsets, nv + 1);
-            adjacency::adjacency_count(p, &s.indices, atomics(&mut s.offsets));
-        });
-        self.time("prefix_sum", |s| {
-            prefix_sum::prefix_sum(nv as u32, &mut s.offsets, &mut s.block_sums)
-        });
-        self.time("adjacency_fill", |s| {
-            reset(&mut s.cursor, nv);
-            s.vertex_faces.resize(3 * nf, 0);
-            adjacency::adjacency_fill(
-                p,
-                &s.indices,
-                &s.offsets,
-                atomics(&mut s.cursor),
-                Scatter::new(&mut s.vertex_faces),
-            );
-        });
-        self.time("adjacency_sort", |s| {
-            adjacency::adjacency_sort(p, &s.offsets, Scatter::new(&mut s.vertex_faces))
-        });
+    /// Runs `steps` of the schedule, each stage through its twin.
+    pub fn run_steps(&mut self, p: &Params, steps: &[Step]) -> Result<()> {
+        for step in steps {
+            match *step {
+                Step::Clear(buf) => self.clear(p, buf)?,
+                Step::ClearTentative => self.counters[CounterField::Tentative as usize] = 0,
+                Step::Run(stage) => self.time(stage.entry, |s| s.run_stage(p, stage))?,
+                Step::PrefixSum { count, data } => {
+                    let n = count.of(p);
+                    let data = match data {
+                        Buf::Offsets => &mut self.offsets,
+                        Buf::EdgeOffsets => &mut self.edge_offsets,
+                        Buf::Marks => &mut self.marks,
+                        Buf::VertexKeep => &mut self.vertex_keep,
+                        Buf::FaceKeep => &mut self.face_keep,
+                        other => return Err(no_twin("a prefix sum over", other)),
+                    };
+                    let t = Instant::now();
+                    prefix_sum::prefix_sum(n, data, &mut self.block_sums);
+                    self.times.add("prefix_sum", t.elapsed().as_secs_f64());
+                }
+                Step::CheckWinners => self.check_winners(p)?,
+            }
+        }
+        Ok(())
     }
 
-    /// The first round's set-up: face normals, vertex flags, quadrics.
-    pub fn setup(&mut self, p: &Params) {
-        self.time("face_planes", |s| {
-            face_planes::face_planes(p, &s.positions, &s.indices, &mut s.face_normals)
-        });
-        self.time("vertex_flags", |s| {
-            vertex_flags::vertex_flags(p, &s.indices, &s.offsets, &s.vertex_faces, &mut s.flags)
-        });
-        self.time("vertex_quadrics", |s| {
-            vertex_quadrics::vertex_quadrics(
+    /// Zeroes `buf`, sized for the round as the GPU's is.
+    fn clear(&mut self, p: &Params, buf: Buf) -> Result<()> {
+        let (nv, nf) = (p.vertex_count as usize, p.face_count as usize);
+        match buf {
+            Buf::Offsets => reset(&mut self.offsets, nv + 1),
+            Buf::Cursor => reset(&mut self.cursor, nv),
+            Buf::Histogram => reset(&mut self.histogram, HIST_BINS as usize),
+            Buf::TrimHistogram => reset(&mut self.trim_histogram, HIST_BINS as usize),
+            Buf::VertexLock => reset(&mut self.vertex_lock, nv),
+            Buf::FaceBest => reset(&mut self.face_best, nf),
+            Buf::FaceId => reset(&mut self.face_id, nf),
+            other => return Err(no_twin("clearing", other)),
+        }
+        Ok(())
+    }
+
+    /// One stage's twin, with the buffers the stage binds, in its binding order.
+    fn run_stage(&mut self, p: &Params, stage: &Stage) -> Result<()> {
+        let (nv, nf) = (p.vertex_count as usize, p.face_count as usize);
+        let s = self;
+        match stage.entry {
+            "adjacency_count" => adjacency::adjacency_count(p, &s.indices, atomics(&mut s.offsets)),
+            "adjacency_fill" => {
+                s.vertex_faces.resize(3 * nf, 0);
+                adjacency::adjacency_fill(
+                    p,
+                    &s.indices,
+                    &s.offsets,
+                    atomics(&mut s.cursor),
+                    Scatter::new(&mut s.vertex_faces),
+                )
+            }
+            "adjacency_sort" => {
+                adjacency::adjacency_sort(p, &s.offsets, Scatter::new(&mut s.vertex_faces))
+            }
+            "face_planes" => {
+                face_planes::face_planes(p, &s.positions, &s.indices, &mut s.face_normals)
+            }
+            "vertex_flags" => {
+                vertex_flags::vertex_flags(p, &s.indices, &s.offsets, &s.vertex_faces, &mut s.flags)
+            }
+            "vertex_quadrics" => vertex_quadrics::vertex_quadrics(
                 p,
                 &s.positions,
                 &s.indices,
                 &s.offsets,
                 &s.vertex_faces,
                 &s.face_normals,
-                &mut s.quadrics,
                 &s.face_extra,
-            )
-        });
-    }
-
-    /// Unique edges and their costs, with the cost histogram.
-    pub fn build_edges(&mut self, p: &Params) -> u32 {
-        let nv = p.vertex_count as usize;
-        self.time("edges_count", |s| {
-            reset(&mut s.edge_offsets, nv + 1);
-            s.remap.resize(nv, 0);
-            s.neighbours.resize(2 * s.vertex_faces.len(), 0);
-            edges::edges_count(
+                &mut s.quadrics,
+            ),
+            "edges_count" => {
+                reset(&mut s.edge_offsets, nv + 1);
+                s.remap.resize(nv, 0);
+                s.neighbours.resize(2 * s.vertex_faces.len(), 0);
+                edges::edges_count(
+                    p,
+                    &s.indices,
+                    &s.offsets,
+                    &s.vertex_faces,
+                    Scatter::new(&mut s.edge_offsets),
+                    Scatter::new(&mut s.remap),
+                    Scatter::new(&mut s.neighbours),
+                )
+            }
+            "edges_fill" => {
+                s.edges.resize(s.edge_offsets[nv] as usize, [0; 2]);
+                edges::edges_fill(
+                    p,
+                    &s.offsets,
+                    &s.neighbours,
+                    &s.edge_offsets,
+                    Scatter::new(&mut s.edges),
+                )
+            }
+            "dispatch_args" => dispatch_args::dispatch_args(
                 p,
-                &s.indices,
-                &s.offsets,
-                &s.vertex_faces,
-                Scatter::new(&mut s.edge_offsets),
-                Scatter::new(&mut s.remap),
-                Scatter::new(&mut s.neighbours),
-            );
-        });
-        let ne = self.time("prefix_sum", |s| {
-            prefix_sum::prefix_sum(nv as u32, &mut s.edge_offsets, &mut s.block_sums)
-        });
-        self.time("edges_fill", |s| {
-            s.edges.resize(ne as usize, [0; 2]);
-            edges::edges_fill(
-                p,
-                &s.offsets,
-                &s.neighbours,
                 &s.edge_offsets,
-                Scatter::new(&mut s.edges),
-            );
-        });
-        ne
-    }
-
-    /// Edge errors, the round's cost ceiling from their histogram, and the costs of the edges
-    /// under it.
-    pub fn costs(&mut self, p: &Params, ne: u32) {
-        self.errors(p, ne);
-        self.time("cost_ceiling", |s| {
-            cost_ceiling::cost_ceiling(p, &s.histogram, atomics(&mut s.counters))
-        });
-        self.costs_under_ceiling(p);
-    }
-
-    /// `live_list` then `edge_costs`, with the ceiling in the counters.
-    pub fn costs_under_ceiling(&mut self, p: &Params) {
-        self.time("live_list", |s| {
-            live_list::live_list(
+                atomics(&mut s.counters),
+                &mut s.dispatch,
+            ),
+            "edge_errors" => {
+                let ne = s.edge_offsets[nv] as usize;
+                s.candidates.resize(ne, EdgeCandidate::default());
+                s.edge_state.resize(ne, 0);
+                s.tentative.resize(ne, 0);
+                edge_errors::edge_errors(
+                    p,
+                    &s.positions,
+                    &s.quadrics,
+                    &s.flags,
+                    &s.indices,
+                    &s.offsets,
+                    &s.vertex_faces,
+                    &s.edges,
+                    &s.edge_offsets,
+                    &s.face_extra,
+                    &mut s.candidates,
+                    &mut s.edge_state,
+                    atomics(&mut s.histogram),
+                    atomics(&mut s.counters),
+                )
+            }
+            "cost_ceiling" => cost_ceiling::cost_ceiling(p, &s.histogram, atomics(&mut s.counters)),
+            "live_list" => live_list::live_list(
                 p,
                 &s.edge_offsets,
                 &s.candidates,
                 &mut s.edge_state,
                 atomics(&mut s.counters),
                 &mut s.live,
-            )
-        });
-        self.listed_costs(p);
-    }
-
-    /// `edge_errors`: placements, errors and their histogram.
-    pub fn errors(&mut self, p: &Params, ne: u32) {
-        self.time("edge_errors", |s| {
-            s.candidates.resize(ne as usize, EdgeCandidate::default());
-            s.edge_state.resize(ne as usize, 0);
-            reset(&mut s.histogram, HIST_BINS as usize);
-            edge_errors::edge_errors(
-                p,
-                &s.positions,
-                &s.quadrics,
-                &s.flags,
-                &s.indices,
-                &s.offsets,
-                &s.vertex_faces,
-                &s.edges,
-                &s.edge_offsets,
-                &mut s.candidates,
-                &mut s.edge_state,
-                atomics(&mut s.histogram),
-                atomics(&mut s.counters),
-                &s.face_extra,
-            );
-        });
-    }
-
-    /// `edge_costs` over the live list.
-    pub fn listed_costs(&mut self, p: &Params) {
-        self.time("edge_costs", |s| {
-            edge_costs::edge_costs(
+            ),
+            "edge_costs" => edge_costs::edge_costs(
                 p,
                 &s.positions,
                 &s.indices,
@@ -364,69 +373,40 @@ impl CpuRounds {
                 Scatter::new(&mut s.candidates),
                 Scatter::new(&mut s.edge_state),
                 atomics(&mut s.counters),
-            );
-        });
-    }
-
-    /// The selection passes, then trimming when the round would overshoot.
-    pub fn select(&mut self, p: &Params, ne: u32, selection: Selection) -> Result<()> {
-        let nf = p.face_count as usize;
-        reset(&mut self.vertex_lock, p.vertex_count as usize);
-        self.tentative.resize(ne as usize, 0);
-        let tentative = edge_costs::CounterField::Tentative as usize;
-        for pass in 0.. {
-            match selection {
-                Selection::Ordinary if pass == self.selection_passes => break,
-                Selection::Exhaustive if pass > 0 && self.counters[tentative] == 0 => break,
-                _ => {}
-            }
-            reset(&mut self.face_best, nf);
-            reset(&mut self.face_id, nf);
-            self.counters[edge_costs::CounterField::Tentative as usize] = 0;
-            let s = &mut *self;
-            let t = Instant::now();
-            let (lock, st, counters) = (
+            ),
+            "select_cost" => select::select_cost(
+                &s.offsets,
+                &s.vertex_faces,
+                &s.edges,
+                &s.live,
+                &s.candidates,
                 atomics(&mut s.vertex_lock),
-                atomics(&mut s.edge_state),
                 atomics(&mut s.counters),
-            );
-            let (best, id) = (atomics(&mut s.face_best), atomics(&mut s.face_id));
-            select::select_cost(
+                atomics(&mut s.edge_state),
+                atomics(&mut s.face_best),
+            ),
+            "select_id" => select::select_id(
                 &s.offsets,
                 &s.vertex_faces,
                 &s.edges,
                 &s.live,
                 &s.candidates,
-                lock,
-                counters,
-                st,
-                best,
-            );
-            let t1 = Instant::now();
-            select::select_id(
+                atomics(&mut s.face_best),
+                atomics(&mut s.counters),
+                atomics(&mut s.edge_state),
+                atomics(&mut s.face_id),
+            ),
+            "select_win" => select::select_win(
                 &s.offsets,
                 &s.vertex_faces,
                 &s.edges,
                 &s.live,
-                &s.candidates,
-                best,
-                st,
-                id,
-                counters,
-            );
-            let t2 = Instant::now();
-            select::select_win(
-                &s.offsets,
-                &s.vertex_faces,
-                &s.edges,
-                &s.live,
-                id,
-                st,
+                atomics(&mut s.face_id),
+                atomics(&mut s.edge_state),
                 Scatter::new(&mut s.tentative),
-                counters,
-            );
-            let t3 = Instant::now();
-            validate::validate(
+                atomics(&mut s.counters),
+            ),
+            "validate" => validate::validate(
                 p,
                 &s.flags,
                 &s.indices,
@@ -435,48 +415,19 @@ impl CpuRounds {
                 &s.edges,
                 &s.tentative,
                 Scatter::new(&mut s.candidates),
-                st,
-                lock,
-                counters,
-            );
-            s.times.add("select_cost", (t1 - t).as_secs_f64());
-            s.times.add("select_id", (t2 - t1).as_secs_f64());
-            s.times.add("select_win", (t3 - t2).as_secs_f64());
-            s.times.add("validate", t3.elapsed().as_secs_f64());
-        }
-        // Always on, release builds included: `collapse` below writes through Scatters on this
-        // promise, and a selection bug must be an error, not a data race.
-        let shared = self.time("check_winners", |s| {
-            select::shared_face(
-                &s.offsets,
-                &s.vertex_faces,
-                &s.edges[..ne as usize],
+                atomics(&mut s.edge_state),
+                atomics(&mut s.vertex_lock),
+                atomics(&mut s.counters),
+            ),
+            "trim_histogram" => trim::trim_histogram(
+                p,
+                &s.candidates,
                 &s.edge_state,
-                &mut s.face_owner,
-                nf,
-            )
-        });
-        if let Some(shared) = shared {
-            return Err(Error::Internal(format!(
-                "round {}: winners {} and {} both reach face {}; the independent set is broken",
-                self.rounds_run, shared.winners[0], shared.winners[1], shared.face
-            )));
-        }
-        if p.trim != 0 {
-            self.time("trim_histogram", |s| {
-                reset(&mut s.trim_histogram, HIST_BINS as usize);
-                trim::trim_histogram(
-                    p,
-                    &s.candidates,
-                    &s.edge_state,
-                    &s.edge_offsets,
-                    atomics(&mut s.trim_histogram),
-                )
-            });
-            self.time("trim_ceiling", |s| {
-                trim::trim_ceiling(p, &s.trim_histogram, atomics(&mut s.counters))
-            });
-            self.time("trim_mark", |s| {
+                &s.edge_offsets,
+                atomics(&mut s.trim_histogram),
+            ),
+            "trim_ceiling" => trim::trim_ceiling(p, &s.trim_histogram, atomics(&mut s.counters)),
+            "trim_mark" => {
                 reset(&mut s.marks, p.edge_capacity as usize + 1);
                 trim::trim_mark(
                     p,
@@ -486,104 +437,185 @@ impl CpuRounds {
                     atomics(&mut s.counters),
                     &mut s.marks,
                 )
-            });
-            self.time("prefix_sum", |s| {
-                prefix_sum::prefix_sum(p.edge_capacity, &mut s.marks, &mut s.block_sums)
-            });
-            self.time("trim_apply", |s| {
-                trim::trim_apply(
-                    p,
-                    &s.candidates,
-                    &s.marks,
-                    atomics(&mut s.counters),
-                    &s.edge_offsets,
-                    &mut s.edge_state,
-                )
-            });
-        }
-        Ok(())
-    }
-
-    pub fn apply_and_compact(&mut self, p: &Params) {
-        let (nv, nf) = (p.vertex_count as usize, p.face_count as usize);
-        self.time("collapse", |s| {
-            collapse::collapse(
+            }
+            "trim_apply" => trim::trim_apply(
+                p,
+                &s.candidates,
+                &s.marks,
+                atomics(&mut s.counters),
+                &s.edge_offsets,
+                &mut s.edge_state,
+            ),
+            "collapse" => collapse::collapse(
                 p,
                 &s.candidates,
                 &s.edge_state,
                 &s.edge_offsets,
+                &s.indices,
+                &s.offsets,
+                &s.vertex_faces,
                 Scatter::new(&mut s.positions),
                 Scatter::new(&mut s.quadrics),
                 Scatter::new(&mut s.flags),
                 Scatter::new(&mut s.remap),
-                &s.indices,
+                Scatter::new(&mut s.face_extra),
+            ),
+            "compact_mark" => {
+                reset(&mut s.vertex_keep, nv + 1);
+                reset(&mut s.face_keep, nf + 1);
+                compact::compact_mark(
+                    p,
+                    &s.indices,
+                    &s.remap,
+                    &mut s.vertex_keep,
+                    &mut s.face_keep,
+                )
+            }
+            "compact_vertices" => {
+                let nv2 = s.vertex_keep[nv] as usize;
+                s.out_positions.resize(nv2, [0.0; 4]);
+                s.out_quadrics.resize(nv2, Quadric::default());
+                s.out_flags.resize(nv2, 0);
+                s.out_vertex_attr.resize(nv2, 0);
+                compact::compact_vertices(
+                    p,
+                    &s.vertex_keep,
+                    &s.positions,
+                    &s.quadrics,
+                    &s.flags,
+                    &s.vertex_attr,
+                    Scatter::new(&mut s.out_positions),
+                    Scatter::new(&mut s.out_quadrics),
+                    Scatter::new(&mut s.out_flags),
+                    Scatter::new(&mut s.out_vertex_attr),
+                )
+            }
+            "compact_faces" => {
+                let nf2 = s.face_keep[nf] as usize;
+                s.out_indices.resize(3 * nf2, 0);
+                s.out_face_normals.resize(nf2, [0.0; 4]);
+                s.out_face_extra.resize(nf2, FaceExtra::default());
+                compact::compact_faces(
+                    p,
+                    &s.indices,
+                    &s.face_normals,
+                    &s.face_extra,
+                    &s.remap,
+                    &s.vertex_keep,
+                    &s.face_keep,
+                    Scatter::new(&mut s.out_indices),
+                    Scatter::new(&mut s.out_face_normals),
+                    Scatter::new(&mut s.out_face_extra),
+                )
+            }
+            "draw_args" => {
+                let mut draw = DrawArgs::default();
+                compact::draw_args(
+                    p,
+                    &s.vertex_keep,
+                    &s.face_keep,
+                    atomics(&mut s.counters),
+                    &mut draw,
+                );
+                s.draw = draw;
+            }
+            other => {
+                return Err(Error::Internal(format!(
+                    "the schedule runs stage {other}, which has no CPU twin"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// `collapse` writes every winner's vertices and faces through Scatters on the promise that
+    /// no two winners reach one face; checked every round, release builds included, so that a
+    /// selection bug is an error, not a data race.
+    fn check_winners(&mut self, p: &Params) -> Result<()> {
+        let ne = self.edge_offsets[p.vertex_count as usize] as usize;
+        let nf = p.face_count as usize;
+        let shared = self.time("check_winners", |s| {
+            select::shared_face(
                 &s.offsets,
                 &s.vertex_faces,
-                Scatter::new(&mut s.face_extra),
+                &s.edges[..ne],
+                &s.edge_state,
+                &mut s.face_owner,
+                nf,
             )
         });
-        self.time("compact_mark", |s| {
-            reset(&mut s.vertex_keep, nv + 1);
-            reset(&mut s.face_keep, nf + 1);
-            compact::compact_mark(
-                p,
-                &s.indices,
-                &s.remap,
-                &mut s.vertex_keep,
-                &mut s.face_keep,
-            )
-        });
-        let (nv2, nf2) = self.time("prefix_sum", |s| {
-            let a = prefix_sum::prefix_sum(nv as u32, &mut s.vertex_keep, &mut s.block_sums);
-            let b = prefix_sum::prefix_sum(nf as u32, &mut s.face_keep, &mut s.block_sums);
-            (a as usize, b as usize)
-        });
-        self.time("compact_vertices", |s| {
-            s.out_positions.resize(nv2, [0.0; 4]);
-            s.out_quadrics.resize(nv2, Quadric::default());
-            s.out_flags.resize(nv2, 0);
-            s.out_vertex_attr.resize(nv2, 0);
-            compact::compact_vertices(
-                p,
-                &s.vertex_keep,
-                &s.positions,
-                &s.quadrics,
-                &s.flags,
-                &s.vertex_attr,
-                Scatter::new(&mut s.out_positions),
-                Scatter::new(&mut s.out_quadrics),
-                Scatter::new(&mut s.out_flags),
-                Scatter::new(&mut s.out_vertex_attr),
-            );
-        });
-        self.time("compact_faces", |s| {
-            s.out_indices.resize(3 * nf2, 0);
-            s.out_face_normals.resize(nf2, [0.0; 4]);
-            s.out_face_extra.resize(nf2, FaceExtra::default());
-            compact::compact_faces(
-                p,
-                &s.indices,
-                &s.face_normals,
-                &s.face_extra,
-                &s.remap,
-                &s.vertex_keep,
-                &s.face_keep,
-                Scatter::new(&mut s.out_indices),
-                Scatter::new(&mut s.out_face_normals),
-                Scatter::new(&mut s.out_face_extra),
-            );
-        });
-        self.time("draw_args", |s| {
-            let mut draw = DrawArgs::default();
-            compact::draw_args(
-                p,
-                &s.vertex_keep,
-                &s.face_keep,
-                atomics(&mut s.counters),
-                &mut draw,
-            );
-            s.draw = draw;
-        });
+        match shared {
+            None => Ok(()),
+            Some(shared) => Err(Error::Internal(format!(
+                "round {}: winners {} and {} both reach face {}; the independent set is broken",
+                self.rounds_run, shared.winners[0], shared.winners[1], shared.face
+            ))),
+        }
+    }
+
+    /// Vertex→face lists of the current faces ([`schedule::ADJACENCY`]).
+    pub fn build_adjacency(&mut self, p: &Params) -> Result<()> {
+        self.run_steps(p, schedule::ADJACENCY)
+    }
+
+    /// The first round's set-up: face normals, vertex flags, quadrics ([`schedule::SETUP`]).
+    pub fn setup(&mut self, p: &Params) -> Result<()> {
+        self.run_steps(p, schedule::SETUP)
+    }
+
+    /// Unique edges ([`schedule::EDGES`]); returns their count.
+    pub fn build_edges(&mut self, p: &Params) -> Result<u32> {
+        self.run_steps(p, schedule::EDGES)?;
+        Ok(self.edge_offsets[p.vertex_count as usize])
+    }
+
+    /// `edge_errors`: placements, errors and their histogram ([`schedule::ERRORS`]).
+    pub fn errors(&mut self, p: &Params) -> Result<()> {
+        self.run_steps(p, schedule::ERRORS)
+    }
+
+    /// `live_list` then `edge_costs`, with the ceiling in the counters
+    /// ([`schedule::LISTED_COSTS`]).
+    pub fn costs_under_ceiling(&mut self, p: &Params) -> Result<()> {
+        self.run_steps(p, schedule::LISTED_COSTS)
+    }
+
+    /// The selection passes as `selection` says, the winners' check, then trimming when the
+    /// round would overshoot: the middle of [`schedule::ROUND`], for tests that compare the
+    /// GPU's buffers part by part.
+    pub fn select(&mut self, p: &Params, selection: Selection) -> Result<()> {
+        self.run_steps(p, schedule::UNLOCK)?;
+        self.passes(p, schedule::SELECTION_PASS, selection)?;
+        self.run_steps(p, schedule::CHECK)?;
+        if p.trim != 0 {
+            self.run_steps(p, schedule::TRIM)?;
+        }
+        Ok(())
+    }
+
+    /// The collapses and compaction ([`schedule::APPLY`]); the halves swap.
+    pub fn apply_and_compact(&mut self, p: &Params) -> Result<()> {
+        self.run_steps(p, schedule::APPLY)?;
+        self.swap_halves();
+        Ok(())
+    }
+
+    /// `steps` once per selection pass: a fixed count, or until a pass lists no tentative winner.
+    fn passes(&mut self, p: &Params, steps: &[Step], selection: Selection) -> Result<()> {
+        let tentative = CounterField::Tentative as usize;
+        for pass in 0.. {
+            match selection {
+                Selection::Ordinary if pass == self.selection_passes => break,
+                Selection::Exhaustive if pass > 0 && self.counters[tentative] == 0 => break,
+                _ => {}
+            }
+            self.run_steps(p, steps)?;
+        }
+        Ok(())
+    }
+
+    /// Compaction wrote the other half; it becomes the current one.
+    fn swap_halves(&mut self) {
         std::mem::swap(&mut self.positions, &mut self.out_positions);
         std::mem::swap(&mut self.quadrics, &mut self.out_quadrics);
         std::mem::swap(&mut self.flags, &mut self.out_flags);
@@ -594,17 +626,24 @@ impl CpuRounds {
     }
 }
 
+/// A step the schedule asks of a buffer the CPU twin does not handle that way.
+fn no_twin(what: &str, buf: Buf) -> Error {
+    Error::Internal(format!("the CPU twin has no {what} {buf:?}"))
+}
+
 impl RoundRunner for CpuRounds {
     fn round(&mut self, p: &Params, first: bool, selection: Selection) -> Result<Counters> {
         reset(&mut self.counters, std::mem::size_of::<Counters>() / 4);
-        self.build_adjacency(p);
-        if first {
-            self.setup(p);
+        for &(when, steps) in schedule::ROUND {
+            match when {
+                When::Always => self.run_steps(p, steps)?,
+                When::FirstRound if first => self.run_steps(p, steps)?,
+                When::Trimming if p.trim != 0 => self.run_steps(p, steps)?,
+                When::FirstRound | When::Trimming => {}
+                When::EachSelectionPass => self.passes(p, steps, selection)?,
+            }
         }
-        let ne = self.build_edges(p);
-        self.costs(p, ne);
-        self.select(p, ne, selection)?;
-        self.apply_and_compact(p);
+        self.swap_halves();
         self.rounds_run += 1;
         Ok(*bytemuck::from_bytes::<Counters>(bytemuck::cast_slice(
             &self.counters,

@@ -76,9 +76,9 @@ pub fn select_id(
     live: &[u32], // per listed candidate
     candidates: &[EdgeCandidate],
     face_best: &[AtomicU32],
+    counters: &[AtomicU32],
     edge_state: &[AtomicU32],
     face_id: &[AtomicU32], // per face, cleared
-    counters: &[AtomicU32],
 ) {
     par_for(live_count(counters), |i| {
         let e = live[i as usize];

@@ -45,8 +45,8 @@ pub fn vertex_quadrics(
     offsets: &[u32],           // per vertex + 1
     vertex_faces: &[u32],      // per corner
     face_normals: &[[f32; 4]], // per face: unit normal, area
-    quadrics: &mut [Quadric],  // per vertex
     face_extra: &[FaceExtra],  // per face
+    quadrics: &mut [Quadric],  // per vertex
 ) {
     let corner_attr = |f: u32, v: u32| corner_attr(indices, face_extra, f, v);
     par_for_mut(&mut quadrics[..params.vertex_count as usize], |v, out| {

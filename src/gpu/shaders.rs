@@ -4,144 +4,90 @@
 //! own source. Tests parse and validate every
 //! stage with naga — no GPU needed — and compare the WGSL structs with their Rust twins.
 
-/// (file stem, entry points, source) of every stage.
-pub const STAGES: &[(&str, &[&str], &str)] = &[
-    (
-        "prefix_sum",
-        &["prefix_sum_reduce", "prefix_sum_spine", "prefix_sum_apply"],
-        include_str!("../../shaders/prefix_sum.wgsl"),
-    ),
+/// (file stem, source) of every stage's shader; [`crate::parallel::schedule::STAGES`] names
+/// each stage's file.
+pub const SOURCES: &[(&str, &str)] = &[
+    ("prefix_sum", include_str!("../../shaders/prefix_sum.wgsl")),
     (
         "adjacency_count",
-        &["adjacency_count"],
         include_str!("../../shaders/adjacency_count.wgsl"),
     ),
     (
         "adjacency_fill",
-        &["adjacency_fill"],
         include_str!("../../shaders/adjacency_fill.wgsl"),
     ),
     (
         "adjacency_sort",
-        &["adjacency_sort"],
         include_str!("../../shaders/adjacency_sort.wgsl"),
     ),
     (
         "face_planes",
-        &["face_planes"],
         include_str!("../../shaders/face_planes.wgsl"),
     ),
     (
         "vertex_flags",
-        &["vertex_flags"],
         include_str!("../../shaders/vertex_flags.wgsl"),
     ),
     (
         "vertex_quadrics",
-        &["vertex_quadrics"],
         include_str!("../../shaders/vertex_quadrics.wgsl"),
     ),
     (
         "edges_count",
-        &["edges_count"],
         include_str!("../../shaders/edges_count.wgsl"),
     ),
-    (
-        "edges_fill",
-        &["edges_fill"],
-        include_str!("../../shaders/edges_fill.wgsl"),
-    ),
+    ("edges_fill", include_str!("../../shaders/edges_fill.wgsl")),
     (
         "edge_errors",
-        &["edge_errors"],
         include_str!("../../shaders/edge_errors.wgsl"),
     ),
-    (
-        "live_list",
-        &["live_list"],
-        include_str!("../../shaders/live_list.wgsl"),
-    ),
-    (
-        "edge_costs",
-        &["edge_costs"],
-        include_str!("../../shaders/edge_costs.wgsl"),
-    ),
+    ("live_list", include_str!("../../shaders/live_list.wgsl")),
+    ("edge_costs", include_str!("../../shaders/edge_costs.wgsl")),
     (
         "cost_ceiling",
-        &["cost_ceiling"],
         include_str!("../../shaders/cost_ceiling.wgsl"),
     ),
     (
         "select_cost",
-        &["select_cost"],
         include_str!("../../shaders/select_cost.wgsl"),
     ),
-    (
-        "select_id",
-        &["select_id"],
-        include_str!("../../shaders/select_id.wgsl"),
-    ),
-    (
-        "select_win",
-        &["select_win"],
-        include_str!("../../shaders/select_win.wgsl"),
-    ),
-    (
-        "validate",
-        &["validate"],
-        include_str!("../../shaders/validate.wgsl"),
-    ),
+    ("select_id", include_str!("../../shaders/select_id.wgsl")),
+    ("select_win", include_str!("../../shaders/select_win.wgsl")),
+    ("validate", include_str!("../../shaders/validate.wgsl")),
     (
         "trim_histogram",
-        &["trim_histogram"],
         include_str!("../../shaders/trim_histogram.wgsl"),
     ),
     (
         "trim_ceiling",
-        &["trim_ceiling"],
         include_str!("../../shaders/trim_ceiling.wgsl"),
     ),
-    (
-        "trim_mark",
-        &["trim_mark"],
-        include_str!("../../shaders/trim_mark.wgsl"),
-    ),
-    (
-        "trim_apply",
-        &["trim_apply"],
-        include_str!("../../shaders/trim_apply.wgsl"),
-    ),
-    (
-        "collapse",
-        &["collapse"],
-        include_str!("../../shaders/collapse.wgsl"),
-    ),
+    ("trim_mark", include_str!("../../shaders/trim_mark.wgsl")),
+    ("trim_apply", include_str!("../../shaders/trim_apply.wgsl")),
+    ("collapse", include_str!("../../shaders/collapse.wgsl")),
     (
         "compact_mark",
-        &["compact_mark"],
         include_str!("../../shaders/compact_mark.wgsl"),
     ),
     (
         "compact_vertices",
-        &["compact_vertices"],
         include_str!("../../shaders/compact_vertices.wgsl"),
     ),
     (
         "compact_faces",
-        &["compact_faces"],
         include_str!("../../shaders/compact_faces.wgsl"),
     ),
     (
         "dispatch_args",
-        &["dispatch_args"],
         include_str!("../../shaders/dispatch_args.wgsl"),
     ),
-    (
-        "draw_args",
-        &["draw_args"],
-        include_str!("../../shaders/draw_args.wgsl"),
-    ),
+    ("draw_args", include_str!("../../shaders/draw_args.wgsl")),
 ];
+
+/// The source of `shaders/<stem>.wgsl`.
+pub fn stage_source(stem: &str) -> Option<&'static str> {
+    SOURCES.iter().find(|s| s.0 == stem).map(|s| s.1)
+}
 
 /// The most storage buffers a stage binds (edge_errors); the device must allow as many per
 /// stage. A unit test counts them in every stage.
@@ -171,6 +117,52 @@ pub fn source(stage_source: &str) -> String {
     format!("{src}\n{stage_source}")
 }
 
+/// The bindings `shaders/<stage.shader>.wgsl` declares, by binding number: each variable's
+/// name and access. What the schedule's test compares with the stage's description.
+#[cfg(test)]
+pub(crate) fn declared_bindings(
+    stage: &crate::parallel::schedule::Stage,
+) -> std::result::Result<Vec<(String, crate::parallel::schedule::Access)>, String> {
+    use crate::parallel::schedule::Access;
+    let src = stage_source(stage.shader).ok_or("no such shader file")?;
+    let module = naga::front::wgsl::parse_str(&source(src)).map_err(|e| e.message().to_string())?;
+    let mut vars: Vec<(u32, String, Access)> = Vec::new();
+    for (_, v) in module.global_variables.iter() {
+        let Some(binding) = &v.binding else { continue };
+        if binding.group != 0 {
+            return Err(format!(
+                "binding group {} (the rounds use group 0)",
+                binding.group
+            ));
+        }
+        let access = match v.space {
+            naga::AddressSpace::Uniform => Access::Uniform,
+            naga::AddressSpace::Storage { access }
+                if access.contains(naga::StorageAccess::STORE) =>
+            {
+                Access::ReadWrite
+            }
+            naga::AddressSpace::Storage { .. } => Access::Read,
+            ref other => return Err(format!("a binding in address space {other:?}")),
+        };
+        vars.push((binding.binding, v.name.clone().unwrap_or_default(), access));
+    }
+    vars.sort_by_key(|v| v.0);
+    for (i, v) in vars.iter().enumerate() {
+        if v.0 != i as u32 {
+            return Err(format!(
+                "bindings not numbered 0..{}: {:?}",
+                vars.len(),
+                vars
+            ));
+        }
+    }
+    Ok(vars
+        .into_iter()
+        .map(|(_, name, access)| (name, access))
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -190,9 +182,9 @@ mod tests {
 
     #[test]
     fn no_stage_binds_more_storage_buffers_than_the_device_check_asks_for() {
-        let most = STAGES
+        let most = SOURCES
             .iter()
-            .map(|(stem, _, src)| {
+            .map(|(stem, src)| {
                 let module = parse(stem, src);
                 module
                     .global_variables
@@ -207,14 +199,19 @@ mod tests {
 
     #[test]
     fn every_stage_parses_and_validates() {
-        for (stem, entries, src) in STAGES {
-            let module = parse(stem, src);
-            for e in *entries {
-                assert!(
-                    module.entry_points.iter().any(|ep| ep.name == *e),
-                    "shaders/{stem}.wgsl has no entry point {e}"
-                );
-            }
+        for (stem, src) in SOURCES {
+            parse(stem, src);
+        }
+        for stage in crate::parallel::schedule::STAGES {
+            let src = stage_source(stage.shader)
+                .unwrap_or_else(|| panic!("{}: no shaders/{}.wgsl", stage.entry, stage.shader));
+            let module = parse(stage.shader, src);
+            assert!(
+                module.entry_points.iter().any(|ep| ep.name == stage.entry),
+                "shaders/{}.wgsl has no entry point {}",
+                stage.shader,
+                stage.entry
+            );
         }
     }
 
@@ -229,8 +226,8 @@ mod tests {
             let name = entry.file_name().into_string().unwrap();
             let stem = name.trim_end_matches(".wgsl");
             assert!(
-                ["common", "mesh", "seams"].contains(&stem) || STAGES.iter().any(|s| s.0 == stem),
-                "shaders/{name} is not listed in STAGES"
+                ["common", "mesh", "seams"].contains(&stem) || stage_source(stem).is_some(),
+                "shaders/{name} is not listed in SOURCES"
             );
         }
     }
@@ -240,10 +237,7 @@ mod tests {
     #[test]
     fn wgsl_constants_match_their_rust_twins() {
         use crate::cpu::edge_costs::CounterField as C;
-        let module = parse(
-            "draw_args",
-            STAGES.iter().find(|s| s.0 == "draw_args").unwrap().2,
-        );
+        let module = parse("draw_args", stage_source("draw_args").unwrap());
         let value = |name: &str| -> u32 {
             let (_, c) = module
                 .constants
@@ -292,10 +286,7 @@ mod tests {
 
     #[test]
     fn wgsl_structs_match_their_rust_twins() {
-        let module = parse(
-            "draw_args",
-            STAGES.iter().find(|s| s.0 == "draw_args").unwrap().2,
-        );
+        let module = parse("draw_args", stage_source("draw_args").unwrap());
         let size = |name: &str| {
             let (_, ty) = module
                 .types

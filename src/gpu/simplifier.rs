@@ -3,9 +3,10 @@
 //! read-back is the 64-byte counters block (and the stage timestamps when the device has them).
 
 use super::context::{ErrorSink, checked_buffer, checked_buffer_init};
-use super::shaders::{MAX_STORAGE_BUFFERS, STAGES, source};
+use super::shaders::{MAX_STORAGE_BUFFERS, source, stage_source};
 use super::types::*;
 use crate::error::{Error, Result};
+use crate::parallel::schedule::{self, Buf, Count, Stage, Step, When};
 use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
 use std::collections::HashMap;
 use std::time::Instant;
@@ -52,24 +53,26 @@ impl GpuSimplifier {
                 limits.max_storage_buffers_per_shader_stage
             )));
         }
+        let mut modules = HashMap::new();
         let mut pipelines = HashMap::new();
-        for (stem, entries, src) in STAGES {
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(stem),
-                source: wgpu::ShaderSource::Wgsl(source(src).into()),
+        for stage in schedule::STAGES {
+            let module = modules.entry(stage.shader).or_insert_with(|| {
+                let src = stage_source(stage.shader).unwrap_or_default();
+                device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(stage.shader),
+                    source: wgpu::ShaderSource::Wgsl(source(src).into()),
+                })
             });
-            for &entry in *entries {
-                let label = format!("meshslim.{entry}");
-                let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(&label),
-                    layout: None,
-                    module: &module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    cache: None,
-                });
-                pipelines.insert(entry, p);
-            }
+            let label = format!("meshslim.{}", stage.entry);
+            let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(&label),
+                layout: None,
+                module,
+                entry_point: Some(stage.entry),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            pipelines.insert(stage.entry, p);
         }
         errors.check("creating the compute pipelines")?;
         Ok(GpuSimplifier {
@@ -218,23 +221,16 @@ pub struct GpuRounds<'a> {
 
 /// How many workgroups a pass runs.
 #[derive(Clone, Copy)]
-enum Grid {
+enum Groups {
     Direct(u32),
     /// From the `dispatch` buffer at this byte offset, written by `dispatch_args`.
     Indirect(u64),
 }
 
 /// Workgroups for `n` invocations.
-fn wg(n: u32) -> Grid {
-    Grid::Direct(n.div_ceil(WG).max(1))
+fn wg(n: u32) -> Groups {
+    Groups::Direct(n.div_ceil(WG).max(1))
 }
-
-/// Byte offsets in the `dispatch` buffer: one grid per edge, one per tentative winner, one per
-/// candidate on the live list.
-const PER_EDGE: Grid = Grid::Indirect(0);
-const PER_TENTATIVE: Grid = Grid::Indirect(16);
-const PER_LIVE: Grid = Grid::Indirect(32);
-const ONE: Grid = Grid::Direct(1);
 
 impl<'a> GpuRounds<'a> {
     /// Uploads `up` and allocates every working buffer for its size (they only shrink).
@@ -359,23 +355,103 @@ impl<'a> GpuRounds<'a> {
         Ok(r)
     }
 
-    /// One compute pass: `entry` with `bindings` in the shader's binding order, over `grid`
-    /// (split over y beyond the per-dimension limit).
+    /// The buffer bound for `buf`; `scan` is the prefix sum's (count, data) when one runs.
+    fn buffer(&self, buf: Buf, scan: Option<(Count, Buf)>) -> &wgpu::Buffer {
+        let (h, o) = (&self.half[self.cur], &self.half[1 - self.cur]);
+        match buf {
+            Buf::Params => &self.params,
+            Buf::ScanCount => match scan.map(|s| s.0) {
+                Some(Count::Faces) => &self.scan_f,
+                Some(Count::EdgeSlots) => &self.scan_e,
+                // A prefix sum always names its count; vertices otherwise.
+                Some(Count::Vertices) | None => &self.scan_v,
+            },
+            Buf::ScanData => match scan {
+                Some((_, data)) if data != Buf::ScanData => self.buffer(data, None),
+                _ => &self.offsets,
+            },
+            Buf::BlockSums => &self.block_sums,
+            Buf::Positions => &h.positions,
+            Buf::Quadrics => &h.quadrics,
+            Buf::Flags => &h.flags,
+            Buf::VertexAttr => &h.vertex_attr,
+            Buf::Indices => &h.indices,
+            Buf::FaceNormals => &h.face_normals,
+            Buf::FaceExtra => &h.face_extra,
+            Buf::PositionsOut => &o.positions,
+            Buf::QuadricsOut => &o.quadrics,
+            Buf::FlagsOut => &o.flags,
+            Buf::VertexAttrOut => &o.vertex_attr,
+            Buf::IndicesOut => &o.indices,
+            Buf::FaceNormalsOut => &o.face_normals,
+            Buf::FaceExtraOut => &o.face_extra,
+            Buf::Offsets => &self.offsets,
+            Buf::Cursor => &self.cursor,
+            Buf::VertexFaces => &self.vertex_faces,
+            Buf::EdgeOffsets => &self.edge_offsets,
+            Buf::Neighbours => &self.neighbours,
+            Buf::Remap => &self.remap,
+            Buf::Edges => &self.edges,
+            Buf::Candidates => &self.candidates,
+            Buf::EdgeState => &self.edge_state,
+            Buf::Histogram => &self.histogram,
+            Buf::Live => &self.live,
+            Buf::VertexLock => &self.vertex_lock,
+            Buf::FaceBest => &self.face_best,
+            Buf::FaceId => &self.face_id,
+            Buf::Tentative => &self.tentative,
+            Buf::TrimHistogram => &self.trim_histogram,
+            Buf::Marks => &self.marks,
+            Buf::VertexKeep => &self.vertex_keep,
+            Buf::FaceKeep => &self.face_keep,
+            Buf::Counters => &self.counters,
+            Buf::Dispatch => &self.dispatch,
+            Buf::DrawArgs => &self.draw_args,
+        }
+    }
+
+    /// Records the steps in `steps`.
+    fn record(&mut self, enc: &mut wgpu::CommandEncoder, p: &Params, steps: &[Step]) {
+        for step in steps {
+            match *step {
+                Step::Clear(buf) => enc.clear_buffer(self.buffer(buf, None), 0, None),
+                Step::ClearTentative => enc.clear_buffer(&self.counters, TENTATIVE_OFFSET, Some(4)),
+                Step::Run(stage) => self.pass(enc, stage, p, None),
+                Step::PrefixSum { count, data } => {
+                    for stage in [
+                        &schedule::PREFIX_SUM_REDUCE,
+                        &schedule::PREFIX_SUM_SPINE,
+                        &schedule::PREFIX_SUM_APPLY,
+                    ] {
+                        self.pass(enc, stage, p, Some((count, data)));
+                    }
+                }
+                // The GPU's winners are checked by the tests against the CPU twin; nothing on
+                // the device writes through unchecked host memory.
+                Step::CheckWinners => {}
+            }
+        }
+    }
+
+    /// One compute pass: `stage` with its bindings in the shader's order, over its grid (split
+    /// over y beyond the per-dimension limit).
     fn pass(
         &mut self,
         enc: &mut wgpu::CommandEncoder,
-        entry: &'static str,
-        bindings: &[&wgpu::Buffer],
-        grid: Grid,
+        stage: &'static Stage,
+        p: &Params,
+        scan: Option<(Count, Buf)>,
     ) {
+        let entry = stage.entry;
         let pipeline = &self.sim.pipelines[entry];
         let layout = pipeline.get_bind_group_layout(0);
-        let entries: Vec<wgpu::BindGroupEntry> = bindings
+        let entries: Vec<wgpu::BindGroupEntry> = stage
+            .bindings
             .iter()
             .enumerate()
             .map(|(i, b)| wgpu::BindGroupEntry {
                 binding: i as u32,
-                resource: b.as_entire_binding(),
+                resource: self.buffer(b.buf, scan).as_entire_binding(),
             })
             .collect();
         let bg = self
@@ -386,6 +462,16 @@ impl<'a> GpuRounds<'a> {
                 layout: &layout,
                 entries: &entries,
             });
+        let groups = match stage.grid {
+            schedule::Grid::Each(count) => wg(count.of(p)),
+            schedule::Grid::VerticesOrFaces => wg(p.vertex_count.max(p.face_count)),
+            schedule::Grid::ScanBlocks => {
+                let n = scan.map_or(p.vertex_count, |(count, _)| count.of(p));
+                Groups::Direct(n.div_ceil(SCAN_BLOCK).max(1))
+            }
+            schedule::Grid::One => Groups::Direct(1),
+            indirect => Groups::Indirect(indirect.indirect_offset().unwrap_or(0)),
+        };
         let max_x = self.sim.max_workgroups;
         let split = |groups: u32| {
             if groups <= max_x {
@@ -412,12 +498,12 @@ impl<'a> GpuRounds<'a> {
         });
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bg, &[]);
-        match grid {
-            Grid::Direct(groups) => {
+        match groups {
+            Groups::Direct(groups) => {
                 let (x, y) = split(groups);
                 pass.dispatch_workgroups(x, y, 1);
             }
-            Grid::Indirect(offset) => pass.dispatch_workgroups_indirect(&self.dispatch, offset),
+            Groups::Indirect(offset) => pass.dispatch_workgroups_indirect(&self.dispatch, offset),
         }
         drop(pass);
         if self.share_queue {
@@ -437,46 +523,6 @@ impl<'a> GpuRounds<'a> {
                 submission_index: Some(index),
                 timeout: None,
             });
-        }
-    }
-
-    /// Exclusive prefix sum of `data` (n + 1 values; `scan` holds n) in three passes.
-    fn prefix_sum(&mut self, enc: &mut wgpu::CommandEncoder, scan: &str, data: &str, n: u32) {
-        let (s, d, b) = (self.buf(scan), self.buf(data), self.block_sums.clone());
-        let blocks = n.div_ceil(SCAN_BLOCK).max(1);
-        self.pass(
-            enc,
-            "prefix_sum_reduce",
-            &[&s, &d, &b],
-            Grid::Direct(blocks),
-        );
-        self.pass(enc, "prefix_sum_spine", &[&s, &d, &b], ONE);
-        self.pass(enc, "prefix_sum_apply", &[&s, &d, &b], Grid::Direct(blocks));
-    }
-
-    /// `dispatch_args`: the indirect grids from the current counts (edges, the pass's tentative
-    /// winners, the live list), before the stages that dispatch from them.
-    fn dispatch_args(&mut self, enc: &mut wgpu::CommandEncoder) {
-        let (p, e, c, d) = (
-            self.params.clone(),
-            self.edge_offsets.clone(),
-            self.counters.clone(),
-            self.dispatch.clone(),
-        );
-        self.pass(enc, "dispatch_args", &[&p, &e, &c, &d], ONE);
-    }
-
-    fn buf(&self, name: &str) -> wgpu::Buffer {
-        match name {
-            "scan_v" => self.scan_v.clone(),
-            "scan_f" => self.scan_f.clone(),
-            "scan_e" => self.scan_e.clone(),
-            "offsets" => self.offsets.clone(),
-            "edge_offsets" => self.edge_offsets.clone(),
-            "vertex_keep" => self.vertex_keep.clone(),
-            "face_keep" => self.face_keep.clone(),
-            "marks" => self.marks.clone(),
-            _ => unreachable!("no scan buffer {name}"),
         }
     }
 
@@ -635,264 +681,43 @@ impl RoundRunner for GpuRounds<'_> {
         let mut enc = dev.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("meshslim.round"),
         });
-        let (nv, nf, cap) = (p.vertex_count, p.face_count, p.edge_capacity);
-        let (h, o) = (self.cur, 1 - self.cur);
-        let hp = |s: &Self| {
-            let x = &s.half[h];
-            (
-                x.positions.clone(),
-                x.quadrics.clone(),
-                x.flags.clone(),
-                x.vertex_attr.clone(),
-                x.indices.clone(),
-                x.face_normals.clone(),
-                x.face_extra.clone(),
-            )
-        };
-        let (pos, quad, flags, vattr, idx, fnorm, fextra) = hp(self);
-        let out = &self.half[o];
-        let (pos_o, quad_o, flags_o, vattr_o, idx_o, fnorm_o, fextra_o) = (
-            out.positions.clone(),
-            out.quadrics.clone(),
-            out.flags.clone(),
-            out.vertex_attr.clone(),
-            out.indices.clone(),
-            out.face_normals.clone(),
-            out.face_extra.clone(),
-        );
-        let c = |b: &wgpu::Buffer| b.clone();
-        let (params, counters, offsets, cursor, vf) = (
-            c(&self.params),
-            c(&self.counters),
-            c(&self.offsets),
-            c(&self.cursor),
-            c(&self.vertex_faces),
-        );
-        let (eoff, edges, cand, est, hist) = (
-            c(&self.edge_offsets),
-            c(&self.edges),
-            c(&self.candidates),
-            c(&self.edge_state),
-            c(&self.histogram),
-        );
-        let (fbest, fid, vlock, remap, vkeep, fkeep, marks) = (
-            c(&self.face_best),
-            c(&self.face_id),
-            c(&self.vertex_lock),
-            c(&self.remap),
-            c(&self.vertex_keep),
-            c(&self.face_keep),
-            c(&self.marks),
-        );
-        let draw = c(&self.draw_args);
-        let tent = c(&self.tentative);
-        let nbrs = c(&self.neighbours);
-
-        enc.clear_buffer(&counters, 0, None);
-        enc.clear_buffer(&offsets, 0, None);
-        enc.clear_buffer(&cursor, 0, None);
-        self.pass(
-            &mut enc,
-            "adjacency_count",
-            &[&params, &idx, &offsets],
-            wg(nf),
-        );
-        self.prefix_sum(&mut enc, "scan_v", "offsets", nv);
-        self.pass(
-            &mut enc,
-            "adjacency_fill",
-            &[&params, &idx, &offsets, &cursor, &vf],
-            wg(nf),
-        );
-        self.pass(
-            &mut enc,
-            "adjacency_sort",
-            &[&params, &offsets, &vf],
-            wg(nv),
-        );
-        if first {
-            self.pass(
-                &mut enc,
-                "face_planes",
-                &[&params, &pos, &idx, &fnorm],
-                wg(nf),
-            );
-            self.pass(
-                &mut enc,
-                "vertex_flags",
-                &[&params, &idx, &offsets, &vf, &flags],
-                wg(nv),
-            );
-            self.pass(
-                &mut enc,
-                "vertex_quadrics",
-                &[&params, &pos, &idx, &offsets, &vf, &fnorm, &quad, &fextra],
-                wg(nv),
-            );
-        }
-        self.pass(
-            &mut enc,
-            "edges_count",
-            &[&params, &idx, &offsets, &vf, &eoff, &remap, &nbrs],
-            wg(nv),
-        );
-        self.prefix_sum(&mut enc, "scan_v", "edge_offsets", nv);
-        self.pass(
-            &mut enc,
-            "edges_fill",
-            &[&params, &offsets, &nbrs, &eoff, &edges],
-            wg(nv),
-        );
-        self.dispatch_args(&mut enc);
-        enc.clear_buffer(&hist, 0, None);
-        self.pass(
-            &mut enc,
-            "edge_errors",
-            &[
-                &params, &pos, &quad, &flags, &idx, &offsets, &vf, &edges, &eoff, &cand, &est,
-                &hist, &counters, &fextra,
-            ],
-            PER_EDGE,
-        );
-        self.pass(&mut enc, "cost_ceiling", &[&params, &hist, &counters], ONE);
-        let live = c(&self.live);
-        self.pass(
-            &mut enc,
-            "live_list",
-            &[&params, &eoff, &cand, &est, &counters, &live],
-            PER_EDGE,
-        );
-        self.dispatch_args(&mut enc);
-        self.pass(
-            &mut enc,
-            "edge_costs",
-            &[
-                &params, &pos, &idx, &offsets, &vf, &fnorm, &live, &cand, &est, &counters,
-            ],
-            PER_LIVE,
-        );
-        enc.clear_buffer(&vlock, 0, None);
-        for pass in 0u32.. {
-            match selection {
-                Selection::Ordinary if pass == self.selection_passes => break,
-                // Exhaustive: every EXHAUSTIVE_CHUNK passes, submit what is recorded and read
-                // the last pass's tentative count; none means no candidate is left to settle.
-                Selection::Exhaustive if pass > 0 && pass % EXHAUSTIVE_CHUNK == 0 => {
-                    let done = std::mem::replace(
-                        &mut enc,
-                        dev.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                            label: Some("meshslim.round"),
-                        }),
-                    );
-                    q.submit([done.finish()]);
-                    let now: Counters = *bytemuck::from_bytes(&self.read(&counters, COUNTERS_BYTES)?);
-                    if now.tentative == 0 {
-                        break;
+        enc.clear_buffer(&self.counters, 0, None);
+        for &(when, steps) in schedule::ROUND {
+            match when {
+                When::Always => self.record(&mut enc, p, steps),
+                When::FirstRound if first => self.record(&mut enc, p, steps),
+                When::Trimming if p.trim != 0 => self.record(&mut enc, p, steps),
+                When::FirstRound | When::Trimming => {}
+                When::EachSelectionPass => {
+                    for pass in 0u32.. {
+                        match selection {
+                            Selection::Ordinary if pass == self.selection_passes => break,
+                            // Exhaustive: every EXHAUSTIVE_CHUNK passes, submit what is
+                            // recorded and read the last pass's tentative count; none means
+                            // no candidate is left to settle.
+                            Selection::Exhaustive if pass > 0 && pass % EXHAUSTIVE_CHUNK == 0 => {
+                                let done = std::mem::replace(
+                                    &mut enc,
+                                    dev.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                                        label: Some("meshslim.round"),
+                                    }),
+                                );
+                                q.submit([done.finish()]);
+                                let now: Counters = *bytemuck::from_bytes(
+                                    &self.read(&self.counters, COUNTERS_BYTES)?,
+                                );
+                                if now.tentative == 0 {
+                                    break;
+                                }
+                            }
+                            _ => {}
+                        }
+                        self.record(&mut enc, p, steps);
                     }
                 }
-                _ => {}
             }
-            enc.clear_buffer(&fbest, 0, None);
-            enc.clear_buffer(&fid, 0, None);
-            // counters.tentative: the list select_win fills is per pass.
-            enc.clear_buffer(&counters, TENTATIVE_OFFSET, Some(4));
-            self.pass(
-                &mut enc,
-                "select_cost",
-                &[
-                    &offsets, &vf, &edges, &live, &cand, &vlock, &counters, &est, &fbest,
-                ],
-                PER_LIVE,
-            );
-            self.pass(
-                &mut enc,
-                "select_id",
-                &[
-                    &offsets, &vf, &edges, &live, &cand, &fbest, &est, &fid, &counters,
-                ],
-                PER_LIVE,
-            );
-            self.pass(
-                &mut enc,
-                "select_win",
-                &[&offsets, &vf, &edges, &live, &fid, &est, &tent, &counters],
-                PER_LIVE,
-            );
-            self.dispatch_args(&mut enc);
-            self.pass(
-                &mut enc,
-                "validate",
-                &[
-                    &params, &flags, &idx, &offsets, &vf, &edges, &tent, &cand, &est, &vlock,
-                    &counters,
-                ],
-                PER_TENTATIVE,
-            );
         }
-        if p.trim != 0 {
-            let thist = c(&self.trim_histogram);
-            enc.clear_buffer(&thist, 0, None);
-            self.pass(
-                &mut enc,
-                "trim_histogram",
-                &[&params, &cand, &est, &eoff, &thist],
-                PER_EDGE,
-            );
-            self.pass(&mut enc, "trim_ceiling", &[&params, &thist, &counters], ONE);
-            self.pass(
-                &mut enc,
-                "trim_mark",
-                &[&params, &cand, &est, &eoff, &counters, &marks],
-                wg(cap),
-            );
-            self.prefix_sum(&mut enc, "scan_e", "marks", cap);
-            self.pass(
-                &mut enc,
-                "trim_apply",
-                &[&params, &cand, &marks, &counters, &eoff, &est],
-                PER_EDGE,
-            );
-        }
-        self.pass(
-            &mut enc,
-            "collapse",
-            &[
-                &params, &cand, &est, &eoff, &pos, &quad, &flags, &remap, &idx, &offsets, &vf,
-                &fextra,
-            ],
-            PER_EDGE,
-        );
-        self.pass(
-            &mut enc,
-            "compact_mark",
-            &[&params, &idx, &remap, &vkeep, &fkeep],
-            wg(nv.max(nf)),
-        );
-        self.prefix_sum(&mut enc, "scan_v", "vertex_keep", nv);
-        self.prefix_sum(&mut enc, "scan_f", "face_keep", nf);
-        self.pass(
-            &mut enc,
-            "compact_vertices",
-            &[
-                &params, &vkeep, &pos, &quad, &flags, &vattr, &pos_o, &quad_o, &flags_o, &vattr_o,
-            ],
-            wg(nv),
-        );
-        self.pass(
-            &mut enc,
-            "compact_faces",
-            &[
-                &params, &idx, &fnorm, &fextra, &remap, &vkeep, &fkeep, &idx_o, &fnorm_o, &fextra_o,
-            ],
-            wg(nf),
-        );
-        self.pass(
-            &mut enc,
-            "draw_args",
-            &[&params, &vkeep, &fkeep, &counters, &draw],
-            ONE,
-        );
-
+        let (o, counters) = (1 - self.cur, self.counters.clone());
         enc.copy_buffer_to_buffer(&counters, 0, &self.readback, 0, COUNTERS_BYTES);
         let used = self.query_stages.len() as u32 * 2;
         if let Some((set, resolve)) = &self.queries

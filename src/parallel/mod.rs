@@ -2,6 +2,8 @@
 //! collapses each round aims for, when it trims to land on the target, why it stops, and how
 //! the result becomes a [`Mesh`] again. The backends only run the stages ([`RoundRunner`]).
 
+pub mod schedule;
+
 use crate::error::Result;
 use crate::gpu::types::{Counters, FaceExtra, Params, flag};
 use crate::mesh::{Mesh, weld, weld::position_classes};
