@@ -13,6 +13,7 @@ pub use topology::{Topology, topology};
 pub use weld::{WeldResult, weld, weld_positions};
 
 use crate::error::{Error, Result};
+use glam::{DVec3, Vec3};
 
 /// A named material, as OBJ `usemtl`/glTF materials name them.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -126,28 +127,16 @@ pub struct Aabb {
 
 impl Aabb {
     pub fn diagonal(&self) -> f64 {
-        let d = sub64(self.max, self.min);
-        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+        sub64(self.max, self.min).length()
     }
     pub fn center(&self) -> [f64; 3] {
         [0, 1, 2].map(|i| (self.min[i] as f64 + self.max[i] as f64) * 0.5)
     }
 }
 
-pub(crate) fn sub64(a: [f32; 3], b: [f32; 3]) -> [f64; 3] {
-    [0, 1, 2].map(|i| a[i] as f64 - b[i] as f64)
-}
-
-pub(crate) fn cross64(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-pub(crate) fn dot64(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+/// `a - b` in f64.
+fn sub64(a: [f32; 3], b: [f32; 3]) -> DVec3 {
+    Vec3::from_array(a).as_dvec3() - Vec3::from_array(b).as_dvec3()
 }
 
 impl Mesh {
@@ -262,19 +251,18 @@ impl Mesh {
     /// Twice the area vector (cross product of two edges) of face `f`, in f64.
     pub fn face_cross(&self, f: usize) -> [f64; 3] {
         let [a, b, c] = self.triangles[f].map(|v| self.positions[v as usize]);
-        cross64(sub64(b, a), sub64(c, a))
+        sub64(b, a).cross(sub64(c, a)).to_array()
     }
 
     pub fn face_area(&self, f: usize) -> f64 {
-        let c = self.face_cross(f);
-        0.5 * dot64(c, c).sqrt()
+        0.5 * DVec3::from_array(self.face_cross(f)).length()
     }
 
     /// Unit normal of face `f`, or `None` when the face has no area.
     pub fn face_normal(&self, f: usize) -> Option<[f64; 3]> {
-        let c = self.face_cross(f);
-        let l = dot64(c, c).sqrt();
-        (l > 0.0 && l.is_finite()).then(|| c.map(|x| x / l))
+        let c = DVec3::from_array(self.face_cross(f));
+        let l = c.length();
+        (l > 0.0 && l.is_finite()).then(|| (c / l).to_array())
     }
 
     pub fn surface_area(&self) -> f64 {
@@ -285,16 +273,13 @@ impl Mesh {
     /// Computed relative to the bounding-box centre so that far-away meshes keep precision.
     pub fn signed_volume(&self) -> f64 {
         let Some(b) = self.bounds() else { return 0.0 };
-        let o = b.center();
-        let rel = |v: u32| {
-            let p = self.positions[v as usize];
-            [0, 1, 2].map(|i| p[i] as f64 - o[i])
-        };
+        let o = DVec3::from_array(b.center());
+        let rel = |v: u32| Vec3::from_array(self.positions[v as usize]).as_dvec3() - o;
         self.triangles
             .iter()
             .map(|t| {
                 let [a, b, c] = t.map(rel);
-                dot64(a, cross64(b, c)) / 6.0
+                a.dot(b.cross(c)) / 6.0
             })
             .sum()
     }
@@ -302,21 +287,19 @@ impl Mesh {
     /// Recomputes per-vertex normals as the area-weighted mean of the incident face normals.
     /// Vertices split at a seam keep their own side's normal, since they are separate vertices.
     pub fn recompute_normals(&mut self) {
-        let mut acc = vec![[0.0f64; 3]; self.positions.len()];
+        let mut acc = vec![DVec3::ZERO; self.positions.len()];
         for f in 0..self.triangles.len() {
-            let c = self.face_cross(f);
+            let c = DVec3::from_array(self.face_cross(f));
             for &v in &self.triangles[f] {
-                for i in 0..3 {
-                    acc[v as usize][i] += c[i];
-                }
+                acc[v as usize] += c;
             }
         }
         self.normals = Some(
             acc.into_iter()
                 .map(|n| {
-                    let l = dot64(n, n).sqrt();
+                    let l = n.length();
                     if l > 0.0 {
-                        n.map(|x| (x / l) as f32)
+                        (n / l).as_vec3().to_array()
                     } else {
                         [0.0, 0.0, 1.0]
                     }

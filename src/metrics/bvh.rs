@@ -25,6 +25,7 @@
 //! Positions are f32, so the f32 boxes bound the faces exactly; distances are computed in f64.
 
 use crate::mesh::Mesh;
+use glam::{DVec3, Vec3};
 
 /// Faces per leaf: four keeps the tree shallow without testing many faces per leaf.
 pub const LEAF_SIZE: usize = 4;
@@ -282,64 +283,47 @@ fn box_dist2(q: [f32; 3], e: f32, n: &Node) -> f32 {
 /// would cost pruning.
 const BOX_SLACK: f32 = 1.0 - 1e-5;
 
-#[inline]
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline]
-fn to64(p: [f32; 3]) -> [f64; 3] {
-    [p[0] as f64, p[1] as f64, p[2] as f64]
-}
-
 /// Squared distance from `p` to the closest point of the triangle `t`, by the Voronoi regions
 /// of its vertices, edges and face (Ericson, Real-Time Collision Detection, 5.1.5). Degenerate
 /// triangles (segments, points) fall into the vertex and edge regions and are handled too.
 pub fn point_triangle_dist2(p: [f64; 3], t: &[[f32; 3]; 3]) -> f64 {
-    let (a, b, c) = (to64(t[0]), to64(t[1]), to64(t[2]));
-    let q = closest_on_triangle(p, a, b, c);
-    let d = sub(p, q);
-    dot(d, d)
+    let [a, b, c] = t.map(|v| Vec3::from_array(v).as_dvec3());
+    let p = DVec3::from_array(p);
+    p.distance_squared(closest_on_triangle(p, a, b, c))
 }
 
-fn closest_on_triangle(p: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f64; 3] {
-    let lerp = |x: [f64; 3], y: [f64; 3], t: f64| [0, 1, 2].map(|k| x[k] + t * (y[k] - x[k]));
-    let ab = sub(b, a);
-    let ac = sub(c, a);
-    let ap = sub(p, a);
-    let d1 = dot(ab, ap);
-    let d2 = dot(ac, ap);
+fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = ab.dot(ap);
+    let d2 = ac.dot(ap);
     if d1 <= 0.0 && d2 <= 0.0 {
         return a;
     }
-    let bp = sub(p, b);
-    let d3 = dot(ab, bp);
-    let d4 = dot(ac, bp);
+    let bp = p - b;
+    let d3 = ab.dot(bp);
+    let d4 = ac.dot(bp);
     if d3 >= 0.0 && d4 <= d3 {
         return b;
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return lerp(a, b, d1 / (d1 - d3));
+        return a + (b - a) * (d1 / (d1 - d3));
     }
-    let cp = sub(p, c);
-    let d5 = dot(ab, cp);
-    let d6 = dot(ac, cp);
+    let cp = p - c;
+    let d5 = ab.dot(cp);
+    let d6 = ac.dot(cp);
     if d6 >= 0.0 && d5 <= d6 {
         return c;
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return lerp(a, c, d2 / (d2 - d6));
+        return a + (c - a) * (d2 / (d2 - d6));
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return lerp(b, c, (d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
     }
     let denom = va + vb + vc;
     if denom.abs() < f64::MIN_POSITIVE || !denom.is_finite() {
@@ -351,23 +335,23 @@ fn closest_on_triangle(p: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f
             seg_closest(p, a, c),
         ]
         .into_iter()
-        .min_by(|x, y| dot(sub(p, *x), sub(p, *x)).total_cmp(&dot(sub(p, *y), sub(p, *y))))
+        .min_by(|x, y| p.distance_squared(*x).total_cmp(&p.distance_squared(*y)))
         .unwrap_or(a);
     }
     let v = vb / denom;
     let w = vc / denom;
-    [0, 1, 2].map(|k| a[k] + ab[k] * v + ac[k] * w)
+    a + ab * v + ac * w
 }
 
-fn seg_closest(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    let ab = sub(b, a);
-    let l2 = dot(ab, ab);
+fn seg_closest(p: DVec3, a: DVec3, b: DVec3) -> DVec3 {
+    let ab = b - a;
+    let l2 = ab.dot(ab);
     let t = if l2 > 0.0 {
-        (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
+        ((p - a).dot(ab) / l2).clamp(0.0, 1.0)
     } else {
         0.0
     };
-    [0, 1, 2].map(|k| a[k] + t * ab[k])
+    a + ab * t
 }
 
 #[cfg(test)]

@@ -5,6 +5,7 @@ use serde::Serialize;
 
 use super::bvh::TriangleBvh;
 use crate::mesh::{Mesh, SplitMix64};
+use glam::DVec3;
 
 /// Samples per parallel task. Fixed, so that every partial sum covers the same samples whatever
 /// the number of threads, and the partial sums are added in task order.
@@ -97,12 +98,14 @@ const EDGE_REL_TOL: f64 = 1e-3;
 /// A point of an edge: its parameter t in [0, 1] and its distance.
 type EdgePoint = (f64, f64);
 
+/// `a + t (b - a)`, not glam's `lerp` (`a (1 - t) + b t`), whose rounding differs.
 fn lerp(a: [f64; 3], b: [f64; 3], t: f64) -> [f64; 3] {
-    [0, 1, 2].map(|k| a[k] + t * (b[k] - a[k]))
+    let (a, b) = (DVec3::from_array(a), DVec3::from_array(b));
+    (a + (b - a) * t).to_array()
 }
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
-    (0..3).map(|k| (b[k] - a[k]).powi(2)).sum::<f64>().sqrt()
+    DVec3::from_array(a).distance(DVec3::from_array(b))
 }
 
 /// Evenly spaced segments of an edge of length `len` for samples `spacing` apart: at least two
@@ -238,7 +241,7 @@ fn sample_rng(seed: u64, i: usize) -> SplitMix64 {
 }
 
 fn p64(p: [f32; 3]) -> [f64; 3] {
-    [p[0] as f64, p[1] as f64, p[2] as f64]
+    glam::Vec3::from_array(p).as_dvec3().to_array()
 }
 
 /// The unique undirected edges of `mesh` (by vertex index), sorted.

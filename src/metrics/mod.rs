@@ -313,12 +313,10 @@ pub fn compare(a: &Mesh, b: &Mesh, opts: &CompareOptions) -> Result<Comparison> 
 
 /// Smallest angle (degrees) and aspect ratio of one face; `None` when it has no area.
 fn face_shape(p: [[f64; 3]; 3]) -> Option<(f64, f64)> {
-    let e = |i: usize, j: usize| [0, 1, 2].map(|k| p[j][k] - p[i][k]);
-    let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    let (ab, bc, ca) = (e(0, 1), e(1, 2), e(2, 0));
-    let (la, lb, lc) = (len(ab), len(bc), len(ca));
-    let cross = crate::mesh::cross64(ab, [-ca[0], -ca[1], -ca[2]]);
-    let twice_area = len(cross);
+    let p = p.map(glam::DVec3::from_array);
+    let (ab, bc, ca) = (p[1] - p[0], p[2] - p[1], p[0] - p[2]);
+    let (la, lb, lc) = (ab.length(), bc.length(), ca.length());
+    let twice_area = ab.cross(-ca).length();
     if twice_area <= 0.0 || !twice_area.is_finite() {
         return None;
     }
