@@ -6,14 +6,19 @@
 
 pub mod app;
 pub mod camera;
+mod file_browser;
+mod jobs;
+pub mod lod;
+pub mod panels;
 pub mod render;
 pub mod scene;
+pub mod views;
 
 use crate::error::{Error, Result};
 use crate::simplify::{Backend, SimplifyOptions};
 pub use app::{Start, ViewerApp};
 use camera::Camera;
-pub use render::{Mode, Renderer, Style};
+pub use render::{Mode, Renderer, Style, encode_png};
 pub use scene::Model;
 
 /// What `screenshot` did, for the command line to report.
@@ -150,16 +155,4 @@ pub fn run_window(
              --screenshot FILE.png"
         ))
     })
-}
-
-/// RGBA8 rows (opaque) to PNG bytes.
-pub fn encode_png(rgba: &[u8], (w, h): (u32, u32)) -> Result<Vec<u8>> {
-    use resvg::tiny_skia;
-    let size = tiny_skia::IntSize::from_wh(w, h)
-        .ok_or_else(|| Error::InvalidOption(format!("image size {w}x{h}")))?;
-    let pixmap = tiny_skia::Pixmap::from_vec(rgba.to_vec(), size)
-        .ok_or_else(|| Error::Internal("frame size does not match its pixels".into()))?;
-    pixmap
-        .encode_png()
-        .map_err(|e| Error::Internal(format!("encoding the PNG: {e}")))
 }

@@ -670,6 +670,18 @@ pub fn render_rgba(
     target.read_rgba(device, queue)
 }
 
+/// RGBA8 rows (opaque) to PNG bytes.
+pub fn encode_png(rgba: &[u8], (w, h): (u32, u32)) -> Result<Vec<u8>> {
+    use resvg::tiny_skia;
+    let size = tiny_skia::IntSize::from_wh(w, h)
+        .ok_or_else(|| Error::InvalidOption(format!("image size {w}x{h}")))?;
+    let pixmap = tiny_skia::Pixmap::from_vec(rgba.to_vec(), size)
+        .ok_or_else(|| Error::Internal("frame size does not match its pixels".into()))?;
+    pixmap
+        .encode_png()
+        .map_err(|e| Error::Internal(format!("encoding the PNG: {e}")))
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

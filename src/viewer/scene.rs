@@ -295,6 +295,14 @@ pub struct Simplified {
     pub error: Option<(f64, f64)>,
 }
 
+pub fn backend_name(b: Backend) -> &'static str {
+    match b {
+        Backend::Gpu => "gpu",
+        Backend::CpuParallel => "cpu-parallel",
+        Backend::Cpu => "cpu",
+    }
+}
+
 /// Simplifies `model` with `opts.backend`. The `gpu` backend runs on `sim` (the window's own
 /// device) and the result stays there: its [`GpuMesh`] is the rounds' buffers. The CPU backends'
 /// results are uploaded once so that one renderer draws them all.
@@ -309,10 +317,7 @@ pub fn simplify(
     phase: &dyn Fn(&str),
 ) -> Result<Simplified> {
     let t = Instant::now();
-    phase(&format!(
-        "simplifying ({})",
-        super::app::backend_name(opts.backend)
-    ));
+    phase(&format!("simplifying ({})", backend_name(opts.backend)));
     let (gpu, positions, indices, mesh, report, uvs) = match opts.backend {
         Backend::Gpu => {
             let sim = sim.ok_or_else(|| Error::Gpu("the GPU backend is not available".into()))?;

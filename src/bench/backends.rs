@@ -1,0 +1,117 @@
+//! What the benchmark can run: every backend with its help line, the call that is timed, and the
+//! device that runs it (the CPU's model or the GPU adapter).
+
+use super::peers::{meshopt_simplify, meshopt_simplify_sloppy};
+use crate::error::Result;
+use crate::mesh::Mesh;
+use crate::simplify::SimplifyOptions;
+
+/// One implementation the benchmark can run. A new backend (cpu-parallel, gpu) is one entry in
+/// [`BACKENDS`]: its name, a line of help, the simplify call that is timed, and the device
+/// that runs it (a GPU backend names its adapter there).
+#[derive(Debug)]
+pub struct BenchBackend {
+    /// The `--backends` name, also the `backend` field of each row.
+    pub name: &'static str,
+    /// One line for `meshslim bench --help`.
+    pub about: &'static str,
+    /// Simplifies the mesh to about this many faces: the call that is timed and measured.
+    pub simplify: fn(&Mesh, usize) -> Result<Mesh>,
+    /// The device that runs it, named in every row.
+    pub device: fn() -> String,
+}
+
+/// Every backend `meshslim bench` knows, in the order of the table and the plot legend.
+pub static BACKENDS: &[BenchBackend] = &[
+    BenchBackend {
+        name: "cpu",
+        about: "meshslim's greedy quadric edge collapse (the quality reference)",
+        simplify: |m, faces| Ok(crate::simplify(m, &SimplifyOptions::with_faces(faces))?.0),
+        device: cpu_name,
+    },
+    BenchBackend {
+        name: "cpu-parallel",
+        about: "meshslim's GPU rounds run on the CPU's cores (rayon)",
+        simplify: |m, faces| {
+            Ok(crate::simplify(m, &with_backend(faces, crate::Backend::CpuParallel))?.0)
+        },
+        device: cpu_name,
+    },
+    BenchBackend {
+        name: "gpu",
+        about: "meshslim's rounds as WGSL compute passes (wgpu)",
+        simplify: |m, faces| Ok(crate::simplify(m, &with_backend(faces, crate::Backend::Gpu))?.0),
+        device: gpu_name,
+    },
+    BenchBackend {
+        name: "meshopt",
+        about: "meshoptimizer's simplify (quadric edge collapse)",
+        simplify: |m, faces| Ok(meshopt_simplify(m, faces)),
+        device: cpu_name,
+    },
+    BenchBackend {
+        name: "meshopt-sloppy",
+        about: "meshoptimizer's simplifySloppy (vertex clustering, topology not kept)",
+        simplify: |m, faces| Ok(meshopt_simplify_sloppy(m, faces)),
+        device: cpu_name,
+    },
+];
+
+fn with_backend(faces: usize, backend: crate::Backend) -> SimplifyOptions {
+    let mut o = SimplifyOptions::with_faces(faces);
+    o.backend = backend;
+    o
+}
+
+/// The GPU adapter's name, or why there is none.
+pub fn gpu_name() -> String {
+    static NAME: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    NAME.get_or_init(|| match crate::gpu::shared() {
+        Ok((c, _)) => c.adapter_name.clone(),
+        Err(e) => format!("no GPU ({e})"),
+    })
+    .clone()
+}
+
+/// Every backend this machine can run: all of [`BACKENDS`], less `gpu` without an adapter.
+pub fn available_backends() -> Vec<&'static BenchBackend> {
+    let gpu = crate::gpu::shared().is_ok();
+    BACKENDS.iter().filter(|b| gpu || b.name != "gpu").collect()
+}
+
+/// The backend called `name` in [`BACKENDS`].
+pub fn backend(name: &str) -> Option<&'static BenchBackend> {
+    BACKENDS.iter().find(|b| b.name == name)
+}
+
+/// The CPU's model name (`model name` in /proc/cpuinfo, else the architecture).
+pub fn cpu_name() -> String {
+    static NAME: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    NAME.get_or_init(|| {
+        std::fs::read_to_string("/proc/cpuinfo")
+            .ok()
+            .and_then(|info| {
+                info.lines()
+                    .filter_map(|l| l.split_once(':'))
+                    .find(|(k, _)| matches!(k.trim(), "model name" | "Model" | "Hardware"))
+                    .map(|(_, v)| v.split_whitespace().collect::<Vec<_>>().join(" "))
+            })
+            .filter(|n| !n.is_empty())
+            .unwrap_or_else(|| format!("unknown {} CPU", std::env::consts::ARCH))
+    })
+    .clone()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn backend_names_are_unique_and_found() {
+        for (i, b) in BACKENDS.iter().enumerate() {
+            assert!(std::ptr::eq(backend(b.name).unwrap(), b));
+            assert!(BACKENDS[..i].iter().all(|o| o.name != b.name));
+        }
+        assert!(backend("nope").is_none());
+    }
+}

@@ -1,0 +1,215 @@
+//! Inputs and the meshoptimizer baseline for benchmarks: shared by `benches/simplify.rs` and the
+//! `meshslim bench` command, so that both measure the same meshes the same way.
+//!
+//! The reference meshes live outside the crate (`../shared/models`, see its README); without
+//! them every function here falls back to a procedural mesh so that benches still run.
+//!
+//! [`run`] is the benchmark itself: every mesh × ratio × backend of [`BACKENDS`], timed
+//! (median over repeats), its peak heap measured ([`alloc`]) and its two-sided Metro distance
+//! to the input measured with [`crate::metrics::compare`]. [`write_table`] and [`plot_svg`]
+//! present the [`Report`]; it serializes to the JSON of `meshslim bench --json`.
+//!
+//! The parts: `models` (the reference meshes and the 1M-triangle scan), `peers` (meshoptimizer's
+//! simplifiers), `backends` (what runs and on which device), `report` (what a run measured),
+//! `present` (the table, the SVG plot and its PNG), [`alloc`] (the counting allocator).
+
+pub mod alloc;
+mod backends;
+mod models;
+mod peers;
+mod present;
+mod report;
+
+use std::time::Instant;
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::metrics::{self, CompareOptions};
+use crate::simplify::SimplifyOptions;
+
+pub use backends::{BACKENDS, BenchBackend, available_backends, backend, cpu_name, gpu_name};
+pub use models::{
+    BENCH_MODELS, MODELS_ENV, RATIOS, inputs, load_model, million_triangle_scan, models_dir,
+};
+pub use peers::{meshopt_simplify, meshopt_simplify_sloppy};
+pub use present::{plot_svg, svg_to_png, write_table};
+pub use report::{Machine, Report, Row};
+
+/// Ratios `meshslim bench` runs at when none are given.
+pub const DEFAULT_RATIOS: [f64; 3] = [0.5, 0.1, 0.01];
+
+/// What to run.
+#[derive(Debug, Clone)]
+pub struct BenchOptions {
+    /// Fractions of the input faces to keep, each in (0, 1].
+    pub ratios: Vec<f64>,
+    pub backends: Vec<&'static BenchBackend>,
+    /// Timed runs per case; the median is reported.
+    pub repeat: usize,
+    /// How the error is measured.
+    pub compare: CompareOptions,
+}
+
+impl Default for BenchOptions {
+    fn default() -> Self {
+        BenchOptions {
+            ratios: DEFAULT_RATIOS.to_vec(),
+            backends: available_backends(),
+            repeat: 3,
+            compare: CompareOptions::default(),
+        }
+    }
+}
+
+/// Runs every mesh × ratio × backend of `opts`, in that nesting order. `progress` gets the
+/// fraction done (0..=1) after every timed run and every measurement.
+pub fn run(
+    inputs: &[(String, Mesh)],
+    opts: &BenchOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<Report> {
+    if opts.repeat == 0 {
+        return Err(Error::InvalidOption("repeat must be at least 1".into()));
+    }
+    if opts.backends.is_empty() || opts.ratios.is_empty() {
+        return Err(Error::InvalidOption(
+            "at least one backend and one ratio are needed".into(),
+        ));
+    }
+    let targets = opts
+        .ratios
+        .iter()
+        .map(|&r| SimplifyOptions::with_ratio(1, r).map(|_| r))
+        .collect::<Result<Vec<f64>>>()?;
+    let steps = inputs.len() * targets.len() * opts.backends.len() * (opts.repeat + 1);
+    let mut done = 0;
+    let mut step = || {
+        done += 1;
+        progress(done as f32 / steps.max(1) as f32)
+    };
+    let mut rows = Vec::new();
+    for (name, mesh) in inputs {
+        mesh.validate()
+            .map_err(|e| Error::InvalidMesh(format!("{name}: {e}")))?;
+        let faces = mesh.face_count();
+        let diagonal = mesh.bounds().map_or(0.0, |b| b.diagonal());
+        for &ratio in &targets {
+            let target = SimplifyOptions::with_ratio(faces, ratio)?.target_faces;
+            for backend in &opts.backends {
+                let mut times = Vec::with_capacity(opts.repeat);
+                let mut peak: Option<u64> = None;
+                let mut out = None;
+                for _ in 0..opts.repeat {
+                    drop(out.take()); // the previous output is not part of this run's baseline
+                    let (result, bytes) = alloc::measure(|| {
+                        let t = Instant::now();
+                        let r = (backend.simplify)(mesh, target);
+                        (r, t.elapsed().as_secs_f64())
+                    });
+                    let (simplified, seconds) = result;
+                    out = Some(simplified?);
+                    times.push(seconds);
+                    peak = bytes.map(|b| peak.map_or(b, |p| p.max(b)));
+                    step();
+                }
+                let out = out.expect("repeat is at least 1");
+                let d = if out.face_count() == 0 {
+                    None
+                } else {
+                    Some(
+                        metrics::compare(mesh, &out, &opts.compare)?
+                            .distance
+                            .two_sided,
+                    )
+                };
+                step();
+                let median_s = median(&times);
+                rows.push(Row {
+                    mesh: name.clone(),
+                    input_faces: faces,
+                    ratio,
+                    target_faces: target,
+                    backend: backend.name.to_string(),
+                    device: (backend.device)(),
+                    output_faces: out.face_count(),
+                    missed_target: out.face_count() > target,
+                    median_s,
+                    times_s: times,
+                    mtri_per_s: faces as f64 / median_s.max(1e-9) / 1e6,
+                    peak_bytes: peak,
+                    peak_mib: peak.map(|b| b as f64 / (1024.0 * 1024.0)),
+                    diagonal,
+                    mean_err: d.as_ref().map(|d| d.mean),
+                    max_err: d.as_ref().map(|d| d.max),
+                    mean_err_rel: d.as_ref().map(|d| d.mean_rel),
+                    max_err_rel: d.as_ref().map(|d| d.max_rel),
+                });
+            }
+        }
+    }
+    Ok(Report {
+        machine: Machine::this(),
+        repeat: opts.repeat,
+        samples: opts.compare.samples,
+        rows,
+    })
+}
+
+fn median(xs: &[f64]) -> f64 {
+    let mut v = xs.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh;
+
+    #[test]
+    fn median_of_odd_and_even_counts() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+    }
+
+    #[test]
+    fn run_without_the_counting_allocator_reports_no_peak_and_plots() {
+        let opts = BenchOptions {
+            ratios: vec![0.5],
+            repeat: 2,
+            compare: CompareOptions {
+                samples: Some(200),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let inputs = [("ico".to_string(), mesh::icosphere(2))];
+        let mut last = 0.0;
+        let report = run(&inputs, &opts, &mut |f| last = f).unwrap();
+        assert_eq!(last, 1.0);
+        let backends = available_backends().len();
+        assert_eq!(report.rows.len(), backends);
+        for r in &report.rows {
+            assert_eq!(r.times_s.len(), 2);
+            assert_eq!(
+                r.peak_bytes, None,
+                "the test harness has no counting allocator"
+            );
+            assert!(r.mean_err_rel.unwrap() > 0.0);
+        }
+        let svg = plot_svg(&report);
+        assert_eq!(svg.matches(r#"class="series""#).count(), backends);
+        let mut table = Vec::new();
+        write_table(&mut table, &report).unwrap();
+        // Header, one row per backend, then the three lines of notes under the table.
+        assert_eq!(
+            String::from_utf8(table).unwrap().lines().count(),
+            1 + backends + 3
+        );
+    }
+}

@@ -1,0 +1,383 @@
+//! The report presented: the table on stdout, the error-against-time plot as SVG, and that SVG
+//! rendered to PNG.
+
+use std::io::Write;
+
+use super::backends::BACKENDS;
+use super::report::{Report, Row};
+
+/// The report as a table, one row per line, errors relative to the input's diagonal.
+pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()> {
+    let mesh_w = report
+        .rows
+        .iter()
+        .map(|r| r.mesh.len())
+        .chain([4])
+        .max()
+        .unwrap_or(4);
+    let backend_w = report
+        .rows
+        .iter()
+        .map(|r| r.backend.len())
+        .chain([7])
+        .max()
+        .unwrap_or(7);
+    writeln!(
+        out,
+        "{:<mesh_w$} {:>9} {:>6} {:<backend_w$} {:>9} {:>9} {:>7} {:>8} {:>9} {:>9}",
+        "mesh",
+        "faces",
+        "ratio",
+        "backend",
+        "out faces",
+        "median s",
+        "Mtri/s",
+        "peak MiB",
+        "mean err",
+        "max err"
+    )?;
+    let opt = |v: Option<f64>, prec: usize, e: bool| match (v, e) {
+        (None, _) => "n/a".to_string(),
+        (Some(v), true) => format!("{v:.prec$e}"),
+        (Some(v), false) => format!("{v:.prec$}"),
+    };
+    for r in &report.rows {
+        writeln!(
+            out,
+            "{:<mesh_w$} {:>9} {:>6} {:<backend_w$} {:>9} {:>9.4} {:>7.2} {:>8} {:>9} {:>9}",
+            r.mesh,
+            r.input_faces,
+            r.ratio,
+            r.backend,
+            if r.missed_target {
+                format!("{}*", r.output_faces)
+            } else {
+                r.output_faces.to_string()
+            },
+            r.median_s,
+            r.mtri_per_s,
+            opt(r.peak_mib, 1, false),
+            opt(r.mean_err_rel, 2, true),
+            opt(r.max_err_rel, 2, true),
+        )?;
+    }
+    let devices: Vec<&str> = report.rows.iter().fold(Vec::new(), |mut v, r| {
+        if !v.contains(&r.device.as_str()) {
+            v.push(&r.device);
+        }
+        v
+    });
+    writeln!(
+        out,
+        "\nmedian of {} run(s) of the simplify call; errors are two-sided Metro distances \
+         relative to the input's bounding-box diagonal; peak MiB is heap held above the \
+         baseline during the call (output included; Rust heap only, meshoptimizer's C++ scratch \
+         memory is not counted)",
+        report.repeat
+    )?;
+    if let Some(r) = report.rows.iter().find(|r| r.missed_target) {
+        writeln!(
+            out,
+            "* stopped above its target (e.g. {} {} at {}: {} faces for {}): no collapse was \
+             left that keeps the topology and the constraints (`meshslim simplify` says why); \
+             its errors are those of a larger mesh",
+            r.mesh, r.backend, r.ratio, r.output_faces, r.target_faces
+        )?;
+    }
+    writeln!(
+        out,
+        "device: {} ({} cores)",
+        devices.join(", "),
+        report.machine.cores
+    )
+}
+
+/// Marker shapes and colours (Okabe–Ito, safe for colour-blind readers) by index in
+/// [`BACKENDS`], so that a backend looks the same in every plot.
+const STYLES: [(&str, &str); 8] = [
+    ("circle", "#0072B2"),
+    ("square", "#E69F00"),
+    ("triangle", "#009E73"),
+    ("diamond", "#D55E00"),
+    ("down", "#CC79A7"),
+    ("circle", "#56B4E9"),
+    ("square", "#000000"),
+    ("triangle", "#F0E442"),
+];
+
+fn style(backend: &str) -> (&'static str, &'static str) {
+    let i = BACKENDS
+        .iter()
+        .position(|b| b.name == backend)
+        .unwrap_or(BACKENDS.len());
+    STYLES[i % STYLES.len()]
+}
+
+fn marker(shape: &str, x: f64, y: f64, colour: &str) -> String {
+    let r = 5.5;
+    let paint = format!(r##"fill="{colour}" stroke="#222" stroke-width="0.8""##);
+    match shape {
+        "square" => format!(
+            r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" {paint}/>"##,
+            x - r * 0.9,
+            y - r * 0.9,
+            r * 1.8,
+            r * 1.8
+        ),
+        "triangle" | "down" => {
+            let s = if shape == "down" { -1.0 } else { 1.0 };
+            format!(
+                r##"<polygon points="{:.1},{:.1} {:.1},{:.1} {:.1},{:.1}" {paint}/>"##,
+                x,
+                y - s * r * 1.2,
+                x - r * 1.1,
+                y + s * r * 0.8,
+                x + r * 1.1,
+                y + s * r * 0.8
+            )
+        }
+        "diamond" => format!(
+            r##"<polygon points="{x:.1},{:.1} {:.1},{y:.1} {x:.1},{:.1} {:.1},{y:.1}" {paint}/>"##,
+            y - r * 1.3,
+            x + r * 1.3,
+            y + r * 1.3,
+            x - r * 1.3
+        ),
+        _ => format!(r##"<circle cx="{x:.1}" cy="{y:.1}" r="{r}" {paint}/>"##),
+    }
+}
+
+fn xml(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A decade range covering `values` (positive ones), at least one decade wide.
+fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| *v > 0.0 && v.is_finite())
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if !lo.is_finite() {
+        return (-1.0, 0.0);
+    }
+    let (a, b) = (lo.log10().floor(), hi.log10().ceil());
+    (a, if b > a { b } else { a + 1.0 })
+}
+
+/// A tick label for 10^e times `m`: plain decimals between 0.001 and 10,000, else `1e-5`.
+fn tick_label(m: f64, e: f64) -> String {
+    let v = m * 10f64.powf(e);
+    if (-3.0..=4.0).contains(&e) {
+        let digits = (-e).max(0.0) as usize;
+        format!("{v:.digits$}")
+    } else {
+        format!("{m}e{e}")
+    }
+}
+
+/// Error against time, log-log: one panel per ratio (shared axes, so panels compare), one
+/// marker shape and colour per backend, each backend's markers in one
+/// `<g class="series" data-backend="NAME">` group. Rows without an error are left out.
+pub fn plot_svg(report: &Report) -> String {
+    use std::fmt::Write as _;
+    let mut ratios: Vec<f64> = Vec::new();
+    let mut backends: Vec<&str> = Vec::new();
+    let mut meshes: Vec<&str> = Vec::new();
+    for r in &report.rows {
+        if !ratios.contains(&r.ratio) {
+            ratios.push(r.ratio);
+        }
+        if !backends.contains(&r.backend.as_str()) {
+            backends.push(&r.backend);
+        }
+        if !meshes.contains(&r.mesh.as_str()) {
+            meshes.push(&r.mesh);
+        }
+    }
+    let points: Vec<&Row> = report
+        .rows
+        .iter()
+        .filter(|r| r.mean_err_rel.is_some_and(|e| e > 0.0) && r.median_s > 0.0)
+        .collect();
+    let (x0, x1) = log_range(points.iter().map(|r| r.median_s));
+    let (y0, y1) = log_range(points.iter().filter_map(|r| r.mean_err_rel));
+
+    let (pw, ph) = (400.0, 330.0); // one panel, plot area and its margins
+    let (ml, mr, mt, mb) = (78.0, 18.0, 76.0, 52.0);
+    let legend_w = 190.0;
+    let n = ratios.len().max(1) as f64;
+    let width = n * (ml + pw + mr) + legend_w;
+    let height = mt + ph + mb;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}" font-family="DejaVu Sans, Helvetica, Arial, sans-serif" font-size="12">"##
+    );
+    let _ = writeln!(
+        s,
+        r##"<rect width="{width}" height="{height}" fill="white"/>"##
+    );
+    let _ = writeln!(
+        s,
+        r##"<text x="12" y="24" font-size="16" font-weight="bold">Mean two-sided error against simplify time (log-log; lower left is better)</text>"##
+    );
+    let _ = writeln!(
+        s,
+        r##"<text x="12" y="44" fill="#444">{} · {} · {} cores · median of {} run(s)</text>"##,
+        xml(&meshes.join(", ")),
+        xml(&report.machine.cpu),
+        report.machine.cores,
+        report.repeat
+    );
+    let px = |panel: usize, t: f64| {
+        panel as f64 * (ml + pw + mr) + ml + (t.log10() - x0) / (x1 - x0) * pw
+    };
+    let py = |e: f64| mt + ph - (e.log10() - y0) / (y1 - y0) * ph;
+    let many = |lo: f64, hi: f64| hi - lo <= 2.0;
+    for (i, &ratio) in ratios.iter().enumerate() {
+        let left = i as f64 * (ml + pw + mr) + ml;
+        let faces: Vec<usize> = report
+            .rows
+            .iter()
+            .filter(|r| r.ratio == ratio)
+            .map(|r| r.target_faces)
+            .fold(Vec::new(), |mut v, f| {
+                if !v.contains(&f) {
+                    v.push(f);
+                }
+                v
+            });
+        let title = if faces.len() == 1 {
+            format!("ratio {ratio} (target {} faces)", faces[0])
+        } else {
+            format!("ratio {ratio}")
+        };
+        let _ = writeln!(
+            s,
+            r##"<text x="{:.1}" y="{:.1}" text-anchor="middle" font-size="14" font-weight="bold">{}</text>"##,
+            left + pw / 2.0,
+            mt - 10.0,
+            xml(&title)
+        );
+        // Grid: every decade labelled; minor lines at 2..9, labelled at 2 and 5 when the axis
+        // spans few decades, so that a narrow range still has numbers to read.
+        for (lo, hi, vertical) in [(x0, x1, true), (y0, y1, false)] {
+            let mut e = lo;
+            while e <= hi {
+                for m in 1..10 {
+                    let v = m as f64 * 10f64.powf(e);
+                    if v.log10() > hi + 1e-9 {
+                        break;
+                    }
+                    let major = m == 1;
+                    let labelled = major || (many(lo, hi) && (m == 2 || m == 5));
+                    let colour = if major { "#bbb" } else { "#e6e6e6" };
+                    let label = tick_label(m as f64, e);
+                    if vertical {
+                        let x = px(i, v);
+                        let _ = writeln!(
+                            s,
+                            r##"<line x1="{x:.1}" y1="{mt}" x2="{x:.1}" y2="{:.1}" stroke="{colour}"/>"##,
+                            mt + ph
+                        );
+                        if labelled {
+                            let _ = writeln!(
+                                s,
+                                r##"<text x="{x:.1}" y="{:.1}" text-anchor="middle" fill="#333">{label}</text>"##,
+                                mt + ph + 16.0
+                            );
+                        }
+                    } else {
+                        let y = py(v);
+                        let _ = writeln!(
+                            s,
+                            r##"<line x1="{left:.1}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="{colour}"/>"##,
+                            left + pw
+                        );
+                        if labelled {
+                            let _ = writeln!(
+                                s,
+                                r##"<text x="{:.1}" y="{:.1}" text-anchor="end" fill="#333">{label}</text>"##,
+                                left - 6.0,
+                                y + 4.0
+                            );
+                        }
+                    }
+                }
+                e += 1.0;
+            }
+        }
+        let _ = writeln!(
+            s,
+            r##"<rect x="{left:.1}" y="{mt}" width="{pw}" height="{ph}" fill="none" stroke="#333"/>"##
+        );
+        let _ = writeln!(
+            s,
+            r##"<text x="{:.1}" y="{:.1}" text-anchor="middle">median simplify time (s)</text>"##,
+            left + pw / 2.0,
+            mt + ph + 38.0
+        );
+        let (lx, ly) = (left - 58.0, mt + ph / 2.0);
+        let _ = writeln!(
+            s,
+            r##"<text x="{lx:.1}" y="{ly:.1}" text-anchor="middle" transform="rotate(-90 {lx:.1} {ly:.1})">mean two-sided error / bbox diagonal</text>"##
+        );
+    }
+    for backend in &backends {
+        let (shape, colour) = style(backend);
+        let _ = writeln!(s, r##"<g class="series" data-backend="{}">"##, xml(backend));
+        for r in points.iter().filter(|r| r.backend == *backend) {
+            let panel = ratios.iter().position(|&q| q == r.ratio).unwrap_or(0);
+            let (x, y) = (px(panel, r.median_s), py(r.mean_err_rel.unwrap_or(0.0)));
+            let _ = writeln!(s, "{}", marker(shape, x, y, colour));
+            if meshes.len() > 1 {
+                let _ = writeln!(
+                    s,
+                    r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#555">{}</text>"##,
+                    x + 8.0,
+                    y - 6.0,
+                    xml(&r.mesh)
+                );
+            }
+        }
+        let _ = writeln!(s, "</g>");
+    }
+    let lx = n * (ml + pw + mr) + 10.0;
+    let _ = writeln!(
+        s,
+        r##"<text x="{lx:.1}" y="{:.1}" font-weight="bold">backend</text>"##,
+        mt + 4.0
+    );
+    for (k, backend) in backends.iter().enumerate() {
+        let (shape, colour) = style(backend);
+        let y = mt + 26.0 + 24.0 * k as f64;
+        let _ = writeln!(s, "{}", marker(shape, lx + 8.0, y, colour));
+        let _ = writeln!(
+            s,
+            r##"<text x="{:.1}" y="{:.1}">{}</text>"##,
+            lx + 22.0,
+            y + 4.0,
+            xml(backend)
+        );
+    }
+    let _ = writeln!(s, "</svg>");
+    s
+}
+
+/// Renders an SVG (the plot) to PNG bytes with resvg, text in the system's fonts.
+pub fn svg_to_png(svg: &str) -> Result<Vec<u8>, String> {
+    use resvg::{tiny_skia, usvg};
+    let mut opt = usvg::Options::default();
+    opt.fontdb_mut().load_system_fonts();
+    let tree = usvg::Tree::from_str(svg, &opt).map_err(|e| e.to_string())?;
+    let size = tree.size().to_int_size();
+    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height())
+        .ok_or_else(|| format!("cannot allocate a {}x{} image", size.width(), size.height()))?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    resvg::render(&tree, tiny_skia::Transform::default(), &mut pixmap.as_mut());
+    pixmap.encode_png().map_err(|e| e.to_string())
+}

@@ -1,0 +1,117 @@
+//! Argument types and value parsers shared by the commands: the input (a file or a generated
+//! mesh), numbers, ratios, angles and image sizes.
+
+use std::path::PathBuf;
+
+use super::builtins::{BUILTIN_PREFIX, BuiltinMesh, parse_builtin};
+
+/// A mesh to read: a file, or a generated mesh `builtin:NAME[:FACES]`.
+#[derive(Debug, Clone)]
+pub enum Input {
+    File(PathBuf),
+    /// The spec as written (`builtin:torus:5000`) and what it names.
+    Builtin {
+        spec: String,
+        kind: &'static BuiltinMesh,
+        min_faces: Option<usize>,
+    },
+}
+
+impl Input {
+    /// How the user named it, for messages and the JSON report.
+    pub fn display(&self) -> String {
+        match self {
+            Input::File(p) => p.display().to_string(),
+            Input::Builtin { spec, .. } => spec.clone(),
+        }
+    }
+}
+
+impl std::str::FromStr for Input {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s.strip_prefix(BUILTIN_PREFIX) {
+            Some(rest) => {
+                let (kind, min_faces) = parse_builtin(rest)?;
+                Ok(Input::Builtin {
+                    spec: s.to_string(),
+                    kind,
+                    min_faces,
+                })
+            }
+            None if s.is_empty() => Err("the input path is empty".into()),
+            None => Ok(Input::File(PathBuf::from(s))),
+        }
+    }
+}
+
+pub(super) fn parse_input_arg(s: &str) -> std::result::Result<Input, String> {
+    s.parse()
+}
+
+pub(super) fn parse_f64(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{s:?} is not a finite number"))
+    }
+}
+
+pub(super) fn parse_face_count(s: &str) -> std::result::Result<usize, String> {
+    s.trim()
+        .parse::<usize>()
+        .map_err(|_| format!("{s:?}: the face count is a whole number, 0 or more"))
+}
+
+pub(super) fn parse_ratio(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v > 0.0 && v <= 1.0 {
+        Ok(v)
+    } else {
+        Err(format!(
+            "the ratio must be in (0, 1], got {v} (use --faces N for a face count)"
+        ))
+    }
+}
+
+pub(super) fn parse_non_negative(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be >= 0, got {v}"))
+    }
+}
+
+pub(super) fn parse_angle(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v > 0.0 && v <= 180.0 {
+        Ok(v)
+    } else {
+        Err(format!("the angle must be in (0, 180] degrees, got {v}"))
+    }
+}
+
+pub(super) fn parse_unit(s: &str) -> std::result::Result<f64, String> {
+    let v = parse_f64(s)?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("must be in [0, 1], got {v}"))
+    }
+}
+
+pub(super) fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let bad = || format!("{s:?}: write the size as WIDTHxHEIGHT, e.g. 1024x768");
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let (w, h) = (w.trim().parse::<u32>(), h.trim().parse::<u32>());
+    match (w, h) {
+        (Ok(w), Ok(h)) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => Ok((w, h)),
+        (Ok(w), Ok(h)) => Err(format!("{w}x{h}: each side must be 1 to 16384 pixels")),
+        _ => Err(bad()),
+    }
+}

@@ -1,0 +1,291 @@
+//! `meshslim simplify`: its arguments, help, and the runner that reads, simplifies (choosing the
+//! backend for `auto`) and writes.
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+
+use super::args::{
+    Input, parse_angle, parse_face_count, parse_input_arg, parse_non_negative, parse_ratio,
+    parse_unit,
+};
+use super::error::{UsageError, lib};
+use super::files::{check_output, load};
+use super::report::{Progress, Times, simplify_json, write_summary};
+use crate::{Backend, SimplifyOptions};
+
+pub(super) const SIMPLIFY_AFTER_HELP: &str = "\
+Built-in meshes (IN = builtin:NAME or builtin:NAME:FACES, FACES a minimum face count):
+  sphere        icosphere, 20480 faces
+  uv-sphere     latitude-longitude sphere with poles, 16128 faces
+  torus         torus, 16384 faces
+  double-torus  genus-2 slab with two square holes, sharp edges, 22528 faces
+  cube          cube with flat faces and sharp edges, 19200 faces
+  grid          flat open square grid with a border, 20000 faces
+  noisy-sphere  icosphere with 1% radial noise, 20480 faces
+  bumpy-sphere  smooth bumpy sphere with fine noise, a stand-in for a scan, 327680 faces
+
+Examples:
+  # 10% of a generated 330k-face scan stand-in
+  meshslim simplify builtin:bumpy-sphere bumpy-10.ply --ratio 0.1
+  # a real file to 5000 faces, with the collapse statistics
+  meshslim simplify scan.ply scan-5k.obj --faces 5000 --stats
+  # on the GPU when there is one (else the same rounds on the CPU's cores), with the
+  # rounds and per-stage times
+  meshslim simplify scan.ply scan-1.ply --ratio 0.01 --backend auto --stats
+  # keep the outline of an open mesh exactly
+  meshslim simplify terrain.obj terrain-small.obj --ratio 0.05 --lock-border
+  # simplify as far as an error of 0.1% of the bounding-box diagonal allows
+  meshslim simplify scan.ply scan-err.ply --faces 0 --max-error 0.001
+  # machine-readable report
+  meshslim simplify builtin:torus torus-half.glb --ratio 0.5 --json";
+
+#[derive(Debug, Args)]
+pub struct SimplifyArgs {
+    /// Input mesh: a .obj, .ply, .stl, .gltf or .glb file, or a generated mesh written
+    /// builtin:NAME or builtin:NAME:FACES (names below)
+    #[arg(value_name = "IN", value_parser = parse_input_arg)]
+    pub input: Option<Input>,
+
+    /// Output file; the format follows its extension (.obj, .ply, .stl, .gltf, .glb). Written
+    /// atomically, and never over the input
+    #[arg(value_name = "OUT")]
+    pub output: Option<PathBuf>,
+
+    /// Keep this fraction of the faces, in (0, 1] [default: 0.1 unless --faces is given]
+    #[arg(short, long, value_name = "R", value_parser = parse_ratio, allow_negative_numbers = true, conflicts_with = "faces")]
+    pub ratio: Option<f64>,
+
+    /// Keep this many faces (reached exactly or one below: an interior collapse removes two).
+    /// 0 simplifies until --max-error or the constraints stop it
+    #[arg(short, long, value_name = "N", value_parser = parse_face_count, allow_negative_numbers = true)]
+    pub faces: Option<usize>,
+
+    /// Stop before a collapse whose error exceeds E, relative to the bounding-box diagonal
+    /// (0.001 = 0.1% of the diagonal), even if the face target is not reached [default: no limit]
+    #[arg(short = 'e', long, value_name = "E", value_parser = parse_non_negative, allow_negative_numbers = true)]
+    pub max_error: Option<f64>,
+
+    /// Keep the border (the outline of an open mesh) exactly: border vertices never move, and one
+    /// is removed only where it lies on the straight line between its border neighbours
+    #[arg(long)]
+    pub lock_border: bool,
+
+    /// Weight of the border and attribute-seam constraint planes relative to the face planes
+    /// (Hoppe's boundary quadrics); larger keeps open borders and seams closer to where they were
+    #[arg(long, value_name = "W", default_value_t = 1.0, value_parser = parse_non_negative, allow_negative_numbers = true)]
+    pub border_weight: f64,
+
+    /// Refuse a collapse that turns any surrounding face's normal by more than DEG degrees,
+    /// in (0, 180]
+    #[arg(long = "max-normal-angle", value_name = "DEG", default_value_t = 90.0, value_parser = parse_angle, allow_negative_numbers = true)]
+    pub max_normal_angle: f64,
+
+    /// Collapses creating faces of quality below Q cost proportionally more (MeshLab's
+    /// QualityThr; quality is 0.866 for an equilateral triangle, 0 for a sliver), in [0, 1].
+    /// 0 turns the term off, giving textbook QEM order
+    #[arg(long, value_name = "Q", default_value_t = 0.3, value_parser = parse_unit, allow_negative_numbers = true)]
+    pub quality_threshold: f64,
+
+    /// Which implementation simplifies
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    pub backend: BackendArg,
+
+    /// Print exactly one JSON object with the report on stdout, and nothing else there
+    #[arg(long)]
+    pub json: bool,
+
+    /// Also print the collapse statistics: collapses, pinned vertices, dropped degenerate faces,
+    /// largest collapse error (the JSON report always has them)
+    #[arg(long)]
+    pub stats: bool,
+
+    /// Print nothing but errors (and the JSON report with --json); no progress bars
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// The `--backend` choices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BackendArg {
+    /// Greedy quadric edge collapse with a priority queue, in f64: the quality reference
+    Cpu,
+    /// The GPU's rounds of parallel collapses, on the CPU's cores (rayon)
+    CpuParallel,
+    /// Rounds of parallel collapses as WGSL compute passes (wgpu: Vulkan, Metal, DX12)
+    Gpu,
+    /// gpu when a GPU adapter is found, else cpu-parallel (says which on stderr); a software
+    /// rasterizer (llvmpipe, WARP) counts as none, being slower than the CPU's cores; falls back
+    /// to cpu-parallel when the GPU fails (a lost device, a mesh too big for it)
+    Auto,
+}
+
+impl BackendArg {
+    /// The library backend, `None` for `auto` (decided when the mesh is there).
+    fn fixed(self) -> Option<Backend> {
+        match self {
+            BackendArg::Cpu => Some(Backend::Cpu),
+            BackendArg::CpuParallel => Some(Backend::CpuParallel),
+            BackendArg::Gpu => Some(Backend::Gpu),
+            BackendArg::Auto => None,
+        }
+    }
+}
+
+/// What a user who typed `meshslim` or `meshslim simplify` alone needs to get going.
+pub const GETTING_STARTED: &str = "\
+meshslim simplifies triangle meshes.
+
+Try it on a generated mesh (a bumpy 330k-face sphere standing in for a scan):
+  meshslim simplify builtin:bumpy-sphere bumpy-10.ply --ratio 0.1
+
+On your own file, down to 5000 faces (.obj, .ply, .stl, .gltf and .glb are read and written):
+  meshslim simplify scan.ply scan-5k.obj --faces 5000
+
+Look at a mesh (faces, borders, manifoldness, genus, area, volume):
+  meshslim info scan.ply
+
+Learn more:
+  meshslim simplify --help
+  meshslim --help";
+
+enum Target {
+    Ratio(f64),
+    Faces(usize),
+}
+
+pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
+    let Some(input) = args.input else {
+        eprintln!("{GETTING_STARTED}");
+        return Ok(ExitCode::from(2));
+    };
+    let Some(output) = args.output else {
+        return Err(UsageError(format!(
+            "no output file: write it after the input, as in\n  meshslim simplify {} OUT.ply \
+             [OPTIONS]\n\nFor more information, try 'meshslim simplify --help'.",
+            input.display()
+        ))
+        .into());
+    };
+    check_output(&input, &output)?;
+
+    let target = match (args.ratio, args.faces) {
+        (_, Some(n)) => Target::Faces(n),
+        (Some(r), None) => Target::Ratio(r),
+        (None, None) => Target::Ratio(0.1),
+    };
+    let progress = Progress::new(!(args.quiet || args.json) && std::io::stderr().is_terminal());
+
+    let t = Instant::now();
+    let mesh = load(&input, &progress)?;
+    let load_s = t.elapsed().as_secs_f64();
+
+    let mut opts = match target {
+        Target::Ratio(r) => SimplifyOptions::with_ratio(mesh.face_count(), r).map_err(lib)?,
+        Target::Faces(n) => SimplifyOptions::with_faces(n),
+    };
+    opts.max_error = args.max_error;
+    opts.lock_border = args.lock_border;
+    opts.border_weight = args.border_weight;
+    opts.max_normal_angle_deg = args.max_normal_angle;
+    opts.quality_threshold = args.quality_threshold;
+    let say = |msg: String| {
+        if !args.quiet {
+            eprintln!("{msg}");
+        }
+    };
+    opts.backend = match args.backend.fixed() {
+        Some(b) => b,
+        // The process's shared device: the adapter found here is the one that simplifies.
+        None => match crate::gpu::shared_context() {
+            Ok(ctx) if ctx.software => {
+                say(format!(
+                    "backend auto: cpu-parallel (the only GPU adapter, {}, is a software \
+                     rasterizer, slower than the CPU's cores; --backend gpu runs on it anyway)",
+                    ctx.adapter_name
+                ));
+                Backend::CpuParallel
+            }
+            Ok(_) => match crate::gpu::shared() {
+                Ok((ctx, _)) => {
+                    say(format!("backend auto: gpu on {}", ctx.adapter_name));
+                    Backend::Gpu
+                }
+                Err(e) => {
+                    say(format!("backend auto: cpu-parallel ({e})"));
+                    Backend::CpuParallel
+                }
+            },
+            Err(e) => {
+                say(format!("backend auto: cpu-parallel ({e})"));
+                Backend::CpuParallel
+            }
+        },
+    };
+
+    let t = Instant::now();
+    let mut result = progress.bar("simplifying", |set| {
+        crate::simplify_with_progress(&mesh, &opts, &mut |f| set(f))
+    });
+    if args.backend == BackendArg::Auto
+        && opts.backend == Backend::Gpu
+        && matches!(
+            result,
+            Err(crate::Error::Gpu(_) | crate::Error::BufferTooLarge { .. })
+        )
+    {
+        if let Err(e) = &result {
+            say(format!(
+                "backend auto: the GPU failed ({e}); falling back to cpu-parallel"
+            ));
+        }
+        opts.backend = Backend::CpuParallel;
+        result = progress.bar("simplifying", |set| {
+            crate::simplify_with_progress(&mesh, &opts, &mut |f| set(f))
+        });
+    }
+    let (simplified, report) = result
+        .map_err(lib)
+        .with_context(|| format!("cannot simplify {}", input.display()))?;
+    let simplify_s = t.elapsed().as_secs_f64();
+    drop(mesh);
+
+    if let Ok(format) = crate::io::Format::from_path(&output) {
+        for lost in crate::io::not_kept(&simplified, format) {
+            say(format!(
+                "note: {} ({}) does not keep {lost}",
+                output.display(),
+                format.extension()
+            ));
+        }
+    }
+    let t = Instant::now();
+    progress
+        .spinner(format!("writing {}", output.display()), || match &input {
+            Input::File(from) => crate::io::write_from(&output, &simplified, from),
+            Input::Builtin { .. } => crate::io::write(&output, &simplified),
+        })
+        .map_err(lib)
+        .context("cannot write the output")?;
+    let save_s = t.elapsed().as_secs_f64();
+
+    let times = Times {
+        load: load_s,
+        simplify: simplify_s,
+        save: save_s,
+    };
+    let out = std::io::stdout();
+    let mut out = out.lock();
+    if args.json {
+        let json = simplify_json(&input, &output, &report, &times);
+        writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
+    } else if !args.quiet {
+        write_summary(&mut out, &input, &output, &report, &times, args.stats)?;
+    }
+    out.flush()?;
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,164 @@
+//! `meshslim view`: the interactive window, or one frame to a PNG with `--screenshot`.
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::Args;
+
+use super::args::{Input, parse_input_arg, parse_ratio, parse_size};
+use super::error::{UsageError, lib};
+use super::files::{check_directory, load};
+use super::report::Progress;
+
+pub(super) const VIEW_AFTER_HELP: &str = "\
+In the window: left drag orbits, right or middle drag pans, the wheel zooms, G flies (W A S D),
+F frames the mesh, 1-4 switch shaded / normals / heatmap / texture, X wireframe, B side by side,
+Enter simplifies to the target, Esc cancels, Ctrl+O opens, Ctrl+S saves, P takes a screenshot;
+F1 lists them all. Simplification runs beside the drawing: the window keeps drawing (frame time
+in the side panel) and the run can be cancelled.
+
+Examples:
+  meshslim view ../shared/models/horse.ply
+  meshslim view ../shared/models/spot/spot_triangulated.obj --mode texture --screenshot spot.png
+  meshslim view ../shared/models/horse.ply --screenshot horse.png --ratio 0.1
+  meshslim view scan.ply --screenshot err.png --ratio 0.01 --mode heatmap --size 1600x1200";
+
+#[derive(Debug, Args)]
+pub struct ViewArgs {
+    /// The mesh: a file or builtin:NAME[:FACES]; without one the window opens empty (Ctrl+O or
+    /// drop a file on it)
+    #[arg(value_name = "MESH", value_parser = parse_input_arg)]
+    pub input: Option<Input>,
+
+    /// Render one frame to this PNG file and exit, without a window
+    #[arg(long, value_name = "FILE.png")]
+    pub screenshot: Option<PathBuf>,
+
+    /// A PNG or JPEG texture for the texture mode (default: the OBJ material's map_Kd, else the
+    /// only PNG or JPEG beside a mesh that has UVs)
+    #[arg(long, value_name = "FILE.png|jpg")]
+    pub texture: Option<PathBuf>,
+
+    /// With --screenshot: simplify to this fraction of the faces on the GPU first, in (0, 1]
+    /// (default 1: the mesh as is). In the window: the starting target (default 0.1)
+    #[arg(long, value_name = "R", value_parser = parse_ratio, allow_negative_numbers = true)]
+    pub ratio: Option<f64>,
+
+    /// What the surface shows
+    #[arg(long, value_enum, default_value_t = crate::viewer::Mode::Shaded)]
+    pub mode: crate::viewer::Mode,
+
+    /// Smooth shading (per-vertex normals) instead of flat faces
+    #[arg(long)]
+    pub smooth: bool,
+
+    /// Draw the edges over the surface
+    #[arg(long)]
+    pub wireframe: bool,
+
+    /// Image size for --screenshot (default 1024x768), or the window's size (default 1280x800),
+    /// WIDTHxHEIGHT
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+
+    /// The mesh's axis drawn up: x, y, z, -x, -y, -z, or auto (the largest silhouette).
+    /// Default: the file's convention, +Y (OBJ, PLY, glTF, generated meshes) or +Z (STL)
+    #[arg(long, value_enum, value_name = "AXIS", allow_hyphen_values = true)]
+    pub up: Option<crate::viewer::camera::Up>,
+}
+
+pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
+    let progress = Progress::new(std::io::stderr().is_terminal());
+    let style = crate::viewer::Style {
+        mode: args.mode,
+        smooth: args.smooth,
+        wireframe: args.wireframe,
+        error_scale: 0.0,
+    };
+    let model = |input: &Input| -> Result<crate::viewer::Model> {
+        match input {
+            Input::File(path) => progress
+                .spinner(format!("reading {}", path.display()), || {
+                    crate::viewer::Model::open(path, args.texture.as_deref())
+                })
+                .map(|mut m| {
+                    m.up_axis = args.up.unwrap_or(m.up_axis);
+                    m
+                })
+                .map_err(lib)
+                .context("cannot read the input"),
+            Input::Builtin { .. } => {
+                let mesh = load(input, &progress)?;
+                let mut m = crate::viewer::Model::from_mesh(input.display(), mesh).map_err(lib)?;
+                m.up_axis = args.up.unwrap_or(m.up_axis);
+                if let Some(t) = &args.texture {
+                    m.texture = Some(crate::viewer::scene::read_texture(t).map_err(lib)?);
+                }
+                Ok(m)
+            }
+        }
+    };
+    let Some(png) = args.screenshot.clone() else {
+        // A file that cannot be opened fails here, not in a window that opens to say so.
+        if let Some(Input::File(p)) = &args.input {
+            std::fs::File::open(p)
+                .map_err(|e| {
+                    lib(crate::Error::Io {
+                        path: p.clone(),
+                        source: e,
+                    })
+                })
+                .context("cannot read the input")?;
+        }
+        let start = match &args.input {
+            Some(Input::File(p)) if args.texture.is_none() => crate::viewer::Start::Open(p.clone()),
+            Some(input) => crate::viewer::Start::Model(model(input)?),
+            None => crate::viewer::Start::Nothing,
+        };
+        let size = args.size.unwrap_or((1280, 800));
+        crate::viewer::run_window(start, args.ratio.unwrap_or(0.1), style, size, args.up)
+            .map_err(lib)?;
+        return Ok(ExitCode::SUCCESS);
+    };
+    let Some(input) = &args.input else {
+        return Err(UsageError("--screenshot needs a MESH to draw".into()).into());
+    };
+    if !png
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+    {
+        return Err(UsageError(format!(
+            "{}: the screenshot is a PNG; name it FILE.png",
+            png.display()
+        ))
+        .into());
+    }
+    // Before any reading or rendering: a screenshot with nowhere to go fails at once.
+    check_directory(&png, "the screenshot's directory")?;
+    let model = model(input)?;
+    let size = args.size.unwrap_or((1024, 768));
+    let frame = progress
+        .spinner("simplifying and rendering on the GPU".to_string(), || {
+            crate::viewer::screenshot(&model, args.ratio.unwrap_or(1.0), style, size)
+        })
+        .map_err(lib)?;
+    crate::io::write_atomic(&png, |w| w.write_all(&frame.png))
+        .map_err(lib)
+        .context("cannot write the screenshot")?;
+    let heat = if args.mode == crate::viewer::Mode::Heatmap {
+        format!(", heatmap red at {:.3e} of the diagonal", frame.max_error)
+    } else {
+        String::new()
+    };
+    println!(
+        "{}: {} faces drawn from the GPU buffers on {}, {}x{}{heat}",
+        png.display(),
+        frame.faces,
+        frame.adapter,
+        size.0,
+        size.1
+    );
+    Ok(ExitCode::SUCCESS)
+}

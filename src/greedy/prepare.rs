@@ -1,0 +1,457 @@
+//! The set-up every run starts from: the mesh welded, its positions grouped into topological
+//! vertices in Morton order, normalized, with per-vertex quadrics (faces, borders, seams) and
+//! how each vertex may move.
+
+use super::vec::{cross, dot, norm, sub};
+use crate::mesh::{Mesh, weld, weld::position_classes};
+use crate::quadric::Quadric;
+use crate::simplify::SimplifyOptions;
+use rayon::prelude::*;
+
+/// How a vertex may take part in collapses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Mobility {
+    /// May move and may be removed.
+    Free,
+    /// Keeps its position; may survive a collapse, never be removed: attribute seams and
+    /// non-manifold spots.
+    Pinned,
+    /// A border vertex under `lock_border`: keeps its position, and may be removed only by sliding
+    /// along a straight stretch of border onto a border neighbour.
+    LockedBorder,
+    /// On an attribute seam (a UV, normal or colour discontinuity): keeps its position, and may be
+    /// removed only by sliding along the seam onto a seam neighbour, each side of the seam
+    /// taking that neighbour's attributes on its side. Seams thin out without tearing.
+    Seam,
+}
+
+/// The prepared surface: welded topology, normalized positions, per-vertex quadrics and flags.
+/// Shared by the greedy backend and (later) the parallel ones, which start from the same state.
+pub(crate) struct Prepared {
+    /// Mesh after exact welding; its vertices are the "attribute vertices" written out.
+    pub mesh: Mesh,
+    /// Attribute vertex → topological vertex (position class).
+    pub topo: Vec<u32>,
+    /// Per topological vertex: one attribute vertex (the only one unless the vertex is a seam).
+    pub first_attr: Vec<u32>,
+    /// Faces with three distinct topological vertices, as attribute-vertex ids.
+    pub faces: Vec<[u32; 3]>,
+    /// Index of each kept face in `mesh.triangles` (for materials and groups).
+    pub face_origin: Vec<u32>,
+    /// Unit normal of each face as it was in the input (zero for a face without area). A face
+    /// keeps its identity through collapses, so checking new normals against it bounds the
+    /// drift that many small turns could add up to.
+    pub ref_normal: Vec<[f32; 3]>,
+    /// Normalized positions per topological vertex: centred on the bounding box, divided by its
+    /// diagonal, so errors are relative to the diagonal and f32 GPU twins keep precision.
+    pub pos: Vec<[f64; 3]>,
+    pub quadrics: Vec<Quadric>,
+    pub mobility: Vec<Mobility>,
+    pub border: Vec<bool>,
+    /// More than one attribute vertex at this position.
+    pub seam: Vec<bool>,
+    pub center: [f64; 3],
+    pub scale: f64,
+    pub dropped_degenerate: usize,
+}
+
+impl Prepared {
+    pub fn new(input: &Mesh, opts: &SimplifyOptions) -> Prepared {
+        let mesh = weld(input).mesh;
+        // Without attributes `weld` merged by position already: every position is its own class,
+        // and hashing them all again cost 0.03 s of 0.4 s here on the 1M scan.
+        let (topo, firsts) =
+            if input.normals.is_none() && input.uvs.is_none() && input.colors.is_none() {
+                let id: Vec<u32> = (0..mesh.positions.len() as u32).collect();
+                (id.clone(), id)
+            } else {
+                position_classes(&mesh.positions)
+            };
+        let (topo, firsts) = spatial_order(&mesh.positions, topo, firsts);
+        let nt = firsts.len();
+        let mut faces = Vec::with_capacity(mesh.triangles.len());
+        let mut face_origin = Vec::with_capacity(mesh.triangles.len());
+        for (f, t) in mesh.triangles.iter().enumerate() {
+            let [a, b, c] = t.map(|v| topo[v as usize]);
+            if a != b && b != c && a != c {
+                faces.push(*t);
+                face_origin.push(f as u32);
+            }
+        }
+        let dropped_degenerate = mesh.triangles.len() - faces.len();
+        // Attribute vertices per position, counting only those the kept faces use: an unused
+        // vertex with other attributes at the same point must not make a seam.
+        let mut used = vec![false; mesh.positions.len()];
+        for f in &faces {
+            for &v in f {
+                used[v as usize] = true;
+            }
+        }
+        let mut attr_count = vec![0u32; nt];
+        let mut firsts = firsts;
+        for (v, &t) in topo.iter().enumerate() {
+            attr_count[t as usize] += used[v] as u32;
+            // A position's representative attribute vertex must be one the faces use: a
+            // collapse maps the removed vertex's corners from it.
+            if used[v] && !used[firsts[t as usize] as usize] {
+                firsts[t as usize] = v as u32;
+            }
+        }
+        // Faces in the order of their first vertex, so a vertex's faces sit close in memory; a
+        // counting sort, stable, so faces with the same first vertex keep their input order.
+        let (order, _) = counting_sort(nt, faces.len(), |f| {
+            faces[f]
+                .map(|v| topo[v as usize])
+                .into_iter()
+                .min()
+                .unwrap_or(0)
+        });
+        let faces: Vec<[u32; 3]> = order.par_iter().map(|&f| faces[f as usize]).collect();
+        let face_origin: Vec<u32> = order.par_iter().map(|&f| face_origin[f as usize]).collect();
+
+        let (center, scale) = match mesh.bounds() {
+            Some(b) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
+            Some(b) => (b.center(), 1.0),
+            None => ([0.0; 3], 1.0),
+        };
+        let pos: Vec<[f64; 3]> = firsts
+            .par_iter()
+            .map(|&v| {
+                let p = mesh.positions[v as usize];
+                // Keep in step with `Prepared::normalize`.
+                [0, 1, 2].map(|i| (p[i] as f64 - center[i]) * scale)
+            })
+            .collect();
+
+        let tf = |f: &[u32; 3]| f.map(|v| topo[v as usize]);
+        // The faces around each vertex, in face order.
+        let (corners, corner_start) =
+            counting_sort(nt, faces.len() * 3, |c| topo[faces[c / 3][c % 3] as usize]);
+        let faces_of = |v: usize| {
+            corners[corner_start[v] as usize..corner_start[v + 1] as usize]
+                .iter()
+                .map(|&c| c / 3)
+        };
+        // A face's unit normal and its plane quadric (area-weighted).
+        let plane = |f: usize| {
+            let [p0, p1, p2] = tf(&faces[f]).map(|v| pos[v as usize]);
+            let c = cross(sub(p1, p0), sub(p2, p0));
+            let len = norm(c);
+            (len > 0.0).then(|| {
+                let n = c.map(|x| x / len);
+                (n, Quadric::from_plane(n, -dot(n, p0), 0.5 * len))
+            })
+        };
+        let ref_normal: Vec<[f32; 3]> = (0..faces.len())
+            .into_par_iter()
+            .map(|f| plane(f).map_or([0.0; 3], |(n, _)| n.map(|x| x as f32)))
+            .collect();
+        // Per vertex, in parallel: the sum of its faces' plane quadrics in face order, then the
+        // constraint planes of its border and seam edges in ascending order of the other end,
+        // which is the order one pass over all edges sorted by (low, high) end gives each
+        // vertex; so the sums do not depend on the thread count. Each face's plane and each
+        // constraint is computed once per vertex that needs it: cheaper than one 88-byte
+        // quadric per face written out and read back, and, measured on the 1M scan, the
+        // sequential pass over all edges with a union-find over all corners took 0.12 s.
+        // Straight into the three arrays: collecting tuples and copying them out took 0.027 s,
+        // on one core, of the 0.25 s set-up of the 1M scan.
+        let (quadrics, (mobility, border)): (Vec<Quadric>, (Vec<Mobility>, Vec<bool>)) = (0..nt)
+            .into_par_iter()
+            .map_init(
+                || (Vec::new(), Vec::new()),
+                |(edges, fan): &mut (Vec<(u32, u32, u32)>, Vec<u32>), v| {
+                    let mut q = Quadric::default();
+                    for f in faces_of(v) {
+                        if let Some((_, fq)) = plane(f as usize) {
+                            q.add(&fq);
+                        }
+                    }
+                    let mut mobility = if attr_count[v] > 1 {
+                        Mobility::Seam
+                    } else {
+                        Mobility::Free
+                    };
+                    let mut border = false;
+                    // The edges at v with their faces (and each face's place among v's faces),
+                    // in face order within an edge: 1 face for a border, 2 for a manifold edge,
+                    // more for a non-manifold one.
+                    let vt = v as u32;
+                    edges.clear();
+                    for (i, f) in faces_of(v).enumerate() {
+                        let t = tf(&faces[f as usize]);
+                        edges.extend(t.into_iter().filter(|&u| u != vt).map(|u| (u, f, i as u32)));
+                    }
+                    edges.sort_unstable();
+                    // v's faces joined across its manifold edges: the fans around v.
+                    fan.clear();
+                    fan.extend(0..faces_of(v).len() as u32);
+                    let root = |fan: &mut Vec<u32>, mut x: u32| {
+                        while fan[x as usize] != x {
+                            fan[x as usize] = fan[fan[x as usize] as usize];
+                            x = fan[x as usize];
+                        }
+                        x
+                    };
+                    let mut i = 0;
+                    while i < edges.len() {
+                        let mut j = i + 1;
+                        while j < edges.len() && edges[j].0 == edges[i].0 {
+                            j += 1;
+                        }
+                        let u = edges[i].0;
+                        let (a, b) = (vt.min(u), vt.max(u));
+                        let (pa, pb) = (pos[a as usize], pos[b as usize]);
+                        match j - i {
+                            1 => {
+                                border = true;
+                                // Hoppe's boundary constraint: a plane through the edge,
+                                // perpendicular to its face, weighted by the squared edge length
+                                // so it scales like an area.
+                                let t = tf(&faces[edges[i].1 as usize]);
+                                let [p0, p1, p2] = t.map(|v| pos[v as usize]);
+                                let fnrm = cross(sub(p1, p0), sub(p2, p0));
+                                if let Some(c) = edge_constraint(pa, pb, fnrm, opts.border_weight) {
+                                    q.add(&c);
+                                }
+                            }
+                            2 => {
+                                let (f1, f2) = (edges[i].1, edges[i + 1].1);
+                                let (r1, r2) = (root(fan, edges[i].2), root(fan, edges[i + 1].2));
+                                fan[r1.max(r2) as usize] = r1.min(r2);
+                                // A seam edge (the faces disagree on an endpoint's attribute
+                                // vertex) gets a constraint plane like a border, so the seam
+                                // keeps its course.
+                                let attr = |fi: u32, x: u32| {
+                                    let t = tf(&faces[fi as usize]);
+                                    faces[fi as usize][t.iter().position(|&y| y == x).unwrap_or(0)]
+                                };
+                                // Only a seam vertex (more than one attribute vertex) can
+                                // disagree; skipping the four lookups for the others saved 60M
+                                // of 3.8G instructions simplifying builtin:bumpy-sphere to 1%.
+                                let seam_end =
+                                    attr_count[a as usize] > 1 || attr_count[b as usize] > 1;
+                                if seam_end
+                                    && (attr(f1, a) != attr(f2, a) || attr(f1, b) != attr(f2, b))
+                                    && opts.border_weight > 0.0
+                                {
+                                    let normal = |fi: u32| {
+                                        let [p0, p1, p2] =
+                                            tf(&faces[fi as usize]).map(|v| pos[v as usize]);
+                                        let c = cross(sub(p1, p0), sub(p2, p0));
+                                        let l = norm(c);
+                                        if l > 0.0 { c.map(|x| x / l) } else { c }
+                                    };
+                                    let (n1, n2) = (normal(f1), normal(f2));
+                                    let avg = [0, 1, 2].map(|k| n1[k] + n2[k]);
+                                    if let Some(c) =
+                                        edge_constraint(pa, pb, avg, opts.border_weight)
+                                    {
+                                        q.add(&c);
+                                    }
+                                }
+                            }
+                            _ => mobility = Mobility::Pinned,
+                        }
+                        i = j;
+                    }
+                    // A vertex whose faces form more than one fan (a bow-tie) is pinned:
+                    // collapsing around it cannot keep the surface's topology well defined.
+                    if (0..fan.len() as u32).filter(|&x| root(fan, x) == x).count() > 1 {
+                        mobility = Mobility::Pinned;
+                    }
+                    if opts.lock_border && border {
+                        mobility = match mobility {
+                            Mobility::Free => Mobility::LockedBorder,
+                            _ => Mobility::Pinned,
+                        };
+                    }
+                    (q, (mobility, border))
+                },
+            )
+            .unzip();
+        Prepared {
+            mesh,
+            topo,
+            first_attr: firsts,
+            faces,
+            face_origin,
+            ref_normal,
+            pos,
+            quadrics,
+            mobility,
+            border,
+            seam: attr_count.iter().map(|&c| c > 1).collect(),
+            center,
+            scale,
+            dropped_degenerate,
+        }
+    }
+
+    /// The sub-problem made of `faces` (indices into `self.faces`): its own dense topological
+    /// ids in the same (Morton) order, everything else copied, `pin` (per topological vertex of
+    /// the whole) added to the pinned vertices. Attribute vertex ids stay those of the whole
+    /// mesh, and `face_origin` holds each face's index in `self.faces`, so results map straight
+    /// back. The sub-problem's `topo` is left empty: it would have to cover every attribute
+    /// vertex of the whole mesh (measured on the 1M scan, zeroing that for each of 32 regions
+    /// was 68 MB of fresh pages); its faces come as topological faces instead.
+    /// Returns the sub-problem, its topological faces and its local → whole topological vertex
+    /// map.
+    pub(crate) fn subset(
+        &self,
+        faces: &[u32],
+        pin: &[bool],
+    ) -> (Prepared, Vec<[u32; 3]>, Vec<u32>) {
+        // The vertices used, in ascending order, through a table over the span of their ids
+        // (a region is one or two runs of the Morton order): measured on the 1M scan, sorting
+        // the 400k corners of each of 8 regions and binary-searching them took 0.05 s per
+        // region, twice the region's whole queue set-up.
+        let corner_topo = |f: u32| self.faces[f as usize].map(|v| self.topo[v as usize]);
+        let (lo, hi) = faces
+            .iter()
+            .flat_map(|&f| corner_topo(f))
+            .fold((u32::MAX, 0), |(lo, hi), t| (lo.min(t), hi.max(t)));
+        let mut local_of = vec![u32::MAX; (hi + 1).saturating_sub(lo) as usize];
+        for &f in faces {
+            for t in corner_topo(f) {
+                local_of[(t - lo) as usize] = 0;
+            }
+        }
+        let mut topo_global = Vec::new();
+        for (i, l) in local_of.iter_mut().enumerate() {
+            if *l == 0 {
+                *l = topo_global.len() as u32;
+                topo_global.push(lo + i as u32);
+            }
+        }
+        let local = |t: u32| local_of[(t - lo) as usize];
+        let topo_faces: Vec<[u32; 3]> = faces.iter().map(|&f| corner_topo(f).map(local)).collect();
+        let mut first_attr = vec![u32::MAX; topo_global.len()];
+        for (&f, t) in faces.iter().zip(&topo_faces) {
+            for (&v, &lt) in self.faces[f as usize].iter().zip(t) {
+                if first_attr[lt as usize] == u32::MAX
+                    || v == self.first_attr[topo_global[lt as usize] as usize]
+                {
+                    first_attr[lt as usize] = v;
+                }
+            }
+        }
+        let pick = |lt: usize| topo_global[lt] as usize;
+        let n = topo_global.len();
+        let sub = Prepared {
+            mesh: Mesh::default(),
+            topo: Vec::new(),
+            first_attr,
+            faces: faces.iter().map(|&f| self.faces[f as usize]).collect(),
+            face_origin: faces.to_vec(),
+            ref_normal: faces.iter().map(|&f| self.ref_normal[f as usize]).collect(),
+            pos: (0..n).map(|l| self.pos[pick(l)]).collect(),
+            quadrics: (0..n).map(|l| self.quadrics[pick(l)]).collect(),
+            mobility: (0..n)
+                .map(|l| {
+                    if pin[pick(l)] {
+                        Mobility::Pinned
+                    } else {
+                        self.mobility[pick(l)]
+                    }
+                })
+                .collect(),
+            border: (0..n).map(|l| self.border[pick(l)]).collect(),
+            seam: (0..n).map(|l| self.seam[pick(l)]).collect(),
+            center: self.center,
+            scale: self.scale,
+            dropped_degenerate: 0,
+        };
+        (sub, topo_faces, topo_global)
+    }
+
+    /// Into the normalized frame; the same arithmetic as the set-up, so a vertex that never
+    /// moved compares equal.
+    pub fn normalize(&self, p: [f32; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|i| (p[i] as f64 - self.center[i]) * self.scale)
+    }
+
+    pub fn denormalize(&self, p: [f64; 3]) -> [f32; 3] {
+        [0, 1, 2].map(|i| (p[i] / self.scale + self.center[i]) as f32)
+    }
+}
+
+/// Indices `0..n` ordered by `key(i) < buckets`, stable (a counting sort), and where each
+/// bucket starts in that order (`buckets + 1` entries).
+fn counting_sort(
+    buckets: usize,
+    n: usize,
+    key: impl Fn(usize) -> u32 + Sync,
+) -> (Vec<u32>, Vec<u32>) {
+    let keys: Vec<u32> = (0..n).into_par_iter().map(&key).collect();
+    let mut start = vec![0u32; buckets + 1];
+    for &k in &keys {
+        start[k as usize + 1] += 1;
+    }
+    for b in 0..buckets {
+        start[b + 1] += start[b];
+    }
+    let begin = start.clone();
+    let mut out = vec![0u32; n];
+    for (i, &k) in keys.iter().enumerate() {
+        out[start[k as usize] as usize] = i as u32;
+        start[k as usize] += 1;
+    }
+    (out, begin)
+}
+
+/// Hoppe's edge constraint: the plane through edge (pa, pb) perpendicular to the surface
+/// (normal `surface`), weighted by the squared edge length so it scales like a face area.
+fn edge_constraint(pa: [f64; 3], pb: [f64; 3], surface: [f64; 3], weight: f64) -> Option<Quadric> {
+    let e = sub(pb, pa);
+    let n = cross(e, surface);
+    let l = norm(n);
+    (l > 0.0 && weight > 0.0).then(|| {
+        let n = n.map(|x| x / l);
+        Quadric::from_plane(n, -dot(n, pa), weight * dot(e, e))
+    })
+}
+
+/// Renumbers position classes along a Morton (Z-order) curve. The queue visits the mesh in cost
+/// order, effectively at random; with neighbours close in memory, the dozen vertices and faces
+/// one collapse touches share cache lines and pages instead of each being a miss.
+pub(crate) fn spatial_order(
+    positions: &[[f32; 3]],
+    topo: Vec<u32>,
+    firsts: Vec<u32>,
+) -> (Vec<u32>, Vec<u32>) {
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for &v in &firsts {
+        let p = positions[v as usize];
+        lo = [0, 1, 2].map(|i| lo[i].min(p[i]));
+        hi = [0, 1, 2].map(|i| hi[i].max(p[i]));
+    }
+    let spread = (0..3)
+        .map(|i| hi[i] - lo[i])
+        .fold(0.0f32, f32::max)
+        .max(f32::MIN_POSITIVE);
+    // Spread the low 10 bits of x to every third bit.
+    let part = |x: u32| {
+        let mut x = x & 0x3ff;
+        x = (x | (x << 16)) & 0x030000ff;
+        x = (x | (x << 8)) & 0x0300f00f;
+        x = (x | (x << 4)) & 0x030c30c3;
+        (x | (x << 2)) & 0x09249249
+    };
+    let code = |v: u32| {
+        let p = positions[v as usize];
+        let q = |i: usize| (((p[i] - lo[i]) / spread) * 1023.0) as u32;
+        part(q(0)) | (part(q(1)) << 1) | (part(q(2)) << 2)
+    };
+    let mut keyed: Vec<(u32, u32)> = (0..firsts.len() as u32)
+        .into_par_iter()
+        .map(|c| (code(firsts[c as usize]), c))
+        .collect();
+    keyed.par_sort_unstable();
+    let order: Vec<u32> = keyed.into_iter().map(|(_, c)| c).collect();
+    let mut rank = vec![0u32; firsts.len()];
+    for (new, &old) in order.iter().enumerate() {
+        rank[old as usize] = new as u32;
+    }
+    let firsts = order.par_iter().map(|&old| firsts[old as usize]).collect();
+    (topo.par_iter().map(|&t| rank[t as usize]).collect(), firsts)
+}
