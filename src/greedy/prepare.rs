@@ -3,9 +3,10 @@
 //! how each vertex may move.
 
 use super::vec::{cross, dot, norm, sub};
-use crate::mesh::{Mesh, weld, weld::position_classes};
+use crate::mesh::Mesh;
+use crate::mesh::prepare::{Surface, counting_sort, denormalize, normalize};
+use crate::options::SimplifyOptions;
 use crate::quadric::Quadric;
-use crate::simplify::SimplifyOptions;
 use rayon::prelude::*;
 
 /// How a vertex may take part in collapses.
@@ -57,70 +58,22 @@ pub(crate) struct Prepared {
 
 impl Prepared {
     pub fn new(input: &Mesh, opts: &SimplifyOptions) -> Prepared {
-        let mesh = weld(input).mesh;
-        // Without attributes `weld` merged by position already: every position is its own class,
-        // and hashing them all again cost 0.03 s of 0.4 s here on the 1M scan.
-        let (topo, firsts) =
-            if input.normals.is_none() && input.uvs.is_none() && input.colors.is_none() {
-                let id: Vec<u32> = (0..mesh.positions.len() as u32).collect();
-                (id.clone(), id)
-            } else {
-                position_classes(&mesh.positions)
-            };
-        let (topo, firsts) = spatial_order(&mesh.positions, topo, firsts);
+        let surface = Surface::new(input);
+        let Surface {
+            welded: mesh,
+            class: topo,
+            representative: firsts,
+            attr_count,
+            faces,
+            face_origin,
+            dropped_degenerate,
+            center,
+            scale,
+        } = surface;
         let nt = firsts.len();
-        let mut faces = Vec::with_capacity(mesh.triangles.len());
-        let mut face_origin = Vec::with_capacity(mesh.triangles.len());
-        for (f, t) in mesh.triangles.iter().enumerate() {
-            let [a, b, c] = t.map(|v| topo[v as usize]);
-            if a != b && b != c && a != c {
-                faces.push(*t);
-                face_origin.push(f as u32);
-            }
-        }
-        let dropped_degenerate = mesh.triangles.len() - faces.len();
-        // Attribute vertices per position, counting only those the kept faces use: an unused
-        // vertex with other attributes at the same point must not make a seam.
-        let mut used = vec![false; mesh.positions.len()];
-        for f in &faces {
-            for &v in f {
-                used[v as usize] = true;
-            }
-        }
-        let mut attr_count = vec![0u32; nt];
-        let mut firsts = firsts;
-        for (v, &t) in topo.iter().enumerate() {
-            attr_count[t as usize] += used[v] as u32;
-            // A position's representative attribute vertex must be one the faces use: a
-            // collapse maps the removed vertex's corners from it.
-            if used[v] && !used[firsts[t as usize] as usize] {
-                firsts[t as usize] = v as u32;
-            }
-        }
-        // Faces in the order of their first vertex, so a vertex's faces sit close in memory; a
-        // counting sort, stable, so faces with the same first vertex keep their input order.
-        let (order, _) = counting_sort(nt, faces.len(), |f| {
-            faces[f]
-                .map(|v| topo[v as usize])
-                .into_iter()
-                .min()
-                .unwrap_or(0)
-        });
-        let faces: Vec<[u32; 3]> = order.par_iter().map(|&f| faces[f as usize]).collect();
-        let face_origin: Vec<u32> = order.par_iter().map(|&f| face_origin[f as usize]).collect();
-
-        let (center, scale) = match mesh.bounds() {
-            Some(b) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
-            Some(b) => (b.center(), 1.0),
-            None => ([0.0; 3], 1.0),
-        };
         let pos: Vec<[f64; 3]> = firsts
             .par_iter()
-            .map(|&v| {
-                let p = mesh.positions[v as usize];
-                // Keep in step with `Prepared::normalize`.
-                [0, 1, 2].map(|i| (p[i] as f64 - center[i]) * scale)
-            })
+            .map(|&v| normalize(mesh.positions[v as usize], center, scale))
             .collect();
 
         let tf = |f: &[u32; 3]| f.map(|v| topo[v as usize]);
@@ -367,36 +320,12 @@ impl Prepared {
     /// Into the normalized frame; the same arithmetic as the set-up, so a vertex that never
     /// moved compares equal.
     pub fn normalize(&self, p: [f32; 3]) -> [f64; 3] {
-        [0, 1, 2].map(|i| (p[i] as f64 - self.center[i]) * self.scale)
+        normalize(p, self.center, self.scale)
     }
 
     pub fn denormalize(&self, p: [f64; 3]) -> [f32; 3] {
-        [0, 1, 2].map(|i| (p[i] / self.scale + self.center[i]) as f32)
+        denormalize(p, self.center, self.scale)
     }
-}
-
-/// Indices `0..n` ordered by `key(i) < buckets`, stable (a counting sort), and where each
-/// bucket starts in that order (`buckets + 1` entries).
-fn counting_sort(
-    buckets: usize,
-    n: usize,
-    key: impl Fn(usize) -> u32 + Sync,
-) -> (Vec<u32>, Vec<u32>) {
-    let keys: Vec<u32> = (0..n).into_par_iter().map(&key).collect();
-    let mut start = vec![0u32; buckets + 1];
-    for &k in &keys {
-        start[k as usize + 1] += 1;
-    }
-    for b in 0..buckets {
-        start[b + 1] += start[b];
-    }
-    let begin = start.clone();
-    let mut out = vec![0u32; n];
-    for (i, &k) in keys.iter().enumerate() {
-        out[start[k as usize] as usize] = i as u32;
-        start[k as usize] += 1;
-    }
-    (out, begin)
 }
 
 /// Hoppe's edge constraint: the plane through edge (pa, pb) perpendicular to the surface
@@ -409,49 +338,4 @@ fn edge_constraint(pa: [f64; 3], pb: [f64; 3], surface: [f64; 3], weight: f64) -
         let n = n.map(|x| x / l);
         Quadric::from_plane(n, -dot(n, pa), weight * dot(e, e))
     })
-}
-
-/// Renumbers position classes along a Morton (Z-order) curve. The queue visits the mesh in cost
-/// order, effectively at random; with neighbours close in memory, the dozen vertices and faces
-/// one collapse touches share cache lines and pages instead of each being a miss.
-pub(crate) fn spatial_order(
-    positions: &[[f32; 3]],
-    topo: Vec<u32>,
-    firsts: Vec<u32>,
-) -> (Vec<u32>, Vec<u32>) {
-    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for &v in &firsts {
-        let p = positions[v as usize];
-        lo = [0, 1, 2].map(|i| lo[i].min(p[i]));
-        hi = [0, 1, 2].map(|i| hi[i].max(p[i]));
-    }
-    let spread = (0..3)
-        .map(|i| hi[i] - lo[i])
-        .fold(0.0f32, f32::max)
-        .max(f32::MIN_POSITIVE);
-    // Spread the low 10 bits of x to every third bit.
-    let part = |x: u32| {
-        let mut x = x & 0x3ff;
-        x = (x | (x << 16)) & 0x030000ff;
-        x = (x | (x << 8)) & 0x0300f00f;
-        x = (x | (x << 4)) & 0x030c30c3;
-        (x | (x << 2)) & 0x09249249
-    };
-    let code = |v: u32| {
-        let p = positions[v as usize];
-        let q = |i: usize| (((p[i] - lo[i]) / spread) * 1023.0) as u32;
-        part(q(0)) | (part(q(1)) << 1) | (part(q(2)) << 2)
-    };
-    let mut keyed: Vec<(u32, u32)> = (0..firsts.len() as u32)
-        .into_par_iter()
-        .map(|c| (code(firsts[c as usize]), c))
-        .collect();
-    keyed.par_sort_unstable();
-    let order: Vec<u32> = keyed.into_iter().map(|(_, c)| c).collect();
-    let mut rank = vec![0u32; firsts.len()];
-    for (new, &old) in order.iter().enumerate() {
-        rank[old as usize] = new as u32;
-    }
-    let firsts = order.par_iter().map(|&old| firsts[old as usize]).collect();
-    (topo.par_iter().map(|&t| rank[t as usize]).collect(), firsts)
 }

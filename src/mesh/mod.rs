@@ -5,6 +5,8 @@
 //! combination of position and attributes: two vertices may share a position (an attribute seam).
 
 mod generate;
+pub(crate) mod morton;
+pub mod prepare;
 pub(crate) mod topology;
 pub(crate) mod weld;
 

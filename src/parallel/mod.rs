@@ -6,9 +6,9 @@ pub mod schedule;
 
 use crate::error::Result;
 use crate::gpu::types::{Counters, FaceExtra, Params, flag};
-use crate::mesh::{Mesh, weld, weld::position_classes};
-use crate::simplify::{SimplifyOptions, SimplifyReport, StopReason};
-use rayon::prelude::*;
+use crate::mesh::Mesh;
+use crate::mesh::prepare::Surface;
+use crate::options::{SimplifyOptions, SimplifyReport, StopReason};
 use serde::Serialize;
 
 /// Selection passes per round. One pass removes ~5% of the faces per round, three ~15%
@@ -148,88 +148,59 @@ pub struct Download {
 
 impl Upload {
     pub fn new(input: &Mesh) -> Upload {
-        let welded = weld(input).mesh;
-        let (topo, firsts) = position_classes(&welded.positions);
-        let (topo, _) = crate::greedy::spatial_order(&welded.positions, topo, firsts);
-        let nclass = topo.iter().map(|&t| t as usize + 1).max().unwrap_or(0);
-        // Faces with three distinct classes; the rest would be degenerate.
-        let mut faces: Vec<(u32, [u32; 3], FaceExtra)> = welded
-            .triangles
-            .iter()
-            .enumerate()
-            .filter_map(|(f, t)| {
-                let c = t.map(|v| topo[v as usize]);
-                (c[0] != c[1] && c[1] != c[2] && c[0] != c[2]).then(|| {
-                    let lo = c[0].min(c[1]).min(c[2]);
-                    (
-                        lo,
-                        c,
-                        FaceExtra {
-                            attr: *t,
-                            origin: f as u32,
-                        },
-                    )
-                })
-            })
-            .collect();
-        let dropped_degenerate = welded.triangles.len() - faces.len();
-        // Faces in the order of their lowest vertex: a vertex's faces sit close in memory.
-        faces.par_sort_unstable_by_key(|e| (e.0, e.2.origin));
-        // Classes the faces use, renumbered densely in Morton order; their attribute vertices.
-        let mut class_attr = vec![u32::MAX; nclass];
-        let mut attr_count = vec![0u32; nclass];
-        let mut seen_attr = vec![false; welded.positions.len()];
-        for (_, c, x) in &faces {
-            for (&cl, &a) in c.iter().zip(&x.attr) {
-                let cl = cl as usize;
-                if !seen_attr[a as usize] {
-                    seen_attr[a as usize] = true;
-                    attr_count[cl] += 1;
-                }
-                if class_attr[cl] == u32::MAX {
-                    class_attr[cl] = a;
-                }
-            }
-        }
-        let mut dense = vec![u32::MAX; nclass];
+        let surface = Surface::new(input);
+        let s = &surface;
+        // Classes the faces use, renumbered densely (still in Morton order).
+        let mut dense = vec![u32::MAX; s.class_count()];
         let mut n = 0u32;
-        for (c, &a) in class_attr.iter().enumerate() {
-            if a != u32::MAX {
-                dense[c] = n;
+        for (c, d) in dense.iter_mut().enumerate() {
+            if s.attr_count[c] > 0 {
+                *d = n;
                 n += 1;
             }
         }
-        let (center, scale) = match welded.bounds() {
-            Some(b) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
-            Some(b) => (b.center(), 1.0),
-            None => ([0.0; 3], 1.0),
-        };
         let mut positions = vec![[0.0f32; 4]; n as usize];
         let mut flags = vec![0u32; n as usize];
         let mut vertex_attr = vec![0u32; n as usize];
-        for c in 0..nclass {
-            if dense[c] != u32::MAX {
-                let d = dense[c] as usize;
-                let p = welded.positions[class_attr[c] as usize];
-                let q = [0, 1, 2].map(|i| ((p[i] as f64 - center[i]) * scale) as f32);
+        for (c, &d) in dense.iter().enumerate() {
+            if d != u32::MAX {
+                let d = d as usize;
+                let a = s.representative[c];
+                let q = s
+                    .normalize(s.welded.positions[a as usize])
+                    .map(|x| x as f32);
                 positions[d] = [q[0], q[1], q[2], 1.0];
-                vertex_attr[d] = class_attr[c];
-                if attr_count[c] > 1 {
+                vertex_attr[d] = a;
+                if s.is_seam(c) {
                     flags[d] = flag::SEAM;
                 }
             }
         }
-        let indices = faces
+        let indices = s
+            .faces
             .iter()
-            .flat_map(|(_, c, _)| c.map(|x| dense[x as usize]))
+            .flat_map(|t| t.map(|v| dense[s.class[v as usize] as usize]))
+            .collect();
+        let face_extra = s
+            .faces
+            .iter()
+            .zip(&s.face_origin)
+            .map(|(&attr, &origin)| FaceExtra { attr, origin })
             .collect();
         let seams = flags.iter().filter(|&&f| f != 0).count();
+        let Surface {
+            welded,
+            center,
+            scale,
+            dropped_degenerate,
+            ..
+        } = surface;
         Upload {
             positions,
             indices,
             flags,
             vertex_attr,
-            face_extra: faces.into_iter().map(|e| e.2).collect(),
+            face_extra,
             welded,
             center,
             scale,
@@ -322,7 +293,7 @@ pub fn drive(
 /// viewer's LOD scene are made in one run this way.
 pub struct Driver {
     base: Params,
-    cancel: crate::simplify::Cancel,
+    cancel: crate::options::Cancel,
     pub vertices: usize,
     pub faces: usize,
     first: bool,
@@ -455,6 +426,7 @@ pub fn simplify_rounds(
         .count();
     let report = SimplifyReport {
         backend: opts.backend,
+        auto: None,
         input_faces: input.triangles.len(),
         target_faces: opts.target_faces,
         output_faces: out.triangles.len(),
