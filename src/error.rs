@@ -64,7 +64,7 @@ pub enum Error {
         limit: u64,
         which: &'static str,
     },
-    /// Stopped on request ([`crate::simplify::Cancel`]); nothing was written.
+    /// Stopped on request ([`crate::options::Cancel`]); nothing was written.
     #[error("cancelled")]
     Cancelled,
     /// A broken invariant inside the library: a bug, reported instead of a panic.

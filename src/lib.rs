@@ -40,6 +40,7 @@ pub mod greedy;
 pub mod io;
 pub mod mesh;
 pub mod metrics;
+pub mod options;
 pub mod parallel;
 pub mod quadric;
 pub mod simplify;
@@ -48,6 +49,5 @@ pub mod viewer;
 
 pub use error::{Error, Location, Result};
 pub use mesh::{Aabb, Material, Mesh, UvOrigin};
-pub use simplify::{
-    Backend, SimplifyOptions, SimplifyReport, StopReason, simplify, simplify_with_progress,
-};
+pub use options::{Backend, SimplifyOptions, SimplifyReport, StopReason};
+pub use simplify::{simplify, simplify_with_progress};

@@ -1,240 +1,9 @@
-//! Options, report and the entry point shared by every backend.
+//! The entry point: check the input, pick the backend (`auto` included), run it, fall back from
+//! a failed GPU to `cpu-parallel` under `auto`, and explain a stop above the target.
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use serde::Serialize;
-
-/// Which implementation simplifies.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
-#[non_exhaustive]
-pub enum Backend {
-    /// Greedy quadric edge collapse with a priority queue, in f64: the quality reference.
-    Cpu,
-    /// The GPU's rounds of independent-set parallel collapses, run on the CPU with rayon.
-    CpuParallel,
-    /// Rounds of parallel collapses as WGSL compute passes through wgpu.
-    Gpu,
-}
-
-impl Backend {
-    pub fn name(self) -> &'static str {
-        match self {
-            Backend::Cpu => "cpu",
-            Backend::CpuParallel => "cpu-parallel",
-            Backend::Gpu => "gpu",
-        }
-    }
-}
-
-/// How far to simplify. Whichever of the face target and the error bound is met first stops it.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SimplifyOptions {
-    /// Stop at this many faces (reached exactly or one below: an interior collapse removes two).
-    pub target_faces: usize,
-    /// Stop before a collapse whose error, relative to the bounding-box diagonal, exceeds this.
-    pub max_error: Option<f64>,
-    /// Keep the border exactly: border vertices never move; a border vertex is removed only
-    /// when it lies on the straight line between its two border neighbours, so the outline is
-    /// unchanged.
-    pub lock_border: bool,
-    /// Weight of the border and attribute-seam constraint planes relative to the face planes
-    /// (Hoppe's boundary quadrics); larger keeps open borders and seams closer to where they were.
-    pub border_weight: f64,
-    /// A collapse may turn no surrounding face's normal by more than this many degrees.
-    pub max_normal_angle_deg: f64,
-    /// A collapse may not create a face of quality below this (quality = |cross| / longest edge²,
-    /// 0.866 for an equilateral triangle) unless the face was already that thin.
-    pub min_quality: f64,
-    /// Faces below this quality make a collapse proportionally more expensive (MeshLab's
-    /// `QualityThr`, default 0.3); 0 turns the term off, giving textbook QEM order.
-    pub quality_threshold: f64,
-    pub backend: Backend,
-    /// `cpu` backend: how many regions large meshes are split into for the parallel first
-    /// level (a second level then uses at most 4); `None` picks one per 32,768 faces, 8 to 32,
-    /// for meshes of 100,000 faces or more and 1 (purely sequential) below. The result depends
-    /// on this number, never on the number of threads.
-    pub partitions: Option<usize>,
-    /// Set from another thread to stop a running simplification (the viewer's Cancel button):
-    /// it then returns [`Error::Cancelled`] within one round or a few thousand collapses.
-    pub cancel: Cancel,
-}
-
-/// A shared stop flag; every clone sees the same flag. Options compare equal whatever it holds.
-#[derive(Debug, Clone, Default)]
-pub struct Cancel(std::sync::Arc<std::sync::atomic::AtomicBool>);
-
-impl Cancel {
-    pub fn cancel(&self) {
-        self.0.store(true, std::sync::atomic::Ordering::Relaxed);
-    }
-    pub fn is_cancelled(&self) -> bool {
-        self.0.load(std::sync::atomic::Ordering::Relaxed)
-    }
-    /// `Err(Cancelled)` once cancelled, for `?` at the points where work may stop.
-    pub fn check(&self) -> Result<()> {
-        if self.is_cancelled() {
-            Err(Error::Cancelled)
-        } else {
-            Ok(())
-        }
-    }
-}
-
-impl PartialEq for Cancel {
-    fn eq(&self, _: &Cancel) -> bool {
-        true
-    }
-}
-
-impl SimplifyOptions {
-    /// Options for reaching `ratio` of `input_faces`, with the defaults for everything else.
-    pub fn with_ratio(input_faces: usize, ratio: f64) -> Result<Self> {
-        if !(ratio > 0.0 && ratio <= 1.0) {
-            return Err(Error::InvalidOption(format!(
-                "ratio must be in (0, 1], got {ratio}"
-            )));
-        }
-        Ok(Self::with_faces(
-            (input_faces as f64 * ratio).round() as usize
-        ))
-    }
-
-    pub fn with_faces(target_faces: usize) -> Self {
-        SimplifyOptions {
-            target_faces,
-            max_error: None,
-            lock_border: false,
-            border_weight: 1.0,
-            max_normal_angle_deg: 90.0,
-            min_quality: 0.01,
-            quality_threshold: 0.3,
-            backend: Backend::Cpu,
-            partitions: None,
-            cancel: Cancel::default(),
-        }
-    }
-
-    pub(crate) fn check(&self) -> Result<()> {
-        let bad = |m: String| Err(Error::InvalidOption(m));
-        if let Some(e) = self.max_error
-            && !(e >= 0.0 && e.is_finite())
-        {
-            return bad(format!("max error must be a finite number >= 0, got {e}"));
-        }
-        if !(self.border_weight >= 0.0 && self.border_weight.is_finite()) {
-            return bad(format!(
-                "border weight must be >= 0, got {}",
-                self.border_weight
-            ));
-        }
-        if !(self.max_normal_angle_deg > 0.0 && self.max_normal_angle_deg <= 180.0) {
-            return bad(format!(
-                "max normal angle must be in (0, 180], got {}",
-                self.max_normal_angle_deg
-            ));
-        }
-        if !(0.0..1.0).contains(&self.min_quality) || !(0.0..=1.0).contains(&self.quality_threshold)
-        {
-            return bad("min quality and quality threshold must lie in [0, 1)".into());
-        }
-        if self.partitions == Some(0) {
-            return bad("partitions must be at least 1".into());
-        }
-        Ok(())
-    }
-}
-
-/// Why simplification stopped.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum StopReason {
-    /// The face target was reached.
-    TargetReached,
-    /// The next cheapest collapse would exceed the error bound.
-    MaxError,
-    /// No collapse is left that keeps the topology and the constraints (flips, needles, locked
-    /// border, seams): the target cannot be reached without breaking them.
-    NoValidCollapse,
-}
-
-impl StopReason {
-    pub fn explain(self) -> &'static str {
-        match self {
-            StopReason::TargetReached => "reached the face target",
-            StopReason::MaxError => "stopped at the maximum error before reaching the face target",
-            StopReason::NoValidCollapse => {
-                "no collapse left that keeps the topology, normals and locked vertices; the target \
-                 cannot be reached without breaking them"
-            }
-        }
-    }
-}
-
-/// Why no collapse was left where a run stopped above its target: the result's edges, counted
-/// by the first of the rounds' checks each fails (see [`crate::cpu::blocked_edges`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub struct Blocked {
-    pub edges: usize,
-    /// Their collapse would exceed `--max-error`.
-    pub over_max_error: usize,
-    /// A face would flip, turn past the normal limit or become a needle, or the edge has no
-    /// allowed placement (a locked border, a seam junction, a non-manifold vertex).
-    pub geometry: usize,
-    /// The collapse would break the topology: the link condition (it would pinch the surface),
-    /// a border pinch, a lone triangle or a tetrahedron folding flat — what is left are the
-    /// smallest shapes each component and hole can have.
-    pub topology: usize,
-    /// Collapses these checks allow when the result is taken as a new input: the run itself
-    /// also compared normals with the original's and carried its quadrics, so a few more may
-    /// pass here than it could take.
-    pub allowed: usize,
-}
-
-impl Blocked {
-    /// One sentence: the reason that holds most of the edges, with the counts.
-    pub fn explain(&self) -> String {
-        let main = if self.topology >= self.geometry.max(self.over_max_error) {
-            "most would break the topology (pinch the surface, or close a hole or a component \
-             already at its smallest)"
-        } else if self.geometry >= self.over_max_error {
-            "most would flip or crush a face, or move a locked, seam or non-manifold vertex"
-        } else {
-            "most would exceed the maximum error"
-        };
-        format!(
-            "{main}: of {} edges, {} topology, {} flip/shape/locked, {} over the error bound, {} \
-             allowed when the result is taken as a new input",
-            self.edges, self.topology, self.geometry, self.over_max_error, self.allowed
-        )
-    }
-}
-
-/// What a simplification did.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct SimplifyReport {
-    pub backend: Backend,
-    pub input_faces: usize,
-    pub target_faces: usize,
-    pub output_faces: usize,
-    pub input_vertices: usize,
-    pub output_vertices: usize,
-    pub collapses: usize,
-    /// Largest quadric error of an applied collapse, as RMS distance relative to the diagonal.
-    pub max_collapse_error: f64,
-    pub stop_reason: StopReason,
-    /// Faces with a repeated vertex dropped from the input before simplifying.
-    pub dropped_degenerate_faces: usize,
-    /// Vertices kept in place: where the surface is not manifold, and (with `lock_border`)
-    /// attribute seams that reach the border. Seam vertices elsewhere slide along their seam
-    /// (`cpu`); the round-based backends keep seams whole.
-    pub pinned_vertices: usize,
-    /// Rounds, per-round removals and stage times of the round-based backends.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub rounds: Option<crate::parallel::RoundsReport>,
-    /// Where the run stopped above its target: why no collapse was left.
-    pub blocked: Option<Blocked>,
-}
+pub use crate::options::{Backend, Blocked, Cancel, SimplifyOptions, SimplifyReport, StopReason};
 
 /// Simplifies `mesh` with the backend and targets in `opts`.
 pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<(Mesh, SimplifyReport)> {
@@ -255,7 +24,41 @@ pub fn simplify_with_progress(
             mesh.positions.len()
         )));
     }
-    let (out, mut report) = match opts.backend {
+    let (chosen, mut auto) = match opts.backend {
+        Backend::Auto => {
+            let (b, why) = auto_backend();
+            (b, Some(why))
+        }
+        b => (b, None),
+    };
+    let mut result = run(mesh, opts, chosen, progress);
+    if opts.backend == Backend::Auto
+        && chosen == Backend::Gpu
+        && let Err(e @ (Error::Gpu(_) | Error::BufferTooLarge { .. })) = &result
+    {
+        auto = Some(format!("the GPU failed ({e}); fell back to cpu-parallel"));
+        result = run(mesh, opts, Backend::CpuParallel, progress);
+    }
+    let (out, mut report) = result?;
+    report.auto = auto;
+    if report.output_faces > opts.target_faces && report.stop_reason != StopReason::TargetReached {
+        report.blocked = Some(crate::cpu::blocked_edges(&out, opts)?);
+    }
+    Ok((out, report))
+}
+
+/// One backend on `mesh`, with `opts` but for the backend.
+fn run(
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    backend: Backend,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport)> {
+    let opts = &SimplifyOptions {
+        backend,
+        ..opts.clone()
+    };
+    match backend {
         Backend::Cpu => crate::greedy::simplify_greedy(mesh, opts, progress),
         Backend::CpuParallel => {
             let up = crate::parallel::Upload::new(mesh);
@@ -270,9 +73,29 @@ pub fn simplify_with_progress(
             )
         }
         Backend::Gpu => crate::gpu::simplify_gpu(mesh, opts, progress),
-    }?;
-    if report.output_faces > opts.target_faces && report.stop_reason != StopReason::TargetReached {
-        report.blocked = Some(crate::cpu::blocked_edges(&out, opts)?);
+        Backend::Auto => Err(Error::Internal(
+            "Backend::Auto reached a backend unresolved".into(),
+        )),
     }
-    Ok((out, report))
+}
+
+/// What [`Backend::Auto`] picks on this machine, and why, in one line: the process's shared GPU
+/// device when its adapter is hardware, else `cpu-parallel`.
+pub fn auto_backend() -> (Backend, String) {
+    match crate::gpu::shared_context() {
+        Ok(ctx) if ctx.software => (
+            Backend::CpuParallel,
+            format!(
+                "cpu-parallel (the only GPU adapter, {}, is a software rasterizer, slower than \
+                 the CPU's cores; the gpu backend runs on it when asked)",
+                ctx.adapter_name
+            ),
+        ),
+        // The shared device: the adapter found here is the one that simplifies.
+        Ok(_) => match crate::gpu::shared() {
+            Ok((ctx, _)) => (Backend::Gpu, format!("gpu on {}", ctx.adapter_name)),
+            Err(e) => (Backend::CpuParallel, format!("cpu-parallel ({e})")),
+        },
+        Err(e) => (Backend::CpuParallel, format!("cpu-parallel ({e})")),
+    }
 }

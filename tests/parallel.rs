@@ -272,6 +272,7 @@ fn a_resumed_run_lands_each_target_and_keeps_the_invariants() {
         let out = up.build_output(&rounds.download().unwrap(), false);
         let report = meshslim::SimplifyReport {
             backend: Backend::CpuParallel,
+            auto: None,
             input_faces: n,
             target_faces: target,
             output_faces: out.triangles.len(),
@@ -315,4 +316,30 @@ fn cancelled_options_stop_every_backend() {
             r.map(|(_, rep)| rep)
         );
     }
+}
+
+/// `Backend::Auto` resolves in the library: it runs a real backend (`gpu` on a hardware adapter,
+/// `cpu-parallel` otherwise, lavapipe included), reports which, says why, and writes what that
+/// backend writes when asked for by name.
+#[test]
+fn auto_backend_runs_a_real_backend_and_says_why() {
+    let m = meshslim::mesh::icosphere(3);
+    let mut opts = SimplifyOptions::with_ratio(m.face_count(), 0.1).unwrap();
+    opts.backend = Backend::Auto;
+    let (out, report) = simplify(&m, &opts).unwrap();
+    assert!(
+        matches!(report.backend, Backend::Gpu | Backend::CpuParallel),
+        "{:?}",
+        report.backend
+    );
+    let why = report.auto.clone().expect("auto says what it picked");
+    assert!(why.starts_with(report.backend.name()), "{why}");
+    let named = SimplifyOptions {
+        backend: report.backend,
+        ..opts.clone()
+    };
+    let (again, _) = simplify(&m, &named).unwrap();
+    assert_eq!(out, again);
+    // A named backend reports no auto choice.
+    assert_eq!(simplify(&m, &named).unwrap().1.auto, None);
 }

@@ -4,7 +4,7 @@
 use super::peers::{meshopt_simplify, meshopt_simplify_sloppy};
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::simplify::SimplifyOptions;
+use crate::options::SimplifyOptions;
 
 /// One implementation the benchmark can run. A new backend (cpu-parallel, gpu) is one entry in
 /// [`BACKENDS`]: its name, a line of help, the simplify call that is timed, and the device

@@ -25,7 +25,7 @@ use std::time::Instant;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::metrics::{self, CompareOptions};
-use crate::simplify::SimplifyOptions;
+use crate::options::SimplifyOptions;
 
 pub use backends::{BACKENDS, BenchBackend, available_backends, backend, cpu_name, gpu_name};
 pub use models::{

@@ -125,13 +125,13 @@ pub enum BackendArg {
 }
 
 impl BackendArg {
-    /// The library backend, `None` for `auto` (decided when the mesh is there).
-    fn fixed(self) -> Option<Backend> {
+    /// The library backend.
+    pub fn backend(self) -> Backend {
         match self {
-            BackendArg::Cpu => Some(Backend::Cpu),
-            BackendArg::CpuParallel => Some(Backend::CpuParallel),
-            BackendArg::Gpu => Some(Backend::Gpu),
-            BackendArg::Auto => None,
+            BackendArg::Cpu => Backend::Cpu,
+            BackendArg::CpuParallel => Backend::CpuParallel,
+            BackendArg::Gpu => Backend::Gpu,
+            BackendArg::Auto => Backend::Auto,
         }
     }
 }
@@ -198,55 +198,24 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
             eprintln!("{msg}");
         }
     };
-    opts.backend = match args.backend.fixed() {
-        Some(b) => b,
-        // The process's shared device: the adapter found here is the one that simplifies.
-        None => match crate::gpu::shared_context() {
-            Ok(ctx) if ctx.software => {
-                say(format!(
-                    "backend auto: cpu-parallel (the only GPU adapter, {}, is a software \
-                     rasterizer, slower than the CPU's cores; --backend gpu runs on it anyway)",
-                    ctx.adapter_name
-                ));
-                Backend::CpuParallel
-            }
-            Ok(_) => match crate::gpu::shared() {
-                Ok((ctx, _)) => {
-                    say(format!("backend auto: gpu on {}", ctx.adapter_name));
-                    Backend::Gpu
-                }
-                Err(e) => {
-                    say(format!("backend auto: cpu-parallel ({e})"));
-                    Backend::CpuParallel
-                }
-            },
-            Err(e) => {
-                say(format!("backend auto: cpu-parallel ({e})"));
-                Backend::CpuParallel
-            }
-        },
-    };
+    opts.backend = args.backend.backend();
+    // Said before the long part; the library makes the same choice (the process's one shared
+    // device), and its report says so again only if the GPU then failed.
+    let early = (opts.backend == Backend::Auto).then(|| {
+        let (_, why) = crate::simplify::auto_backend();
+        say(format!("backend auto: {why}"));
+        why
+    });
 
     let t = Instant::now();
-    let mut result = progress.bar("simplifying", |set| {
+    let result = progress.bar("simplifying", |set| {
         crate::simplify_with_progress(&mesh, &opts, &mut |f| set(f))
     });
-    if args.backend == BackendArg::Auto
-        && opts.backend == Backend::Gpu
-        && matches!(
-            result,
-            Err(crate::Error::Gpu(_) | crate::Error::BufferTooLarge { .. })
-        )
+    if let Ok((_, report)) = &result
+        && let Some(note) = &report.auto
+        && Some(note) != early.as_ref()
     {
-        if let Err(e) = &result {
-            say(format!(
-                "backend auto: the GPU failed ({e}); falling back to cpu-parallel"
-            ));
-        }
-        opts.backend = Backend::CpuParallel;
-        result = progress.bar("simplifying", |set| {
-            crate::simplify_with_progress(&mesh, &opts, &mut |f| set(f))
-        });
+        say(format!("backend auto: {note}"));
     }
     let (simplified, report) = result
         .map_err(lib)

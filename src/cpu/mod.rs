@@ -27,9 +27,9 @@ pub mod vertex_quadrics;
 
 use crate::error::{Error, Result};
 use crate::gpu::types::*;
+use crate::options::{Blocked, SimplifyOptions};
 use crate::parallel::schedule::{self, Buf, Stage, Step, When};
 use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
-use crate::simplify::{Blocked, SimplifyOptions};
 use edge_costs::CounterField;
 use rayon::prelude::*;
 use std::marker::PhantomData;

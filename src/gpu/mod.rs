@@ -11,8 +11,8 @@ pub use simplifier::{GpuMesh, GpuRounds, GpuSimplifier};
 
 use crate::error::Result;
 use crate::mesh::Mesh;
+use crate::options::{SimplifyOptions, SimplifyReport};
 use crate::parallel::{RoundsReport, SELECTION_PASSES, Upload, simplify_rounds};
-use crate::simplify::{SimplifyOptions, SimplifyReport};
 
 /// Simplifies on the first GPU adapter found, made ready once per process ([`shared`]).
 pub fn simplify_gpu(

@@ -6,7 +6,7 @@ use super::evaluate::{Collapse, Evaluation};
 use super::prepare::Prepared;
 use super::queue::{Queue, key};
 use super::state::{DEAD, State, VertFaces};
-use crate::simplify::SimplifyOptions;
+use crate::options::SimplifyOptions;
 
 impl<'a> State<'a> {
     /// Applies a checked collapse; returns how many faces it removed.

@@ -380,7 +380,7 @@ mod tests {
     use super::super::prepare::Prepared;
     use super::*;
     use crate::mesh::Mesh;
-    use crate::simplify::SimplifyOptions;
+    use crate::options::SimplifyOptions;
 
     /// ```text
     ///           C

@@ -27,10 +27,9 @@ mod vec;
 
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::simplify::{SimplifyOptions, SimplifyReport, StopReason};
+use crate::options::{SimplifyOptions, SimplifyReport, StopReason};
 use output::build_output;
 use partition::{Cuts, LevelStats, SECOND_LEVEL_REGIONS, partitioned_level, partitioned_stop};
-pub(crate) use prepare::spatial_order;
 use prepare::{Mobility, Prepared};
 use state::State;
 
@@ -110,6 +109,7 @@ pub fn simplify_greedy(
     let out = build_output(&s.p, &s.face_alive, &s.alive, input.normals.is_some());
     let report = SimplifyReport {
         backend: opts.backend,
+        auto: None,
         input_faces: input.triangles.len(),
         target_faces: target,
         output_faces: out.triangles.len(),

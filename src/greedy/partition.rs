@@ -4,7 +4,7 @@
 use super::prepare::Prepared;
 use super::queue::Queue;
 use super::state::State;
-use crate::simplify::SimplifyOptions;
+use crate::options::SimplifyOptions;
 
 /// Regions of the second level.
 pub(super) const SECOND_LEVEL_REGIONS: usize = 4;

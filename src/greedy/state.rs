@@ -2,7 +2,7 @@
 //! vertex, liveness, versions that retire stale queue entries, and the run's statistics.
 
 use super::prepare::Prepared;
-use crate::simplify::SimplifyOptions;
+use crate::options::SimplifyOptions;
 
 /// The faces around each vertex, all in one arena: a vertex's list is `data[start..start + len]`
 /// with room up to `cap`. Built in vertex (Morton) order, so the lists of neighbours sit side by

@@ -18,7 +18,7 @@ use super::render::{Mode, Renderer, SceneMesh, Style, Target};
 use super::scene::{Model, Simplified};
 use crate::error::{Error, Result};
 use crate::gpu::GpuSimplifier;
-use crate::simplify::{Backend, Cancel};
+use crate::options::{Backend, Cancel};
 use eframe::egui;
 use eframe::egui_wgpu;
 use glam::Vec3;

@@ -5,9 +5,9 @@
 use super::app::{Done, Job, ViewerApp};
 use super::lod::LOD_RATIOS;
 use super::panels::error_text;
-use super::scene::{self, Model, backend_name};
+use super::scene::{self, Model};
 use crate::error::{Error, Result};
-use crate::simplify::{Cancel, SimplifyOptions};
+use crate::options::{Cancel, SimplifyOptions};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -49,7 +49,7 @@ impl ViewerApp {
         let backend = self.backend;
         let device = self.gpu.device.clone();
         let sim = self.gpu.sim.clone();
-        let label = format!("simplifying to {target} faces ({})", backend_name(backend));
+        let label = format!("simplifying to {target} faces ({})", backend.name());
         self.spawn(
             label,
             move |cancel, progress, phase| {
@@ -177,7 +177,7 @@ impl ViewerApp {
                     s.report.input_faces,
                     s.report.output_faces,
                     s.seconds,
-                    backend_name(s.report.backend),
+                    s.report.backend.name(),
                     error_text(s.error)
                 );
                 self.style.error_scale = s.scene.max_error;

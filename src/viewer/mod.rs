@@ -15,7 +15,7 @@ pub mod scene;
 pub mod views;
 
 use crate::error::{Error, Result};
-use crate::simplify::{Backend, SimplifyOptions};
+use crate::options::{Backend, SimplifyOptions};
 pub use app::{Start, ViewerApp};
 use camera::Camera;
 pub use render::{Mode, Renderer, Style, encode_png};

@@ -6,8 +6,7 @@ use super::camera::Up;
 use super::file_browser::Browser;
 use super::lod::LOD_GRID;
 use super::render::Mode;
-use super::scene::backend_name;
-use crate::simplify::Backend;
+use crate::options::Backend;
 use eframe::egui;
 
 impl ViewerApp {
@@ -127,7 +126,7 @@ impl ViewerApp {
             for b in [Backend::Gpu, Backend::CpuParallel, Backend::Cpu] {
                 let enabled = b != Backend::Gpu || self.gpu.sim.is_some();
                 ui.add_enabled_ui(enabled, |ui| {
-                    ui.selectable_value(&mut self.backend, b, backend_name(b));
+                    ui.selectable_value(&mut self.backend, b, b.name());
                 });
             }
         });
@@ -310,7 +309,7 @@ impl ViewerApp {
         let Some(s) = &self.simplified else { return };
         ui.label(format!(
             "{}: {:.3} s, stop: {:?}",
-            backend_name(s.report.backend),
+            s.report.backend.name(),
             s.seconds,
             s.report.stop_reason
         ));

@@ -8,10 +8,10 @@ use crate::error::{Error, Result};
 use crate::gpu::{GpuMesh, GpuRounds, GpuSimplifier};
 use crate::mesh::{Mesh, UvOrigin};
 use crate::metrics::{CompareOptions, TriangleBvh, compare};
+use crate::options::{Backend, SimplifyOptions, SimplifyReport};
 use crate::parallel::{
     Driver, RoundRunner, RoundsReport, SELECTION_PASSES, Upload, corner_attributes,
 };
-use crate::simplify::{Backend, SimplifyOptions, SimplifyReport};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -295,14 +295,6 @@ pub struct Simplified {
     pub error: Option<(f64, f64)>,
 }
 
-pub fn backend_name(b: Backend) -> &'static str {
-    match b {
-        Backend::Gpu => "gpu",
-        Backend::CpuParallel => "cpu-parallel",
-        Backend::Cpu => "cpu",
-    }
-}
-
 /// Simplifies `model` with `opts.backend`. The `gpu` backend runs on `sim` (the window's own
 /// device) and the result stays there: its [`GpuMesh`] is the rounds' buffers. The CPU backends'
 /// results are uploaded once so that one renderer draws them all.
@@ -317,7 +309,7 @@ pub fn simplify(
     phase: &dyn Fn(&str),
 ) -> Result<Simplified> {
     let t = Instant::now();
-    phase(&format!("simplifying ({})", backend_name(opts.backend)));
+    phase(&format!("simplifying ({})", opts.backend.name()));
     let (gpu, positions, indices, mesh, report, uvs) = match opts.backend {
         Backend::Gpu => {
             let sim = sim.ok_or_else(|| Error::Gpu("the GPU backend is not available".into()))?;
@@ -405,7 +397,7 @@ pub fn lod_levels(
     sim: &GpuSimplifier,
     model: &Model,
     ratios: &[f64],
-    cancel: &crate::simplify::Cancel,
+    cancel: &crate::options::Cancel,
     progress: &mut dyn FnMut(f32),
 ) -> Result<Vec<SceneMesh>> {
     let up = &model.up;
