@@ -33,16 +33,20 @@
 pub mod bench;
 #[cfg(feature = "cli")]
 pub mod cli;
+// The CPU twin and the round driver: internals, public (and hidden from the docs) only so that
+// the integration tests can diff the GPU's buffers stage by stage.
+#[doc(hidden)]
 pub mod cpu;
 pub mod error;
 pub mod gpu;
-pub mod greedy;
+mod greedy;
 pub mod io;
 pub mod mesh;
 pub mod metrics;
 pub mod options;
+#[doc(hidden)]
 pub mod parallel;
-pub mod quadric;
+mod quadric;
 pub mod simplify;
 #[cfg(feature = "viewer")]
 pub mod viewer;

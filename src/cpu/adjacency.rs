@@ -17,7 +17,7 @@ pub fn adjacency_count(params: &Params, indices: &[u32], counts: &[AtomicU32]) {
 }
 
 /// Per face: its id into each corner's list at `offsets[v] + cursor[v]++` (`cursor` cleared).
-pub fn adjacency_fill(
+pub(crate) fn adjacency_fill(
     params: &Params,
     indices: &[u32],            // per face × 3
     offsets: &[u32],            // per vertex + 1 (scanned counts)
@@ -36,7 +36,7 @@ pub fn adjacency_fill(
 }
 
 /// Per vertex: insertion sort of its face list (valences are small).
-pub fn adjacency_sort(params: &Params, offsets: &[u32], vertex_faces: Scatter<u32>) {
+pub(crate) fn adjacency_sort(params: &Params, offsets: &[u32], vertex_faces: Scatter<u32>) {
     par_for(params.vertex_count, |v| {
         let (lo, hi) = (
             offsets[v as usize] as usize,

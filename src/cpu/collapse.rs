@@ -81,7 +81,7 @@ impl Corners<'_> {
 }
 
 #[allow(clippy::too_many_arguments)]
-pub fn collapse(
+pub(crate) fn collapse(
     params: &Params,
     candidates: &[EdgeCandidate],   // per edge
     edge_state: &[u32],             // per edge

@@ -37,7 +37,7 @@ pub fn compact_mark(
 
 /// Per vertex: survivors move to their scanned slot.
 #[allow(clippy::too_many_arguments)]
-pub fn compact_vertices(
+pub(crate) fn compact_vertices(
     params: &Params,
     vertex_keep: &[u32], // scanned
     positions: &[[f32; 4]],
@@ -66,7 +66,7 @@ pub fn compact_vertices(
 
 /// Per face: kept faces move to their scanned slot with corners renumbered.
 #[allow(clippy::too_many_arguments)]
-pub fn compact_faces(
+pub(crate) fn compact_faces(
     params: &Params,
     indices: &[u32],
     face_normals: &[[f32; 4]],

@@ -76,7 +76,7 @@ pub fn moved_faces(
 
 /// Per listed candidate (`live_list`): its priority, or it drops out as invalid.
 #[allow(clippy::too_many_arguments)]
-pub fn edge_costs(
+pub(crate) fn edge_costs(
     params: &Params,
     positions: &[[f32; 4]],             // per vertex
     indices: &[u32],                    // per face × 3

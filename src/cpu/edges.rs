@@ -28,7 +28,7 @@ fn higher_neighbours(indices: &[u32], list: &[u32], v: u32, slots: &mut [u32]) -
 /// Per vertex: its higher neighbours into `neighbours[2 · offsets[v]..]` and their count; also
 /// resets the vertex's collapse remap to itself.
 #[allow(clippy::too_many_arguments)]
-pub fn edges_count(
+pub(crate) fn edges_count(
     params: &Params,
     indices: &[u32],           // per face × 3
     offsets: &[u32],           // per vertex + 1
@@ -54,7 +54,7 @@ pub fn edges_count(
 }
 
 /// Per vertex: copies its listed neighbours to its scanned edge offset.
-pub fn edges_fill(
+pub(crate) fn edges_fill(
     params: &Params,
     offsets: &[u32],          // per vertex + 1
     neighbours: &[u32],       // 2 per corner

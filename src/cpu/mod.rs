@@ -93,7 +93,7 @@ pub fn atomics(s: &mut [u32]) -> &[AtomicU32] {
 
 /// A buffer that parallel invocations write at indices the algorithm proves distinct (prefix-sum
 /// slots, winners' own vertices): what a shader's plain `buf[i] = x` does.
-pub struct Scatter<'a, T> {
+pub(crate) struct Scatter<'a, T> {
     ptr: *mut T,
     len: usize,
     _borrow: PhantomData<&'a mut [T]>,
@@ -105,7 +105,7 @@ unsafe impl<T: Send> Send for Scatter<'_, T> {}
 unsafe impl<T: Send> Sync for Scatter<'_, T> {}
 
 impl<'a, T: Copy> Scatter<'a, T> {
-    pub fn new(s: &'a mut [T]) -> Self {
+    pub(crate) fn new(s: &'a mut [T]) -> Self {
         Scatter {
             ptr: s.as_mut_ptr(),
             len: s.len(),
@@ -116,7 +116,7 @@ impl<'a, T: Copy> Scatter<'a, T> {
     /// # Safety
     /// No other invocation reads or writes index `i` during the stage.
     #[inline]
-    pub unsafe fn write(&self, i: usize, v: T) {
+    pub(crate) unsafe fn write(&self, i: usize, v: T) {
         assert!(i < self.len, "scatter index {i} out of {}", self.len);
         // SAFETY: in bounds (asserted), exclusive per the caller's promise.
         unsafe { self.ptr.add(i).write(v) }
@@ -125,7 +125,7 @@ impl<'a, T: Copy> Scatter<'a, T> {
     /// # Safety
     /// No other invocation writes index `i` during the stage.
     #[inline]
-    pub unsafe fn read(&self, i: usize) -> T {
+    pub(crate) unsafe fn read(&self, i: usize) -> T {
         assert!(i < self.len, "scatter index {i} out of {}", self.len);
         // SAFETY: in bounds (asserted), not written concurrently per the caller's promise.
         unsafe { self.ptr.add(i).read() }
@@ -135,7 +135,7 @@ impl<'a, T: Copy> Scatter<'a, T> {
     /// No other invocation touches `lo..hi` during the stage.
     #[inline]
     #[allow(clippy::mut_from_ref)] // the point of a scatter: disjoint writes through a shared view
-    pub unsafe fn range_mut(&self, lo: usize, hi: usize) -> &mut [T] {
+    pub(crate) unsafe fn range_mut(&self, lo: usize, hi: usize) -> &mut [T] {
         assert!(
             lo <= hi && hi <= self.len,
             "scatter range {lo}..{hi} out of {}",

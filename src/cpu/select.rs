@@ -106,7 +106,7 @@ pub fn select_id(
 }
 
 #[allow(clippy::too_many_arguments)]
-pub fn select_win(
+pub(crate) fn select_win(
     offsets: &[u32],
     vertex_faces: &[u32],
     edges: &[[u32; 2]],

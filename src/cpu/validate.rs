@@ -88,7 +88,7 @@ pub fn check(
 
 /// Per listed tentative winner: it wins (and locks the vertices of its faces) or drops out.
 #[allow(clippy::too_many_arguments)]
-pub fn validate(
+pub(crate) fn validate(
     params: &Params,
     flags: &[u32],
     indices: &[u32],

@@ -2,8 +2,10 @@
 //! stage; src/cpu/ holds their twins).
 
 pub mod context;
-pub mod shaders;
+pub(crate) mod shaders;
 pub mod simplifier;
+// The GPU structs and constants with their Rust twins: public for the stage-by-stage tests.
+#[doc(hidden)]
 pub mod types;
 
 pub use context::GpuContext;
