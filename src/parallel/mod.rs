@@ -8,8 +8,8 @@ use crate::error::Result;
 use crate::gpu::types::{Counters, FaceExtra, Params, flag};
 use crate::mesh::Mesh;
 use crate::mesh::prepare::Surface;
+pub use crate::options::{RoundsReport, StageTimes};
 use crate::options::{SimplifyOptions, SimplifyReport, StopReason};
-use serde::Serialize;
 
 /// Selection passes per round. One pass removes ~5% of the faces per round, three ~15%
 /// (ARCHITECTURE.md's prototype); more passes add little once most candidates are blocked.
@@ -49,48 +49,6 @@ pub trait RoundRunner {
     /// The current mesh, read back; the rounds can go on afterwards.
     fn download(&mut self) -> Result<Download>;
     fn stage_times(&self) -> &StageTimes;
-}
-
-/// Seconds per stage name, in first-seen order, summed over rounds.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct StageTimes(pub Vec<(String, f64)>);
-
-impl StageTimes {
-    pub fn add(&mut self, stage: &str, seconds: f64) {
-        match self.0.iter_mut().find(|(s, _)| s == stage) {
-            Some(e) => e.1 += seconds,
-            None => self.0.push((stage.to_string(), seconds)),
-        }
-    }
-    pub fn total(&self) -> f64 {
-        self.0.iter().map(|e| e.1).sum()
-    }
-    /// The stage that took longest.
-    pub fn slowest(&self) -> Option<(&str, f64)> {
-        self.0
-            .iter()
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(s, t)| (s.as_str(), *t))
-    }
-}
-
-/// What the rounds did, reported by `--stats` and `--json`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct RoundsReport {
-    /// GPU adapter name (gpu backend only).
-    pub adapter: Option<String>,
-    pub rounds: usize,
-    /// Faces removed by each round.
-    pub faces_removed_per_round: Vec<usize>,
-    /// Time per stage: GPU time from timestamp queries when the device has them (else the
-    /// wall time of each submission), CPU time for cpu-parallel.
-    pub stage_seconds: StageTimes,
-    /// Whether `stage_seconds` comes from GPU timestamp queries.
-    pub gpu_timestamps: bool,
-    /// Shader compilation and pipeline creation (gpu backend), reported apart from simplifying.
-    pub pipeline_seconds: f64,
-    /// Upload and download between host and device (gpu backend).
-    pub transfer_seconds: f64,
 }
 
 /// The surface as the rounds see it: position classes (a seam's vertices share one), Morton

@@ -1,0 +1,165 @@
+//! The house rules a reviewer would otherwise check by eye: no source file over 800 lines, and no
+//! import circle between source files (file A naming something in file B while B names
+//! something in A, directly or through others). Read from the sources, by the paths they write:
+//! `crate::a::b`, `super::c` and `crate::a::{b, c::d}`, comments and unit tests left out. A
+//! file naming its own parent module (a stage's twin using `super::Scatter`) is the module
+//! tree, not a circle, and is not counted.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+const MAX_LINES: usize = 800;
+
+fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            sources(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The module path of a source file: src/a/b.rs and src/a/b/mod.rs are ["a", "b"].
+fn module_of(src: &Path, file: &Path) -> Vec<String> {
+    let rel = file.strip_prefix(src).unwrap().with_extension("");
+    let mut parts: Vec<String> = rel
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    if parts.last().is_some_and(|p| p == "mod" || p == "lib") {
+        parts.pop();
+    }
+    parts
+}
+
+/// The code without comments and without the unit tests at the end of a file.
+fn code(text: &str) -> String {
+    let text = match text.find("#[cfg(test)]\nmod tests") {
+        Some(i) => &text[..i],
+        None => text,
+    };
+    text.lines()
+        .map(|l| l.split("//").next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// Every path the code names from `crate::` or `super::`, as module paths (brace groups
+/// expanded one level).
+fn named_paths(module: &[String], code: &str) -> Vec<Vec<String>> {
+    let mut out = Vec::new();
+    let bytes = code.as_bytes();
+    let ident = |b: u8| b.is_ascii_alphanumeric() || b == b'_';
+    for start in ["crate::", "super::"] {
+        let mut from = 0;
+        while let Some(i) = code[from..].find(start) {
+            let at = from + i;
+            from = at + start.len();
+            if at > 0 && ident(bytes[at - 1]) {
+                continue;
+            }
+            let base: Vec<String> = if start == "crate::" {
+                Vec::new()
+            } else {
+                // super:: of a/b.rs, and of a/b/mod.rs, is module a.
+                module[..module.len().saturating_sub(1)].to_vec()
+            };
+            let rest = &code[from..];
+            let end = rest
+                .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
+                .unwrap_or(rest.len());
+            let mut path = base.clone();
+            path.extend(
+                rest[..end]
+                    .split("::")
+                    .filter(|s| !s.is_empty())
+                    .map(str::to_string),
+            );
+            if rest[end..].starts_with('{') {
+                let close = rest[end..].find('}').map_or(rest.len(), |c| end + c);
+                for item in rest[end + 1..close].split(',') {
+                    let item = item.split(" as ").next().unwrap_or("").trim();
+                    let mut p = path.clone();
+                    p.extend(
+                        item.split("::")
+                            .filter(|s| !s.is_empty() && *s != "self")
+                            .map(str::to_string),
+                    );
+                    out.push(p);
+                }
+            } else {
+                out.push(path);
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn no_source_file_is_over_800_lines_and_no_import_circle() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    sources(&src, &mut files);
+    let modules: BTreeMap<Vec<String>, PathBuf> = files
+        .iter()
+        .map(|f| (module_of(&src, f), f.clone()))
+        .collect();
+    let mut long = Vec::new();
+    let mut edges: BTreeMap<Vec<String>, BTreeSet<Vec<String>>> = BTreeMap::new();
+    for (module, file) in &modules {
+        let text = std::fs::read_to_string(file).unwrap();
+        let lines = text.lines().count();
+        if lines > MAX_LINES {
+            long.push(format!("{} ({lines} lines)", file.display()));
+        }
+        let deps = edges.entry(module.clone()).or_default();
+        for path in named_paths(module, &code(&text)) {
+            // The longest prefix of the path that is a source file's module.
+            let target = (1..=path.len())
+                .rev()
+                .map(|k| path[..k].to_vec())
+                .find(|p| modules.contains_key(p));
+            if let Some(t) = target
+                && &t != module
+                && !module.starts_with(&t)
+            {
+                deps.insert(t);
+            }
+        }
+    }
+    assert!(long.is_empty(), "files over {MAX_LINES} lines: {long:?}");
+    // A circle: a path back to where it started.
+    let name = |m: &Vec<String>| {
+        if m.is_empty() {
+            "lib".to_string()
+        } else {
+            m.join("/")
+        }
+    };
+    let mut circles = Vec::new();
+    for start in edges.keys() {
+        let mut stack = vec![vec![start.clone()]];
+        let mut seen = BTreeSet::new();
+        while let Some(path) = stack.pop() {
+            let last = path.last().unwrap();
+            for next in edges.get(last).into_iter().flatten() {
+                if next == start {
+                    circles.push(
+                        path.iter()
+                            .chain([next])
+                            .map(name)
+                            .collect::<Vec<_>>()
+                            .join(" -> "),
+                    );
+                } else if seen.insert(next.clone()) {
+                    let mut p = path.clone();
+                    p.push(next.clone());
+                    stack.push(p);
+                }
+            }
+        }
+    }
+    assert!(circles.is_empty(), "import circles: {circles:#?}");
+}
