@@ -163,3 +163,49 @@ fn no_source_file_is_over_800_lines_and_no_import_circle() {
     }
     assert!(circles.is_empty(), "import circles: {circles:#?}");
 }
+
+/// The core library is lean: without the default features, none of the application's crates
+/// (the window, the command line, the plot, the progress bars, the peer simplifier) is a
+/// dependency. Read from `cargo tree`, which resolves from Cargo.lock without building.
+#[test]
+fn the_core_library_depends_on_no_application_crate() {
+    let out = std::process::Command::new(env!("CARGO"))
+        .args([
+            "tree",
+            "--offline",
+            "--no-default-features",
+            "--edges",
+            "normal",
+            "--prefix",
+            "none",
+            "--package",
+            "meshslim",
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("running cargo tree");
+    assert!(
+        out.status.success(),
+        "cargo tree failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let tree = String::from_utf8_lossy(&out.stdout);
+    let names: BTreeSet<&str> = tree
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .collect();
+    for app in [
+        "eframe",
+        "egui",
+        "clap",
+        "resvg",
+        "indicatif",
+        "meshopt",
+        "anyhow",
+    ] {
+        assert!(!names.contains(app), "the core depends on {app}:\n{tree}");
+    }
+    for core in ["wgpu", "naga", "bytemuck", "glam", "rayon"] {
+        assert!(names.contains(core), "the core lost {core}:\n{tree}");
+    }
+}
