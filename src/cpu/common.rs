@@ -157,7 +157,7 @@ pub fn quality_from_area2(area2: f32, p0: V3, p1: V3, p2: V3) -> f32 {
 }
 
 /// |cross| / longest edge²: 0 for a needle, √3/2 for an equilateral triangle (vcglib's measure,
-/// as `crate::greedy::triangle_quality`).
+/// as the greedy's `triangle_quality` in src/greedy/evaluate.rs).
 pub fn triangle_quality(p0: V3, p1: V3, p2: V3) -> f32 {
     let d10 = sub(p1, p0);
     let d20 = sub(p2, p0);

@@ -11,7 +11,6 @@ use eframe::egui;
 use glam::{Mat4, Vec3};
 
 impl ViewerApp {
-    /// The camera that frames the LOD grid from above one corner.
     /// The LOD scene's first view: low over one side of the grid, so that the nearest
     /// instances are large on screen and the farthest small — every level has its turn.
     pub(super) fn lod_home(&self) -> Camera {

@@ -22,10 +22,10 @@ fn u32_at(b: &[u8], off: usize) -> Option<u32> {
     ))
 }
 
-/// Splits a GLB container into its JSON chunk (with its byte offset) and BIN chunk.
 /// A GLB's JSON chunk, the JSON chunk's byte offset, and the BIN chunk.
 type GlbParts<'a> = (&'a [u8], usize, Option<&'a [u8]>);
 
+/// Splits a GLB container into its JSON chunk (with its byte offset) and BIN chunk.
 fn split_glb<'a>(b: &'a [u8], path: &Path) -> Result<GlbParts<'a>> {
     let bad = |off: usize, m: &str| Error::parse(path, Location::Byte(off as u64), m.to_string());
     let version = u32_at(b, 4).ok_or_else(|| bad(4, "truncated GLB header"))?;
