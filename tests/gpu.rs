@@ -8,6 +8,7 @@ use common::*;
 use meshslim::cpu::CpuRounds;
 use meshslim::gpu::types::*;
 use meshslim::gpu::{GpuRounds, GpuSimplifier};
+use meshslim::parallel::schedule::Buf;
 use meshslim::parallel::{RoundRunner, SELECTION_PASSES, Selection, Upload};
 use meshslim::{Backend, Mesh, SimplifyOptions, simplify};
 
@@ -48,31 +49,31 @@ fn each_stage_matches_its_cpu_twin() {
         let gc = gpu.round(&p, true, Selection::Ordinary).unwrap();
         let mut cpu = CpuRounds::new(&up, SELECTION_PASSES);
         let (nv, nf) = (p.vertex_count as usize, p.face_count as usize);
-        let rd = |what: &str, bytes: usize| gpu.read_buffer(what, bytes as u64).unwrap();
+        let rd = |what: Buf, bytes: usize| gpu.read_buffer(what, bytes as u64).unwrap();
 
         cpu.counters = vec![0; 16];
         // adjacency_count, prefix_sum, adjacency_fill, adjacency_sort
         cpu.build_adjacency(&p).unwrap();
         assert_eq!(
-            pod::<u32>(rd("offsets", 4 * (nv + 1))),
+            pod::<u32>(rd(Buf::Offsets, 4 * (nv + 1))),
             cpu.offsets,
             "{name}: offsets"
         );
         assert_eq!(
-            pod::<u32>(rd("vertex_faces", 12 * nf)),
+            pod::<u32>(rd(Buf::VertexFaces, 12 * nf)),
             cpu.vertex_faces,
             "{name}: vertex_faces"
         );
         // face_planes, vertex_flags, vertex_quadrics
         cpu.setup(&p).unwrap();
-        let g_norm: Vec<[f32; 4]> = pod(rd("face_normals_before", 16 * nf));
+        let g_norm: Vec<[f32; 4]> = pod(rd(Buf::FaceNormalsOut, 16 * nf));
         for (f, (g, c)) in g_norm.iter().zip(&cpu.face_normals).enumerate() {
             assert!(
                 (0..4).all(|k| close(g[k], c[k], 1e-4)),
                 "{name}: face_normals[{f}] {g:?} {c:?}"
             );
         }
-        let g_flags: Vec<u32> = pod(rd("flags_before", 4 * nv));
+        let g_flags: Vec<u32> = pod(rd(Buf::FlagsOut, 4 * nv));
         let moved = |x: &u32| x & !flag::MOVED & !flag::BORDER;
         // The round's collapse adds MOVED and carries BORDER; compare what vertex_flags wrote.
         assert_eq!(
@@ -83,12 +84,12 @@ fn each_stage_matches_its_cpu_twin() {
         // edges_count, prefix_sum, edges_fill
         let ne = cpu.build_edges(&p).unwrap() as usize;
         assert_eq!(
-            pod::<u32>(rd("edge_offsets", 4 * (nv + 1))),
+            pod::<u32>(rd(Buf::EdgeOffsets, 4 * (nv + 1))),
             cpu.edge_offsets,
             "{name}: edge_offsets"
         );
         assert_eq!(
-            pod::<[u32; 2]>(rd("edges", 8 * ne)),
+            pod::<[u32; 2]>(rd(Buf::Edges, 8 * ne)),
             cpu.edges,
             "{name}: edges"
         );
@@ -96,7 +97,7 @@ fn each_stage_matches_its_cpu_twin() {
         // errors agree to rounding, so only an edge on a bin's boundary may land in another bin.
         cpu.errors(&p).unwrap();
         let errors = cpu.candidates.clone();
-        let g_hist: Vec<u32> = pod(rd("histogram", 4 * HIST_BINS as usize));
+        let g_hist: Vec<u32> = pod(rd(Buf::Histogram, 4 * HIST_BINS as usize));
         let moved_bins: u32 = g_hist
             .iter()
             .zip(&cpu.histogram)
@@ -122,7 +123,7 @@ fn each_stage_matches_its_cpu_twin() {
         cpu.costs_under_ceiling(&p).unwrap();
         // live_list: the same candidates, in the GPU's order of arrival. An edge whose error
         // is within rounding of the ceiling may be listed on one side only, as in the histogram.
-        let mut g_live: Vec<u32> = pod(rd("live", 4 * gc.live as usize));
+        let mut g_live: Vec<u32> = pod(rd(Buf::Live, 4 * gc.live as usize));
         g_live.sort_unstable();
         assert!(
             g_live.windows(2).all(|w| w[0] < w[1]),
@@ -149,7 +150,7 @@ fn each_stage_matches_its_cpu_twin() {
         );
         // edge_costs, compared through the candidates. The GPU's candidates are read after its
         // whole round: validate has only added face counts.
-        let g_cand: Vec<EdgeCandidate> = pod(rd("candidates", size_of::<EdgeCandidate>() * ne));
+        let g_cand: Vec<EdgeCandidate> = pod(rd(Buf::Candidates, size_of::<EdgeCandidate>() * ne));
         let mut mismatched = 0;
         for (e, (g, c)) in g_cand.iter().zip(&cpu.candidates).enumerate() {
             let same_validity = (g.cost_bits == INVALID_COST) == (c.cost_bits == INVALID_COST);
@@ -186,7 +187,7 @@ fn each_stage_matches_its_cpu_twin() {
         cpu.live = g_live;
         // select_cost, select_id, select_win, validate, and the trim stages.
         cpu.select(&p, Selection::Ordinary).unwrap();
-        let g_state = pod::<u32>(rd("edge_state", 4 * ne));
+        let g_state = pod::<u32>(rd(Buf::EdgeState, 4 * ne));
         assert_eq!(
             g_state, cpu.edge_state,
             "{name}: edge_state after selection"
@@ -217,12 +218,12 @@ fn each_stage_matches_its_cpu_twin() {
             &mut args,
         );
         assert_eq!(
-            pod::<u32>(rd("dispatch", 48)),
+            pod::<u32>(rd(Buf::Dispatch, 48)),
             args,
             "{name}: dispatch_args"
         );
         let faces = |v: &[EdgeCandidate]| v.iter().map(|c| c.faces).collect::<Vec<_>>();
-        let g_after: Vec<EdgeCandidate> = pod(rd("candidates", size_of::<EdgeCandidate>() * ne));
+        let g_after: Vec<EdgeCandidate> = pod(rd(Buf::Candidates, size_of::<EdgeCandidate>() * ne));
         assert_eq!(
             faces(&g_after),
             faces(&cpu.candidates),
@@ -230,31 +231,35 @@ fn each_stage_matches_its_cpu_twin() {
         );
         // collapse, compact_*, draw_args
         cpu.apply_and_compact(&p).unwrap();
-        assert_eq!(pod::<u32>(rd("remap", 4 * nv)), cpu.remap, "{name}: remap");
+        assert_eq!(
+            pod::<u32>(rd(Buf::Remap, 4 * nv)),
+            cpu.remap,
+            "{name}: remap"
+        );
         assert_eq!(
             gc.faces_out as usize * 3,
             cpu.indices.len(),
             "{name}: faces after compaction"
         );
         assert_eq!(
-            pod::<u32>(rd("indices", 4 * cpu.indices.len())),
+            pod::<u32>(rd(Buf::Indices, 4 * cpu.indices.len())),
             cpu.indices,
             "{name}: indices"
         );
         // The seam corners' attribute vertices, rewritten by collapse and carried by compaction.
         assert_eq!(
-            pod::<FaceExtra>(rd("face_extra", 16 * cpu.face_extra.len())),
+            pod::<FaceExtra>(rd(Buf::FaceExtra, 16 * cpu.face_extra.len())),
             cpu.face_extra,
             "{name}: face_extra"
         );
-        let g_pos: Vec<[f32; 4]> = pod(rd("positions", 16 * cpu.positions.len()));
+        let g_pos: Vec<[f32; 4]> = pod(rd(Buf::Positions, 16 * cpu.positions.len()));
         for (v, (g, c)) in g_pos.iter().zip(&cpu.positions).enumerate() {
             assert!(
                 (0..3).all(|k| (g[k] - c[k]).abs() < 1e-5),
                 "{name}: position {v} {g:?} {c:?}"
             );
         }
-        let g_q: Vec<Quadric> = pod(rd("quadrics", 48 * cpu.quadrics.len()));
+        let g_q: Vec<Quadric> = pod(rd(Buf::Quadrics, 48 * cpu.quadrics.len()));
         for (v, (g, c)) in g_q.iter().zip(&cpu.quadrics).enumerate() {
             let scale = c.q.iter().flatten().fold(0f32, |m, x| m.max(x.abs()));
             let ok =
@@ -264,7 +269,7 @@ fn each_stage_matches_its_cpu_twin() {
                     .all(|(a, b)| (a - b).abs() <= 1e-4 * scale);
             assert!(ok, "{name}: quadric {v} {g:?} {c:?}");
         }
-        let args: DrawArgs = *bytemuck::from_bytes(&rd("draw_args", 20));
+        let args: DrawArgs = *bytemuck::from_bytes(&rd(Buf::DrawArgs, 20));
         assert_eq!(
             args.index_count as usize,
             cpu.indices.len(),
@@ -373,7 +378,7 @@ fn gpu_mesh_is_drawable_from_the_simplifier_buffers() {
         (opts.target_faces - 1..=opts.target_faces).contains(&faces),
         "{faces} faces"
     );
-    let args: DrawArgs = *bytemuck::from_bytes(&rounds.read_buffer("draw_args", 20).unwrap());
+    let args: DrawArgs = *bytemuck::from_bytes(&rounds.read_buffer(Buf::DrawArgs, 20).unwrap());
     assert_eq!(
         (args.index_count as usize, args.instance_count),
         (3 * faces, 1)

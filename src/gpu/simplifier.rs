@@ -595,39 +595,11 @@ impl<'a> GpuRounds<'a> {
         Ok(mesh)
     }
 
-    /// The first `bytes` of a working buffer, by its WGSL variable name (the buffers of the
-    /// current half for per-vertex and per-face data): what tests diff against the CPU twin.
-    pub fn read_buffer(&self, name: &str, bytes: u64) -> Result<Vec<u8>> {
-        let h = &self.half[self.cur];
-        let other = &self.half[1 - self.cur];
-        let b = match name {
-            "positions" => &h.positions,
-            "quadrics" => &h.quadrics,
-            "flags" => &h.flags,
-            "indices" => &h.indices,
-            "face_normals" => &h.face_normals,
-            "face_extra" => &h.face_extra,
-            // The buffers the last round compacted from.
-            "positions_before" => &other.positions,
-            "quadrics_before" => &other.quadrics,
-            "flags_before" => &other.flags,
-            "face_normals_before" => &other.face_normals,
-            "offsets" => &self.offsets,
-            "vertex_faces" => &self.vertex_faces,
-            "edge_offsets" => &self.edge_offsets,
-            "edges" => &self.edges,
-            "candidates" => &self.candidates,
-            "edge_state" => &self.edge_state,
-            "histogram" => &self.histogram,
-            "live" => &self.live,
-            "remap" => &self.remap,
-            "vertex_keep" => &self.vertex_keep,
-            "face_keep" => &self.face_keep,
-            "draw_args" => &self.draw_args,
-            "dispatch" => &self.dispatch,
-            _ => return Err(Error::Internal(format!("no GPU buffer named {name}"))),
-        };
-        self.read(b, bytes)
+    /// The first `bytes` of a working buffer, as the schedule names it: what tests diff against
+    /// the CPU twin. After a round the plain per-vertex and per-face names are its result and
+    /// the `*Out` ones the half it compacted from.
+    pub fn read_buffer(&self, buf: Buf, bytes: u64) -> Result<Vec<u8>> {
+        self.read(self.buffer(buf, None), bytes)
     }
 
     fn read(&self, src: &wgpu::Buffer, bytes: u64) -> Result<Vec<u8>> {
