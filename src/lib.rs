@@ -33,6 +33,9 @@
 pub mod bench;
 #[cfg(feature = "cli")]
 pub mod cli;
+// Vertex clustering; public (hidden) for the tests of its stages.
+#[doc(hidden)]
+pub mod cluster;
 // The CPU twin and the round driver: internals, public (and hidden from the docs) only so that
 // the integration tests can diff the GPU's buffers stage by stage.
 #[doc(hidden)]
@@ -53,5 +56,5 @@ pub mod viewer;
 
 pub use error::{Error, Location, Result};
 pub use mesh::{Aabb, Material, Mesh, UvOrigin};
-pub use options::{Backend, SimplifyOptions, SimplifyReport, StopReason};
+pub use options::{Backend, Method, SimplifyOptions, SimplifyReport, StopReason};
 pub use simplify::{simplify, simplify_with_progress};

@@ -33,6 +33,46 @@ impl Backend {
     }
 }
 
+/// Which family of algorithms simplifies.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum Method {
+    /// Quadric edge collapse (Garland & Heckbert 1997): the best quality, on every backend.
+    #[default]
+    Qem,
+    /// Uniform-grid vertex clustering (Rossignac & Borrel 1993) with one quadric per cell
+    /// (Lindstrom 2000): the fastest, lands within 5% of the target, may change topology.
+    Cluster,
+    /// Low & Tan's floating cells (1997): clusters centred on the most important vertices, so
+    /// creases and corners survive where a uniform grid cuts them; within 5% of the target.
+    FloatingCell,
+    /// Clustering to an intermediate count, then the QEM rounds to the exact target with the
+    /// clusters' quadrics carried over (Garland & Shaffer's multiphase simplification, 2002):
+    /// near-QEM quality at clustering speed on large scans.
+    Hybrid,
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Qem => "qem",
+            Method::Cluster => "cluster",
+            Method::FloatingCell => "floating-cell",
+            Method::Hybrid => "hybrid",
+        }
+    }
+
+    /// Whether the result may have other topology than the input (clustering merges vertices
+    /// that no edge joined).
+    pub fn changes_topology(self) -> bool {
+        matches!(
+            self,
+            Method::Cluster | Method::FloatingCell | Method::Hybrid
+        )
+    }
+}
+
 /// How far to simplify. Whichever of the face target and the error bound is met first stops it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimplifyOptions {
@@ -56,6 +96,8 @@ pub struct SimplifyOptions {
     /// `QualityThr`, default 0.3); 0 turns the term off, giving textbook QEM order.
     pub quality_threshold: f64,
     pub backend: Backend,
+    /// The algorithm; the clustering methods run on `cpu-parallel` (`cpu` means it too).
+    pub method: Method,
     /// `cpu` backend: how many regions large meshes are split into for the parallel first
     /// level (a second level then uses at most 4); `None` picks one per 32,768 faces, 8 to 32,
     /// for meshes of 100,000 faces or more and 1 (purely sequential) below. The result depends
@@ -116,6 +158,7 @@ impl SimplifyOptions {
             min_quality: 0.01,
             quality_threshold: 0.3,
             backend: Backend::Cpu,
+            method: Method::Qem,
             partitions: None,
             cancel: Cancel::default(),
         }
@@ -155,8 +198,11 @@ impl SimplifyOptions {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum StopReason {
-    /// The face target was reached.
+    /// The face target was reached (clustering: within 5% of it).
     TargetReached,
+    /// Clustering: no cell size lands within 5% of the target (the count jumps past it, or
+    /// the grid is at its finest); the result is the nearest found.
+    ClusterBand,
     /// The next cheapest collapse would exceed the error bound.
     MaxError,
     /// No collapse is left that keeps the topology and the constraints (flips, needles, locked
@@ -168,6 +214,9 @@ impl StopReason {
     pub fn explain(self) -> &'static str {
         match self {
             StopReason::TargetReached => "reached the face target",
+            StopReason::ClusterBand => {
+                "no cell size lands within 5% of the face target; this is the nearest count found"
+            }
             StopReason::MaxError => "stopped at the maximum error before reaching the face target",
             StopReason::NoValidCollapse => {
                 "no collapse left that keeps the topology, normals and locked vertices; the target \
@@ -244,6 +293,42 @@ pub struct SimplifyReport {
     pub rounds: Option<RoundsReport>,
     /// Where the run stopped above its target: why no collapse was left.
     pub blocked: Option<Blocked>,
+    /// What clustering did (`cluster`, `floating-cell`, `hybrid`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub clustering: Option<ClusterReport>,
+}
+
+/// What the clustering methods did, reported by `--stats` and `--json`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct ClusterReport {
+    pub method: Method,
+    /// The cell size (grid side, or floating-cell radius), relative to the bounding-box
+    /// diagonal.
+    pub cell_size: f64,
+    /// Cell sizes whose face count was taken while searching for the target (four a pass).
+    pub sizes_counted: usize,
+    /// Full clusterings run (the last is the result).
+    pub builds: usize,
+    /// Clusters (output vertices before unused ones are dropped).
+    pub clusters: usize,
+    /// Clusters beyond one per cell, from splitting cells by connectivity.
+    pub split_clusters: usize,
+    /// `hybrid`: clusters taken apart because they made a non-manifold edge.
+    pub repaired_clusters: usize,
+    /// How each cluster's vertex was placed: a single member kept, the clamped quadric
+    /// minimum, the member of least error, the centroid.
+    pub placed_single: usize,
+    pub placed_solve: usize,
+    pub placed_member: usize,
+    pub placed_centroid: usize,
+    /// `hybrid`: the faces clustering left for the rounds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub intermediate_faces: Option<usize>,
+    /// `floating-cell`: rounds of choosing centres.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub centre_rounds: Option<usize>,
+    /// Seconds in clustering (for `hybrid`, before the rounds).
+    pub seconds: f64,
 }
 
 /// Seconds per stage name, in first-seen order, summed over rounds.

@@ -3,7 +3,9 @@
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-pub use crate::options::{Backend, Blocked, Cancel, SimplifyOptions, SimplifyReport, StopReason};
+pub use crate::options::{
+    Backend, Blocked, Cancel, Method, SimplifyOptions, SimplifyReport, StopReason,
+};
 
 /// Simplifies `mesh` with the backend and targets in `opts`.
 pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<(Mesh, SimplifyReport)> {
@@ -23,6 +25,16 @@ pub fn simplify_with_progress(
             "the mesh has no faces ({} vertices: a point cloud?), so there is nothing to simplify",
             mesh.positions.len()
         )));
+    }
+    match opts.method {
+        Method::Qem => {}
+        Method::Cluster => return crate::cluster::simplify_cluster(mesh, opts, progress),
+        Method::Hybrid => return crate::cluster::simplify_hybrid(mesh, opts, progress),
+        Method::FloatingCell => {
+            return Err(Error::InvalidOption(
+                "--method floating-cell is not built yet".into(),
+            ));
+        }
     }
     let (chosen, mut auto) = match opts.backend {
         Backend::Auto => {

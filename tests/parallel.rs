@@ -285,6 +285,7 @@ fn a_resumed_run_lands_each_target_and_keeps_the_invariants() {
             pinned_vertices: 0,
             rounds: None,
             blocked: None,
+            clustering: None,
         };
         check_invariants(&format!("resumed to {ratio}"), &m, &out, &report);
     }

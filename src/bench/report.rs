@@ -34,7 +34,8 @@ pub struct Row {
     /// What ran it: the CPU model for CPU backends, the adapter for GPU ones.
     pub device: String,
     pub output_faces: usize,
-    /// The run stopped above its target (the error columns then compare a larger mesh);
+    /// The run stopped above its target (beyond its backend's band: 5% for clustering; the
+    /// error columns then compare a larger mesh);
     /// the table marks it with `*`.
     pub missed_target: bool,
     /// Median wall time of the simplify call over the repeats, seconds.

@@ -17,11 +17,37 @@ pub(super) struct Times {
     pub(super) save: f64,
 }
 
+/// What a clustering method did to the topology: it may join sheets and close handles.
+#[derive(Debug, Clone, serde::Serialize)]
+pub(super) struct TopologyChange {
+    pub non_manifold_edges_before: usize,
+    pub non_manifold_edges_after: usize,
+    pub euler_characteristic_before: i64,
+    pub euler_characteristic_after: i64,
+    pub components_before: usize,
+    pub components_after: usize,
+}
+
+impl TopologyChange {
+    pub fn of(before: &crate::Mesh, after: &crate::Mesh) -> TopologyChange {
+        let (a, b) = (crate::mesh::topology(before), crate::mesh::topology(after));
+        TopologyChange {
+            non_manifold_edges_before: a.non_manifold_edges,
+            non_manifold_edges_after: b.non_manifold_edges,
+            euler_characteristic_before: a.euler_characteristic,
+            euler_characteristic_after: b.euler_characteristic,
+            components_before: a.connected_components,
+            components_after: b.connected_components,
+        }
+    }
+}
+
 pub(super) fn simplify_json(
     input: &Input,
     output: &Path,
     r: &SimplifyReport,
     t: &Times,
+    topology: Option<&TopologyChange>,
 ) -> serde_json::Value {
     serde_json::json!({
         "input": input.display(),
@@ -40,6 +66,8 @@ pub(super) fn simplify_json(
         "dropped_degenerate_faces": r.dropped_degenerate_faces,
         "seconds": { "load": t.load, "simplify": t.simplify, "save": t.save },
         "rounds": r.rounds,
+        "clustering": r.clustering,
+        "topology": topology,
     })
 }
 
@@ -50,6 +78,7 @@ pub(super) fn write_summary(
     r: &SimplifyReport,
     t: &Times,
     stats: bool,
+    topology: Option<&TopologyChange>,
 ) -> std::io::Result<()> {
     let pct = |n: usize| {
         if r.input_faces == 0 {
@@ -94,6 +123,35 @@ pub(super) fn write_summary(
         t.save,
         r.backend.name()
     )?;
+    if let Some(c) = &r.clustering {
+        let intermediate = c.intermediate_faces.map_or(String::new(), |n| {
+            format!(", {n} faces handed to the rounds")
+        });
+        writeln!(
+            out,
+            "method   {}: cell {:.3e} of the diagonal, {} clusters ({} from splitting cells by connectivity){intermediate}",
+            c.method.name(),
+            c.cell_size,
+            c.clusters,
+            c.split_clusters
+        )?;
+    }
+    if let Some(tc) = topology {
+        let changed = tc.non_manifold_edges_after > tc.non_manifold_edges_before
+            || tc.euler_characteristic_after != tc.euler_characteristic_before
+            || tc.components_after != tc.components_before;
+        writeln!(
+            out,
+            "topology {}: non-manifold edges {} -> {}, Euler characteristic {} -> {}, components {} -> {}",
+            if changed { "changed" } else { "kept" },
+            tc.non_manifold_edges_before,
+            tc.non_manifold_edges_after,
+            tc.euler_characteristic_before,
+            tc.euler_characteristic_after,
+            tc.components_before,
+            tc.components_after
+        )?;
+    }
     if stats {
         writeln!(out, "collapses           {}", r.collapses)?;
         writeln!(
@@ -111,6 +169,19 @@ pub(super) fn write_summary(
             "max collapse error  {:.3e} of the bounding-box diagonal",
             r.max_collapse_error
         )?;
+        if let Some(c) = &r.clustering {
+            writeln!(
+                out,
+                "clustering          {:.3} s; {} cell sizes counted, {} builds; vertices placed: {} single, {} quadric minimum, {} best member, {} centroid",
+                c.seconds,
+                c.sizes_counted,
+                c.builds,
+                c.placed_single,
+                c.placed_solve,
+                c.placed_member,
+                c.placed_centroid
+            )?;
+        }
         if let Some(rr) = &r.rounds {
             write_rounds(out, rr)?;
         }

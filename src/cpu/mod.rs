@@ -194,6 +194,8 @@ pub struct CpuRounds {
     face_owner: Vec<u32>,
     /// Rounds run so far, to name the round in an internal error.
     rounds_run: u32,
+    /// The quadrics came with the upload: the first round does not compute them.
+    carried_quadrics: bool,
 }
 
 fn reset(v: &mut Vec<u32>, n: usize) {
@@ -205,7 +207,11 @@ impl CpuRounds {
     pub fn new(up: &Upload, selection_passes: u32) -> CpuRounds {
         CpuRounds {
             positions: up.positions.clone(),
-            quadrics: vec![Quadric::default(); up.positions.len()],
+            quadrics: up
+                .quadrics
+                .clone()
+                .unwrap_or_else(|| vec![Quadric::default(); up.positions.len()]),
+            carried_quadrics: up.quadrics.is_some(),
             flags: up.flags.clone(),
             vertex_attr: up.vertex_attr.clone(),
             indices: up.indices.clone(),
@@ -558,9 +564,14 @@ impl CpuRounds {
         self.run_steps(p, schedule::ADJACENCY)
     }
 
-    /// The first round's set-up: face normals, vertex flags, quadrics ([`schedule::SETUP`]).
+    /// The first round's set-up: face normals, vertex flags ([`schedule::SETUP`]), and the
+    /// quadrics unless they were carried in ([`schedule::SETUP_QUADRICS`]).
     pub fn setup(&mut self, p: &Params) -> Result<()> {
-        self.run_steps(p, schedule::SETUP)
+        self.run_steps(p, schedule::SETUP)?;
+        if !self.carried_quadrics {
+            self.run_steps(p, schedule::SETUP_QUADRICS)?;
+        }
+        Ok(())
     }
 
     /// Unique edges ([`schedule::EDGES`]); returns their count.
@@ -638,8 +649,11 @@ impl RoundRunner for CpuRounds {
             match when {
                 When::Always => self.run_steps(p, steps)?,
                 When::FirstRound if first => self.run_steps(p, steps)?,
+                When::FirstRoundQuadrics if first && !self.carried_quadrics => {
+                    self.run_steps(p, steps)?
+                }
                 When::Trimming if p.trim != 0 => self.run_steps(p, steps)?,
-                When::FirstRound | When::Trimming => {}
+                When::FirstRound | When::FirstRoundQuadrics | When::Trimming => {}
                 When::EachSelectionPass => self.passes(p, steps, selection)?,
             }
         }

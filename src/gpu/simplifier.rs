@@ -657,9 +657,11 @@ impl RoundRunner for GpuRounds<'_> {
         for &(when, steps) in schedule::ROUND {
             match when {
                 When::Always => self.record(&mut enc, p, steps),
-                When::FirstRound if first => self.record(&mut enc, p, steps),
+                When::FirstRound | When::FirstRoundQuadrics if first => {
+                    self.record(&mut enc, p, steps)
+                }
                 When::Trimming if p.trim != 0 => self.record(&mut enc, p, steps),
-                When::FirstRound | When::Trimming => {}
+                When::FirstRound | When::FirstRoundQuadrics | When::Trimming => {}
                 When::EachSelectionPass => {
                     for pass in 0u32.. {
                         match selection {

@@ -122,6 +122,7 @@ pub fn simplify_greedy(
         pinned_vertices,
         rounds: None,
         blocked: None,
+        clustering: None,
     };
     Ok((out, report))
 }

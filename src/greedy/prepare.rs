@@ -67,6 +67,7 @@ impl Prepared {
             faces,
             face_origin,
             dropped_degenerate,
+            weld_remap: _,
             center,
             scale,
         } = surface;

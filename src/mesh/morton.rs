@@ -21,18 +21,10 @@ pub(crate) fn spatial_order(
         .map(|i| hi[i] - lo[i])
         .fold(0.0f32, f32::max)
         .max(f32::MIN_POSITIVE);
-    // Spread the low 10 bits of x to every third bit.
-    let part = |x: u32| {
-        let mut x = x & 0x3ff;
-        x = (x | (x << 16)) & 0x030000ff;
-        x = (x | (x << 8)) & 0x0300f00f;
-        x = (x | (x << 4)) & 0x030c30c3;
-        (x | (x << 2)) & 0x09249249
-    };
     let code = |v: u32| {
         let p = positions[v as usize];
         let q = |i: usize| (((p[i] - lo[i]) / spread) * 1023.0) as u32;
-        part(q(0)) | (part(q(1)) << 1) | (part(q(2)) << 2)
+        morton3(q(0), q(1), q(2))
     };
     let mut keyed: Vec<(u32, u32)> = (0..firsts.len() as u32)
         .into_par_iter()
@@ -46,4 +38,19 @@ pub(crate) fn spatial_order(
     }
     let firsts = order.par_iter().map(|&old| firsts[old as usize]).collect();
     (topo.par_iter().map(|&t| rank[t as usize]).collect(), firsts)
+}
+
+/// The Morton code of a cell with coordinates below 1024: the low 10 bits of x, y and z
+/// interleaved, x lowest.
+#[inline]
+pub(crate) fn morton3(x: u32, y: u32, z: u32) -> u32 {
+    // Spread the low 10 bits of x to every third bit.
+    let part = |x: u32| {
+        let mut x = x & 0x3ff;
+        x = (x | (x << 16)) & 0x030000ff;
+        x = (x | (x << 8)) & 0x0300f00f;
+        x = (x | (x << 4)) & 0x030c30c3;
+        (x | (x << 2)) & 0x09249249
+    };
+    part(x) | (part(y) << 1) | (part(z) << 2)
 }

@@ -31,6 +31,8 @@ pub struct Surface {
     pub face_origin: Vec<u32>,
     /// Faces dropped because two corners share a class.
     pub dropped_degenerate: usize,
+    /// Per input vertex: the vertex of `welded` it became.
+    pub weld_remap: Vec<u32>,
     /// The frame: positions are centred on the bounding box and divided by its diagonal, so
     /// errors are relative to the diagonal and f32 GPU twins keep precision.
     pub center: [f64; 3],
@@ -39,7 +41,17 @@ pub struct Surface {
 
 impl Surface {
     pub fn new(input: &Mesh) -> Surface {
-        let welded = weld(input).mesh;
+        Surface::in_frame(input, None)
+    }
+
+    /// As [`Surface::new`], normalized with the given `(center, scale)` instead of the input's
+    /// own box (the hybrid method's clustered mesh keeps the original's frame, so the quadrics
+    /// it carries keep their units).
+    pub fn in_frame(input: &Mesh, frame: Option<([f64; 3], f64)>) -> Surface {
+        let weld::WeldResult {
+            mesh: welded,
+            remap: weld_remap,
+        } = weld(input);
         // Without attributes `weld` merged by position already: every position is its own class,
         // and hashing them all again cost 0.03 s of 0.4 s here on the 1M scan.
         let (class, firsts) =
@@ -85,11 +97,7 @@ impl Surface {
             .par_iter()
             .map(|&f| welded.triangles[f as usize])
             .collect();
-        let (center, scale) = match welded.bounds() {
-            Some(b) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
-            Some(b) => (b.center(), 1.0),
-            None => ([0.0; 3], 1.0),
-        };
+        let (center, scale) = frame.unwrap_or_else(|| frame_of(&welded));
         Surface {
             welded,
             class,
@@ -98,6 +106,7 @@ impl Surface {
             faces,
             face_origin,
             dropped_degenerate,
+            weld_remap,
             center,
             scale,
         }
@@ -117,6 +126,15 @@ impl Surface {
     /// moved compares equal.
     pub fn normalize(&self, p: [f32; 3]) -> [f64; 3] {
         normalize(p, self.center, self.scale)
+    }
+}
+
+/// The frame of `mesh`: its box's centre, and one over its diagonal.
+pub fn frame_of(mesh: &Mesh) -> ([f64; 3], f64) {
+    match mesh.bounds() {
+        Some(b) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
+        Some(b) => (b.center(), 1.0),
+        None => ([0.0; 3], 1.0),
     }
 }
 

@@ -70,6 +70,9 @@ pub struct Upload {
     pub dropped_degenerate: usize,
     /// Seam vertices.
     pub seams: usize,
+    /// Per class: the quadric carried in (the hybrid method's clusters), relative to the
+    /// vertex; `None` computes them in the first round.
+    pub quadrics: Option<Vec<crate::gpu::types::Quadric>>,
 }
 
 /// The attribute vertex (of the welded input) of every corner of the rounds' faces: a seam
@@ -106,7 +109,30 @@ pub struct Download {
 
 impl Upload {
     pub fn new(input: &Mesh) -> Upload {
-        let surface = Surface::new(input);
+        Upload::from_surface(Surface::new(input), None)
+    }
+
+    /// The upload of `input` in the frame `(center, scale)`, with each input vertex's quadric
+    /// (relative to it, in that frame) carried in; vertices welded together sum theirs.
+    pub fn with_quadrics(
+        input: &Mesh,
+        frame: ([f64; 3], f64),
+        quadrics: &[crate::gpu::types::Quadric],
+    ) -> Upload {
+        let surface = Surface::in_frame(input, Some(frame));
+        let carried = quadrics
+            .iter()
+            .zip(&surface.weld_remap)
+            .map(|(q, &w)| (surface.class[w as usize], q))
+            .collect::<Vec<_>>();
+        Upload::from_surface(surface, Some(carried))
+    }
+
+    /// `carried`: (class, quadric) pairs to sum per class.
+    fn from_surface(
+        surface: Surface,
+        carried: Option<Vec<(u32, &crate::gpu::types::Quadric)>>,
+    ) -> Upload {
         let s = &surface;
         // Classes the faces use, renumbered densely (still in Morton order).
         let mut dense = vec![u32::MAX; s.class_count()];
@@ -146,6 +172,16 @@ impl Upload {
             .map(|(&attr, &origin)| FaceExtra { attr, origin })
             .collect();
         let seams = flags.iter().filter(|&&f| f != 0).count();
+        let quadrics = carried.map(|pairs| {
+            let mut q = vec![crate::gpu::types::Quadric::default(); n as usize];
+            for (c, x) in pairs {
+                let d = dense[c as usize];
+                if d != u32::MAX {
+                    q[d as usize] = crate::cpu::common::quadric_add(&q[d as usize], x);
+                }
+            }
+            q
+        });
         let Surface {
             welded,
             center,
@@ -164,6 +200,7 @@ impl Upload {
             scale,
             dropped_degenerate,
             seams,
+            quadrics,
         }
     }
 
@@ -397,6 +434,7 @@ pub fn simplify_rounds(
         pinned_vertices: pinned,
         rounds: Some(rounds_report),
         blocked: None,
+        clustering: None,
     };
     Ok((out, report))
 }

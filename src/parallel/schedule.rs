@@ -315,8 +315,11 @@ pub enum Step {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum When {
     Always,
-    /// The first round only: face planes, flags and quadrics of the input.
+    /// The first round only: face planes and flags of the input.
     FirstRound,
+    /// The first round, unless the quadrics were carried in (the hybrid method's clustering
+    /// hands over each cluster's quadric of the original surface).
+    FirstRoundQuadrics,
     /// Repeated as the round's [`crate::parallel::Selection`] says.
     EachSelectionPass,
     /// When the round trims its winners to land on the target (`Params::trim`).
@@ -338,7 +341,9 @@ pub const ADJACENCY: &[Step] = &[
     Run(&ADJACENCY_SORT),
 ];
 /// The first round's set-up.
-pub const SETUP: &[Step] = &[Run(&FACE_PLANES), Run(&VERTEX_FLAGS), Run(&VERTEX_QUADRICS)];
+pub const SETUP: &[Step] = &[Run(&FACE_PLANES), Run(&VERTEX_FLAGS)];
+/// The input's vertex quadrics.
+pub const SETUP_QUADRICS: &[Step] = &[Run(&VERTEX_QUADRICS)];
 /// Unique edges, and the indirect grids over them.
 pub const EDGES: &[Step] = &[
     Run(&EDGES_COUNT),
@@ -402,6 +407,7 @@ pub const APPLY: &[Step] = &[
 pub const ROUND: &[(When, &[Step])] = &[
     (When::Always, ADJACENCY),
     (When::FirstRound, SETUP),
+    (When::FirstRoundQuadrics, SETUP_QUADRICS),
     (When::Always, EDGES),
     (When::Always, ERRORS),
     (When::Always, CEILING),

@@ -1,0 +1,639 @@
+//! Vertex clustering: `cluster` (a uniform grid, Rossignac & Borrel 1993, with one quadric per
+//! cell placed at its minimum inside the cell, Lindstrom 2000 and Lindstrom & Silva 2001) and
+//! `hybrid` (clustering to an intermediate count, then the QEM rounds with each cluster's
+//! quadric carried over, Garland & Shaffer 2002). Every stage is a map, a sort or a gather
+//! (stages.rs); the grid's size is searched by counting passes (grid.rs).
+//!
+//! Attributes are not kept apart: a cluster's vertex takes the UV, normal and colour of its
+//! member nearest to it, so UV seams inside a cell close (as meshoptimizer's sloppy
+//! simplifier's do). `qem` keeps seams.
+
+pub mod grid;
+pub mod stages;
+
+use crate::cpu::common::{V3, xyz};
+use crate::error::{Error, Result};
+use crate::gpu::types::Quadric;
+use crate::mesh::Mesh;
+use crate::mesh::prepare::{denormalize, frame_of, normalize};
+use crate::options::{Backend, ClusterReport, Method, SimplifyOptions, SimplifyReport, StopReason};
+use grid::Grid;
+use rayon::prelude::*;
+use stages::{Cells, Clusters, Csr, Placed, Placement};
+use std::time::Instant;
+
+/// `cluster` lands within this share of the target.
+pub const BAND: f64 = 0.05;
+/// `hybrid` clusters to this many times the target, then the rounds take over...
+pub const HYBRID_FACTOR: f64 = 2.0;
+/// ...but to no fewer than this share of the input's faces: cells coarse enough for 2% of the
+/// 1M scan left errors the rounds could not undo (mean 1.38× the greedy's at 1%, against
+/// 1.10× from 5%; docs/PERFORMANCE.md, "hybrid").
+pub const HYBRID_MIN_SHARE: f64 = 0.05;
+/// ...unless that is more than this share of the input: merging only pairs of vertices costs a
+/// clustering without saving rounds, so the rounds start from the input.
+pub const HYBRID_SKIP: f64 = 0.5;
+
+/// The points clustering works on, in the unit-diagonal frame.
+struct Points<'m> {
+    positions: Vec<[f32; 4]>,
+    faces: std::borrow::Cow<'m, [[u32; 3]]>,
+    /// Per point: an input vertex (its attributes, its exact position).
+    attr: Vec<u32>,
+    lo: V3,
+    hi: V3,
+    center: [f64; 3],
+    scale: f64,
+    area: f64,
+}
+
+impl<'m> Points<'m> {
+    /// The input's vertices as they are: coincident ones share a cell anyway, and the
+    /// connectivity split joins them.
+    fn new(mesh: &'m Mesh) -> Points<'m> {
+        let (center, scale) = frame_of(mesh);
+        let attr: Vec<u32> = (0..mesh.positions.len() as u32).collect();
+        let faces = mesh.triangles.as_slice().into();
+        let positions: Vec<[f32; 4]> = attr
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&v| {
+                let q = normalize(mesh.positions[v as usize], center, scale);
+                [q[0] as f32, q[1] as f32, q[2] as f32, 1.0]
+            })
+            .collect();
+        let (lo, hi) = positions
+            .par_iter()
+            .with_min_len(4096)
+            .fold(
+                || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+                |(lo, hi), p| {
+                    (
+                        [0, 1, 2].map(|i| lo[i].min(p[i])),
+                        [0, 1, 2].map(|i| hi[i].max(p[i])),
+                    )
+                },
+            )
+            .reduce(
+                || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+                |a, b| {
+                    (
+                        [0, 1, 2].map(|i| a.0[i].min(b.0[i])),
+                        [0, 1, 2].map(|i| a.1[i].max(b.1[i])),
+                    )
+                },
+            );
+        Points {
+            positions,
+            faces,
+            attr,
+            lo,
+            hi,
+            center,
+            scale,
+            area: 0.0,
+        }
+    }
+}
+
+/// One clustering at a given grid.
+struct Built {
+    placed: Vec<Placed>,
+    faces: Vec<(u32, [u32; 3])>,
+    vertex_cluster: Vec<u32>,
+    clusters: usize,
+    cells: usize,
+}
+
+struct Work<'a, 'm> {
+    pts: &'a Points<'m>,
+    /// `hybrid`: the vertex→face lists, face planes and border vertices its gather and its
+    /// connectivity split read; `cluster` scatters its quadrics without them.
+    gather: Option<Gather>,
+    border_weight: f32,
+    /// Per point: clustered with nobody (a locked border; a hybrid cluster that made a
+    /// non-manifold edge, taken apart).
+    locked: Vec<bool>,
+}
+
+struct Gather {
+    csr: Csr,
+    planes: Vec<[f32; 4]>,
+    border: Vec<bool>,
+}
+
+impl Work<'_, '_> {
+    fn build(&self, grid: &Grid) -> Built {
+        let keys = stages::cell_keys(grid, &self.pts.positions, &self.locked);
+        let (sorted, members) = stages::radix_sort(&keys);
+        drop(keys);
+        let cells: Cells = stages::cell_ranges(&sorted, members);
+        let (clusters, label) = match &self.gather {
+            Some(g) => {
+                let _ = g;
+                let label = stages::cell_labels(&cells, &self.pts.faces, &self.pts.positions);
+                (Clusters::split(&cells, &label), Some(label))
+            }
+            None => (Clusters::whole_cells(&cells), None),
+        };
+        // Each cluster's box: its cell's, or its vertex for a singleton.
+        let boxes: Vec<(V3, V3)> = (0..clusters.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|k| {
+                let key = cells.key[clusters.cell[k] as usize];
+                if key == stages::SINGLETON {
+                    let m = cells.members[cells.start[clusters.cell[k] as usize] as usize];
+                    let p = xyz(self.pts.positions[m as usize]);
+                    (p, p)
+                } else {
+                    grid.cell_box(key)
+                }
+            })
+            .collect();
+        let centre = |k: usize| [0, 1, 2].map(|i| 0.5 * (boxes[k].0[i] + boxes[k].1[i]));
+        let scattered = match &self.gather {
+            Some(_) => None,
+            None => {
+                let origins: Vec<V3> = (0..clusters.len()).map(centre).collect();
+                Some(stages::scatter_quadrics(
+                    &self.pts.positions,
+                    &self.pts.faces,
+                    &clusters.vertex_cluster,
+                    &origins,
+                ))
+            }
+        };
+        let placed: Vec<Placed> = (0..clusters.len())
+            .into_par_iter()
+            .with_min_len(256)
+            .map_init(Vec::new, |members, k| {
+                members.clear();
+                members.extend(clusters.members(&cells, label.as_deref(), k));
+                let (lo, hi) = boxes[k];
+                match (&self.gather, &scattered) {
+                    (Some(g), _) => {
+                        let surface = stages::Surface {
+                            positions: &self.pts.positions,
+                            faces: &self.pts.faces,
+                            planes: &g.planes,
+                            csr: &g.csr,
+                            border: &g.border,
+                            border_weight: self.border_weight,
+                        };
+                        stages::cluster_quadric(&surface, members, centre(k), lo, hi)
+                    }
+                    (None, Some(q)) => {
+                        stages::place(&self.pts.positions, q[k], members, centre(k), lo, hi)
+                    }
+                    (None, None) => unreachable!("cluster quadrics scattered without a gather"),
+                }
+            })
+            .collect();
+        let faces = stages::cluster_faces(
+            &self.pts.faces,
+            &clusters.vertex_cluster,
+            clusters.len(),
+            self.gather.is_some(),
+        );
+        Built {
+            placed,
+            faces,
+            clusters: clusters.len(),
+            vertex_cluster: clusters.vertex_cluster,
+            cells: cells.key.len(),
+        }
+    }
+}
+
+/// The grid size a face count suggests: on a surface about `3 area / h²` faces survive
+/// (occupied cells ≈ 1.5 area / h², two faces a cell).
+fn estimate(area: f64, faces: usize) -> f32 {
+    (3.0 * area / faces.max(1) as f64).sqrt() as f32
+}
+
+/// `hybrid` takes clusters on non-manifold edges apart at most this many times.
+const MAX_REPAIRS: usize = 4;
+
+/// The clusters at either end of an edge that more than two faces share, or that two faces
+/// run the same way (a fold), sorted.
+fn pinched_clusters(b: &Built) -> Vec<u32> {
+    let mut half: Vec<(u64, bool)> = b
+        .faces
+        .par_iter()
+        .flat_map_iter(|(_, t)| {
+            (0..3).map(move |i| {
+                let (a, c) = (t[i], t[(i + 1) % 3]);
+                (((a.min(c) as u64) << 32) | a.max(c) as u64, a < c)
+            })
+        })
+        .collect();
+    half.par_sort_unstable();
+    let mut bad = Vec::new();
+    let mut i = 0;
+    while i < half.len() {
+        let mut j = i + 1;
+        while j < half.len() && half[j].0 == half[i].0 {
+            j += 1;
+        }
+        let pinched = j - i > 2 || (j - i == 2 && half[i].1 == half[i + 1].1);
+        if pinched {
+            bad.push((half[i].0 >> 32) as u32);
+            bad.push(half[i].0 as u32);
+        }
+        i = j;
+    }
+    bad.sort_unstable();
+    bad.dedup();
+    bad
+}
+
+/// Builds at most this many times to land in the band.
+const MAX_BUILDS: usize = 4;
+
+/// Clusters to about `target` faces: within [`BAND`] of it, or (`floor`, the hybrid) at least
+/// `floor`. `--max-error` caps the cell so that no vertex moves farther than it. One sampled
+/// counting pass fits faces against cell size (a power law, faces ∝ h⁻² on a surface); each
+/// build's own count then corrects the size, by the secant through the last two builds in
+/// log-log once there are two.
+fn cluster_to(
+    work: &Work,
+    target: usize,
+    max_error: Option<f64>,
+    floor: Option<usize>,
+    report: &mut ClusterReport,
+) -> (Grid, Built, StopReason) {
+    let pts = work.pts;
+    let (lo, hi) = (pts.lo, pts.hi);
+    let t = target.max(1) as f64;
+    // A vertex moves at most a cell's diagonal, √3 h.
+    let h_cap = max_error.map(|e| (e / 3f64.sqrt()) as f32);
+    let h0 = estimate(pts.area, target) as f64;
+    // About 2,000 sampled faces survive at the estimate: their count is within a few percent.
+    let stride = (target / 2000).clamp(1, 8);
+    let grids: Vec<Grid> = [0.85, 0.95, 1.05, 1.15]
+        .iter()
+        .map(|k| Grid::new(lo, hi, (k * h0) as f32))
+        .collect();
+    let counts = grid::probe_sampled(&grids, &pts.positions, &work.locked, &pts.faces, stride);
+    report.sizes_counted += grids.len();
+    let probed: Vec<(f64, f64)> = grids
+        .iter()
+        .zip(&counts)
+        .map(|(g, &n)| (g.h as f64, n as f64))
+        .collect();
+    let mut h = grid::fit(&probed, t).unwrap_or(h0);
+    let mut stop = StopReason::TargetReached;
+    let mut builds: Vec<(f64, f64)> = Vec::new();
+    let mut best: Option<(Grid, Built)> = None;
+    for _ in 0..MAX_BUILDS {
+        let mut grid = Grid::new(lo, hi, h as f32);
+        if let Some(cap) = h_cap
+            && (grid.h > cap || target == 0)
+        {
+            grid = Grid::new(lo, hi, cap);
+            stop = StopReason::MaxError;
+        }
+        let built = work.build(&grid);
+        report.builds += 1;
+        let n = built.faces.len() as f64;
+        let ok = |n: f64| match floor {
+            Some(f) => n >= f as f64,
+            None => (n - t).abs() <= BAND * t,
+        };
+        let done = stop == StopReason::MaxError || ok(n);
+        let closer = best.as_ref().is_none_or(|(_, b)| {
+            let m = b.faces.len() as f64;
+            match (ok(n), ok(m)) {
+                (true, false) => true,
+                (false, true) => false,
+                _ => (n - t).abs() < (m - t).abs(),
+            }
+        });
+        if closer {
+            best = Some((grid, built));
+        }
+        if done {
+            break;
+        }
+        builds.push((grid.h as f64, n));
+        // The secant through the last two builds, else the probes' slope through this one.
+        let next = match builds.len() {
+            1 => {
+                let shifted: Vec<(f64, f64)> = probed
+                    .iter()
+                    .map(|&(ph, pn)| (ph, pn * n.max(1.0) / count_at(&probed, grid.h as f64)))
+                    .collect();
+                grid::fit(&shifted, t)
+            }
+            _ => grid::fit(&builds[builds.len() - 2..], t),
+        };
+        let Some(next) = next.filter(|x| (x / grid.h as f64 - 1.0).abs() > 1e-4) else {
+            break;
+        };
+        h = next;
+    }
+    let (grid, built) = best.expect("one build at least");
+    let n = built.faces.len() as f64;
+    if stop == StopReason::TargetReached && floor.is_none() && (n - t).abs() > BAND * t {
+        stop = StopReason::ClusterBand;
+    }
+    (grid, built, stop)
+}
+
+/// The probes' count at `h`, interpolated in log-log between the nearest two.
+fn count_at(probed: &[(f64, f64)], h: f64) -> f64 {
+    let fitted = |target: f64| grid::fit(probed, target);
+    // Invert the fit by bisection on the count (monotone where the fit exists).
+    let (mut a, mut b) = (1.0f64, 1e9f64);
+    for _ in 0..60 {
+        let m = (a * b).sqrt();
+        match fitted(m) {
+            Some(hm) if hm > h => a = m,
+            Some(_) => b = m,
+            None => return 1.0,
+        }
+    }
+    (a * b).sqrt()
+}
+
+/// What to hand out: the mesh (vertices at the clusters, attributes of the nearest member,
+/// unused clusters dropped) and each output vertex's quadric.
+fn output(mesh: &Mesh, pts: &Points, b: &Built) -> (Mesh, Vec<Quadric>) {
+    let mut id = vec![u32::MAX; b.clusters];
+    let mut order = Vec::new();
+    for (_, t) in &b.faces {
+        for &k in t {
+            if id[k as usize] == u32::MAX {
+                id[k as usize] = order.len() as u32;
+                order.push(k);
+            }
+        }
+    }
+    let src = |k: u32| pts.attr[b.placed[k as usize].attr as usize] as usize;
+    let mut out = mesh.clone_without_geometry();
+    out.positions = order
+        .par_iter()
+        .map(|&k| {
+            let p = &b.placed[k as usize];
+            if p.how == Placement::Single {
+                mesh.positions[src(k)]
+            } else {
+                let q = p.pos.map(|x| x as f64);
+                denormalize(q, pts.center, pts.scale)
+            }
+        })
+        .collect();
+    out.normals = mesh
+        .normals
+        .as_ref()
+        .map(|n| order.iter().map(|&k| n[src(k)]).collect());
+    out.uvs = mesh
+        .uvs
+        .as_ref()
+        .map(|n| order.iter().map(|&k| n[src(k)]).collect());
+    out.colors = mesh
+        .colors
+        .as_ref()
+        .map(|n| order.iter().map(|&k| n[src(k)]).collect());
+    out.triangles = b
+        .faces
+        .iter()
+        .map(|(_, t)| t.map(|k| id[k as usize]))
+        .collect();
+    out.face_materials = mesh
+        .face_materials
+        .as_ref()
+        .map(|m| b.faces.iter().map(|(f, _)| m[*f as usize]).collect());
+    out.face_groups = mesh
+        .face_groups
+        .as_ref()
+        .map(|g| b.faces.iter().map(|(f, _)| g[*f as usize]).collect());
+    let quadrics = order
+        .iter()
+        .map(|&k| b.placed[k as usize].quadric)
+        .collect();
+    (out, quadrics)
+}
+
+fn tally(report: &mut ClusterReport, b: &Built) {
+    report.clusters = b.clusters;
+    report.split_clusters = b.clusters - b.cells;
+    for p in &b.placed {
+        match p.how {
+            Placement::Single => report.placed_single += 1,
+            Placement::Solve => report.placed_solve += 1,
+            Placement::Member => report.placed_member += 1,
+            Placement::Centroid => report.placed_centroid += 1,
+        }
+    }
+}
+
+/// The largest cluster error, as an RMS distance relative to the diagonal.
+fn max_error(b: &Built) -> f64 {
+    b.placed
+        .iter()
+        .filter(|p| p.quadric.q[2][2] > 0.0)
+        .map(|p| (p.quadric.q[2][1].max(0.0) / p.quadric.q[2][2]) as f64)
+        .fold(0.0, f64::max)
+        .sqrt()
+}
+
+/// The surface area in the unit-diagonal frame, summed in fixed chunks (the same for any
+/// thread count, as the grid search that starts from it must be).
+fn area(positions: &[[f32; 4]], faces: &[[u32; 3]]) -> f64 {
+    let parts: Vec<f64> = faces
+        .par_chunks(16384)
+        .map(|part| {
+            part.iter()
+                .map(|t| {
+                    let p = t.map(|v| xyz(positions[v as usize]));
+                    let c = crate::cpu::common::cross(
+                        crate::cpu::common::sub(p[1], p[0]),
+                        crate::cpu::common::sub(p[2], p[0]),
+                    );
+                    0.5 * crate::cpu::common::length(c) as f64
+                })
+                .sum::<f64>()
+        })
+        .collect();
+    parts.iter().sum()
+}
+
+/// `split` (hybrid): build the vertex→face lists, face planes and border vertices.
+fn prepare<'a, 'm>(pts: &'a mut Points<'m>, opts: &SimplifyOptions, split: bool) -> Work<'a, 'm> {
+    let gather = (split || opts.lock_border).then(|| {
+        let csr = Csr::new(pts.positions.len(), &pts.faces);
+        let planes = stages::face_planes(&pts.positions, &pts.faces);
+        let border = border_vertices(&csr, &pts.faces);
+        Gather {
+            csr,
+            planes,
+            border,
+        }
+    });
+    pts.area = area(&pts.positions, &pts.faces);
+    let locked = match &gather {
+        Some(g) if opts.lock_border => g.border.clone(),
+        _ => vec![false; pts.positions.len()],
+    };
+    Work {
+        pts,
+        gather: gather.filter(|_| split),
+        border_weight: opts.border_weight as f32,
+        locked,
+    }
+}
+
+/// Vertices on an edge of one face.
+fn border_vertices(csr: &Csr, faces: &[[u32; 3]]) -> Vec<bool> {
+    (0..csr.offsets.len() as u32 - 1)
+        .into_par_iter()
+        .map(|v| {
+            let list = csr.faces_of(v);
+            list.iter().any(|&f| {
+                faces[f as usize].iter().any(|&u| {
+                    u != v
+                        && list
+                            .iter()
+                            .filter(|&&g| faces[g as usize].contains(&u))
+                            .count()
+                            == 1
+                })
+            })
+        })
+        .collect()
+}
+
+fn check_backend(opts: &SimplifyOptions) -> Result<Backend> {
+    match opts.backend {
+        Backend::Cpu | Backend::CpuParallel | Backend::Auto => Ok(Backend::CpuParallel),
+        Backend::Gpu => Err(Error::InvalidOption(format!(
+            "--method {} runs on the CPU only so far (backend cpu-parallel); the gpu backend \
+             runs --method qem",
+            opts.method.name()
+        ))),
+        #[allow(unreachable_patterns)]
+        _ => Ok(Backend::CpuParallel),
+    }
+}
+
+/// `--method cluster`.
+pub fn simplify_cluster(
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport)> {
+    let backend = check_backend(opts)?;
+    let t = Instant::now();
+    let mut pts = Points::new(mesh);
+    let work = prepare(&mut pts, opts, false);
+    progress(0.2);
+    let mut report = ClusterReport {
+        method: Method::Cluster,
+        ..Default::default()
+    };
+    let (grid, built, stop) =
+        cluster_to(&work, opts.target_faces, opts.max_error, None, &mut report);
+    opts.cancel.check()?;
+    progress(0.9);
+    tally(&mut report, &built);
+    report.cell_size = grid.h as f64;
+    let (out, _) = output(mesh, work.pts, &built);
+    report.seconds = t.elapsed().as_secs_f64();
+    let report = SimplifyReport {
+        backend,
+        auto: None,
+        input_faces: mesh.triangles.len(),
+        target_faces: opts.target_faces,
+        output_faces: out.triangles.len(),
+        input_vertices: mesh.positions.len(),
+        output_vertices: out.positions.len(),
+        collapses: mesh.positions.len().saturating_sub(out.positions.len()),
+        max_collapse_error: max_error(&built),
+        stop_reason: stop,
+        dropped_degenerate_faces: 0,
+        pinned_vertices: 0,
+        rounds: None,
+        blocked: None,
+        clustering: Some(report),
+    };
+    Ok((out, report))
+}
+
+/// `--method hybrid`.
+pub fn simplify_hybrid(
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport)> {
+    let backend = check_backend(opts)?;
+    let opts = &SimplifyOptions {
+        backend,
+        ..opts.clone()
+    };
+    let t = Instant::now();
+    let intermediate = ((opts.target_faces as f64 * HYBRID_FACTOR)
+        .max(HYBRID_MIN_SHARE * mesh.triangles.len() as f64))
+    .round() as usize;
+    let mut report = ClusterReport {
+        method: Method::Hybrid,
+        ..Default::default()
+    };
+    let (up, built_error) = if intermediate as f64 >= HYBRID_SKIP * mesh.triangles.len() as f64
+        || opts.target_faces == 0
+    {
+        (crate::parallel::Upload::new(mesh), 0.0)
+    } else {
+        let mut pts = Points::new(mesh);
+        let mut work = prepare(&mut pts, opts, true);
+        let (grid, mut built, _) = cluster_to(
+            &work,
+            intermediate,
+            None,
+            Some(opts.target_faces),
+            &mut report,
+        );
+        // Splitting cells by connectivity keeps separate sheets apart, but a sheet folded
+        // inside one cell can still pinch into a non-manifold edge: take the clusters on one
+        // apart (their members each their own cluster) and build again, until none is left.
+        for _ in 0..MAX_REPAIRS {
+            let bad = pinched_clusters(&built);
+            if bad.is_empty() {
+                break;
+            }
+            for (v, &k) in built.vertex_cluster.iter().enumerate() {
+                if bad.binary_search(&k).is_ok() {
+                    work.locked[v] = true;
+                }
+            }
+            built = work.build(&grid);
+            report.builds += 1;
+            report.repaired_clusters += bad.len();
+        }
+        tally(&mut report, &built);
+        report.cell_size = grid.h as f64;
+        report.intermediate_faces = Some(built.faces.len());
+        let (clustered, quadrics) = output(mesh, work.pts, &built);
+        let frame = (work.pts.center, work.pts.scale);
+        (
+            crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics),
+            max_error(&built),
+        )
+    };
+    report.seconds = t.elapsed().as_secs_f64();
+    opts.cancel.check()?;
+    let mut runner = crate::cpu::CpuRounds::new(&up, crate::parallel::SELECTION_PASSES);
+    let (out, mut r) = crate::parallel::simplify_rounds(
+        &mut runner,
+        &up,
+        mesh,
+        opts,
+        progress,
+        Default::default(),
+    )?;
+    r.max_collapse_error = r.max_collapse_error.max(built_error);
+    r.collapses = mesh.positions.len().saturating_sub(out.positions.len());
+    r.clustering = Some(report);
+    Ok((out, r))
+}

@@ -1,0 +1,212 @@
+//! The clustering methods (`cluster`, `hybrid`) and their stages, on generated meshes with
+//! known answers.
+
+use meshslim::cluster::grid::Grid;
+use meshslim::cluster::stages;
+use meshslim::mesh::{grid, icosphere, topology, torus};
+use meshslim::{Backend, Error, Mesh, Method, SimplifyOptions, StopReason, simplify};
+
+fn opts(faces: usize, method: Method) -> SimplifyOptions {
+    let mut o = SimplifyOptions::with_faces(faces);
+    o.method = method;
+    o.backend = Backend::CpuParallel;
+    o
+}
+
+/// A flat sheet of `n`×`n` quads over the unit square at height `z`.
+fn sheet(n: usize, z: f32) -> Mesh {
+    let mut m = grid(n);
+    let b = m.bounds().unwrap();
+    for p in &mut m.positions {
+        p[0] = (p[0] - b.min[0]) / (b.max[0] - b.min[0]);
+        p[1] = (p[1] - b.min[1]) / (b.max[1] - b.min[1]);
+        p[2] = z;
+    }
+    m
+}
+
+fn join(a: &Mesh, b: &Mesh) -> Mesh {
+    let n = a.positions.len() as u32;
+    let mut positions = a.positions.clone();
+    positions.extend_from_slice(&b.positions);
+    let mut triangles = a.triangles.clone();
+    triangles.extend(b.triangles.iter().map(|t| t.map(|v| v + n)));
+    Mesh::new(positions, triangles)
+}
+
+#[test]
+fn the_radix_sort_is_the_stable_sort_by_key() {
+    let keys: Vec<u32> = (0..5000u32)
+        .map(|i| (i.wrapping_mul(2_654_435_761) % 70_000) | ((i % 3) << 24))
+        .collect();
+    let (sorted, ids) = stages::radix_sort(&keys);
+    let mut want: Vec<u32> = (0..keys.len() as u32).collect();
+    want.sort_by_key(|&i| keys[i as usize]);
+    assert_eq!(ids, want);
+    assert!(sorted.windows(2).all(|w| w[0] <= w[1]));
+}
+
+#[test]
+fn a_grid_of_countable_cells_keeps_the_faces_between_them() {
+    // The unit square with 8×8 quads (vertices every 1/8), on cells of side 0.27 from
+    // -1/16: each cell holds a 2×2 block of vertices (3 along the far walls), 4×4 cells.
+    let m = sheet(8, 0.0);
+    let positions: Vec<[f32; 4]> = m
+        .positions
+        .iter()
+        .map(|p| [p[0], p[1], p[2], 1.0])
+        .collect();
+    // Shift the grid by half a vertex spacing so no vertex sits on a cell wall.
+    let g = Grid::new([-1.0 / 16.0, -1.0 / 16.0, 0.0], [1.0, 1.0, 0.0], 0.27);
+    let keys = stages::cell_keys(&g, &positions, &vec![false; positions.len()]);
+    let (sorted, members) = stages::radix_sort(&keys);
+    let cells = stages::cell_ranges(&sorted, members);
+    assert_eq!(cells.key.len(), 16, "4 x 4 occupied cells");
+    let clusters = stages::Clusters::whole_cells(&cells);
+    let faces = stages::cluster_faces(
+        &m.triangles,
+        &clusters.vertex_cluster,
+        clusters.len(),
+        false,
+    );
+    // A 4×4 grid of cluster vertices is a 3×3 grid of quads: 18 triangles, each from the one
+    // input quad with a corner in each of four cells.
+    assert_eq!(faces.len(), 18);
+}
+
+#[test]
+fn cluster_lands_within_five_percent_of_the_target() {
+    let m = icosphere(6); // 81,920 faces
+    for target in [20_000, 5_000, 800] {
+        let (out, r) = simplify(&m, &opts(target, Method::Cluster)).unwrap();
+        out.validate().unwrap();
+        let n = out.triangles.len() as f64;
+        assert!(
+            (n - target as f64).abs() <= 0.05 * target as f64,
+            "{n} faces for {target}"
+        );
+        assert_eq!(r.stop_reason, StopReason::TargetReached);
+        assert_eq!(r.output_faces, out.triangles.len());
+        let c = r.clustering.expect("a clustering report");
+        assert!(c.builds >= 1 && c.clusters >= out.positions.len());
+        // Every output vertex lies within a cell's diagonal of the sphere (radius 1; the
+        // cell size is relative to the box's diagonal, 2√3).
+        let side = c.cell_size * 2.0 * 3f64.sqrt();
+        for p in &out.positions {
+            let r = (p[0] as f64).hypot(p[1] as f64).hypot(p[2] as f64);
+            assert!(
+                (r - 1.0).abs() <= 3f64.sqrt() * side,
+                "vertex at radius {r}"
+            );
+        }
+    }
+}
+
+#[test]
+fn hybrid_reaches_the_exact_target_and_keeps_a_manifold_manifold() {
+    let mut m = torus(1.0, 0.3, 256, 96); // 49,152 faces, genus 1
+    meshslim::mesh::add_noise(&mut m, 0.002, 7);
+    for target in [4000, 600] {
+        let (out, r) = simplify(&m, &opts(target, Method::Hybrid)).unwrap();
+        out.validate().unwrap();
+        assert!(
+            out.triangles.len() <= target && out.triangles.len() + 2 >= target,
+            "{} faces for {target}",
+            out.triangles.len()
+        );
+        let c = r.clustering.expect("a clustering report");
+        assert!(c.intermediate_faces.unwrap() >= target);
+        let t = topology(&out);
+        assert_eq!(t.non_manifold_edges, 0, "target {target}");
+        assert_eq!(t.euler_characteristic, 0, "still a torus at {target}");
+    }
+}
+
+#[test]
+fn hybrid_keeps_two_sheets_closer_than_a_cell_apart() {
+    // Two parallel sheets 0.02 apart (about 1.4% of the diagonal); clustering at 20% of the
+    // faces uses cells several times that, so plain cells would merge the sheets.
+    let m = join(&sheet(60, 0.0), &sheet(60, 0.02));
+    let faces = m.triangles.len();
+    let (out, r) = simplify(&m, &opts(faces / 40, Method::Hybrid)).unwrap();
+    let c = r.clustering.unwrap();
+    assert!(
+        c.cell_size > 0.02 / 1.42,
+        "cells of {} do span the gap",
+        c.cell_size
+    );
+    assert!(c.split_clusters > 0, "cells were split by connectivity");
+    let t = topology(&out);
+    assert_eq!(t.connected_components, 2, "the sheets stay apart");
+    assert_eq!(t.non_manifold_edges, 0);
+    // And the plain grid does join them.
+    let (joined, _) = simplify(&m, &opts(faces / 40, Method::Cluster)).unwrap();
+    let zs: Vec<f32> = joined.positions.iter().map(|p| p[2]).collect();
+    assert!(
+        zs.iter().any(|&z| z > 0.002 && z < 0.018),
+        "cluster puts vertices between the sheets"
+    );
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let mut m = icosphere(5);
+    meshslim::mesh::add_noise(&mut m, 0.01, 3);
+    for method in [Method::Cluster, Method::Hybrid] {
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| simplify(&m, &opts(2000, method)).unwrap().0)
+        };
+        let (a, b, c) = (run(1), run(2), run(3));
+        assert_eq!(a.triangles, b.triangles, "{method:?}");
+        assert_eq!(a.positions, b.positions, "{method:?}");
+        assert_eq!(a.triangles, c.triangles, "{method:?}");
+        assert_eq!(a.positions, c.positions, "{method:?}");
+    }
+}
+
+#[test]
+fn max_error_bounds_the_cell() {
+    let m = icosphere(5);
+    let mut o = opts(0, Method::Cluster);
+    o.max_error = Some(0.02);
+    let (out, r) = simplify(&m, &o).unwrap();
+    assert_eq!(r.stop_reason, StopReason::MaxError);
+    let c = r.clustering.unwrap();
+    assert!(c.cell_size * 3f64.sqrt() <= 0.02 + 1e-6);
+    // Every output vertex within the bound (relative to the diagonal, 2√3) of the sphere.
+    let diag = 2.0 * 3f64.sqrt();
+    for p in &out.positions {
+        let r = (p[0] as f64).hypot(p[1] as f64).hypot(p[2] as f64);
+        assert!((r - 1.0).abs() <= 0.02 * diag, "vertex at radius {r}");
+    }
+}
+
+#[test]
+fn clustering_on_the_gpu_backend_is_refused_with_a_clear_message() {
+    let mut o = opts(100, Method::Cluster);
+    o.backend = Backend::Gpu;
+    match simplify(&icosphere(3), &o) {
+        Err(Error::InvalidOption(msg)) => assert!(msg.contains("cpu-parallel"), "{msg}"),
+        other => panic!("expected an invalid option, got {other:?}"),
+    }
+}
+
+#[test]
+fn a_locked_border_stays_where_it_was() {
+    let m = sheet(40, 0.0);
+    let mut o = opts(800, Method::Cluster);
+    o.lock_border = true;
+    let (out, _) = simplify(&m, &o).unwrap();
+    out.validate().unwrap();
+    // Every input border vertex is still an output vertex, bit for bit.
+    for p in &m.positions {
+        let on_border = p[0] == 0.0 || p[0] == 1.0 || p[1] == 0.0 || p[1] == 1.0;
+        if on_border {
+            assert!(out.positions.contains(p), "border vertex {p:?} moved");
+        }
+    }
+}
