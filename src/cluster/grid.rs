@@ -2,10 +2,12 @@
 //! integer resolution, whose steps near 20 cells an axis move the face count by ~10%, more than
 //! the ±5% band) found by counting passes (`cluster_probe`), four sizes a pass.
 
-use super::stages::SINGLETON;
 use crate::cpu::common::{V3, xyz};
 use crate::mesh::morton::morton3;
 use rayon::prelude::*;
+
+/// A singleton key (a locked vertex, clustered with nobody): above every Morton cell key.
+pub const SINGLETON: u32 = 1 << 31;
 
 /// Cells an axis at most: keys are 30-bit Morton codes.
 pub const MAX_CELLS: u32 = 1024;

@@ -5,15 +5,13 @@
 //! not depend on the thread count, and integer outputs depend on positions and keys alone.
 
 use super::grid::Grid;
+pub use super::grid::SINGLETON;
 use crate::cpu::common::{
     V3, add, cross, dot, length, quadric_add, quadric_eval, quadric_from_plane, quadric_shift,
     scale, sub, xyz,
 };
 use crate::gpu::types::Quadric;
 use rayon::prelude::*;
-
-/// A singleton key (a locked vertex, clustered with nobody): above every Morton cell key.
-pub const SINGLETON: u32 = 1 << 31;
 
 /// The vertex→face lists (CSR): `faces_of(v) = vertex_faces[offsets[v]..offsets[v + 1]]`, each
 /// list in increasing face order, the order the GPU's `adjacency_sort` leaves.
