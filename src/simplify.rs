@@ -30,11 +30,7 @@ pub fn simplify_with_progress(
         Method::Qem => {}
         Method::Cluster => return crate::cluster::simplify_cluster(mesh, opts, progress),
         Method::Hybrid => return crate::cluster::simplify_hybrid(mesh, opts, progress),
-        Method::FloatingCell => {
-            return Err(Error::InvalidOption(
-                "--method floating-cell is not built yet".into(),
-            ));
-        }
+        Method::FloatingCell => return crate::cluster::simplify_floating(mesh, opts, progress),
     }
     let (chosen, mut auto) = match opts.backend {
         Backend::Auto => {

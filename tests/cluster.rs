@@ -2,7 +2,7 @@
 //! known answers.
 
 use meshslim::cluster::grid::Grid;
-use meshslim::cluster::stages;
+use meshslim::cluster::{floating, stages};
 use meshslim::mesh::{grid, icosphere, topology, torus};
 use meshslim::{Backend, Error, Mesh, Method, SimplifyOptions, StopReason, simplify};
 
@@ -209,4 +209,81 @@ fn a_locked_border_stays_where_it_was() {
             assert!(out.positions.contains(p), "border vertex {p:?} moved");
         }
     }
+}
+
+#[test]
+fn floating_cells_in_rounds_are_the_sequential_greedy() {
+    // Low & Tan's sequential rule: the highest-ranked unclaimed vertex becomes a centre and
+    // claims the unclaimed vertices within its radius. The parallel rounds must pick the same centres
+    // and the same claims.
+    let mut m = icosphere(4);
+    meshslim::mesh::add_noise(&mut m, 0.02, 11);
+    let positions: Vec<[f32; 4]> = m
+        .positions
+        .iter()
+        .map(|p| [p[0], p[1], p[2], 1.0])
+        .collect();
+    let csr = stages::Csr::new(positions.len(), &m.triangles);
+    let ranks = floating::ranks(&floating::grades(&positions, &m.triangles, &csr));
+    let locked = vec![false; positions.len()];
+    for r in [0.05f32, 0.15, 0.4] {
+        let (centre, rounds) = floating::claim(&positions, &ranks, &locked, [-1.1; 3], [1.1; 3], r);
+        let mut order: Vec<usize> = (0..positions.len()).collect();
+        order.sort_by_key(|&v| std::cmp::Reverse(ranks[v]));
+        let mut want = vec![u32::MAX; positions.len()];
+        for &v in &order {
+            if want[v] != u32::MAX {
+                continue;
+            }
+            let rv = floating::radius(r, v as u32);
+            for u in 0..positions.len() {
+                let d: f32 = (0..3)
+                    .map(|i| (positions[u][i] - positions[v][i]).powi(2))
+                    .sum();
+                if want[u] == u32::MAX && d <= rv * rv {
+                    want[u] = v as u32;
+                }
+            }
+        }
+        assert_eq!(centre, want, "radius {r}, {rounds} rounds");
+    }
+}
+
+#[test]
+fn floating_cells_land_in_the_band_and_keep_a_cubes_corners() {
+    let m = meshslim::mesh::cube(20); // 20×20 quads a side
+    let faces = m.triangles.len();
+    for target in [faces / 10, faces / 50] {
+        let (out, r) = simplify(&m, &opts(target, Method::FloatingCell)).unwrap();
+        out.validate().unwrap();
+        let n = out.triangles.len() as f64;
+        assert!(
+            (n - target as f64).abs() <= 0.05 * target as f64,
+            "{n} faces for {target}"
+        );
+        assert!(r.clustering.unwrap().centre_rounds.unwrap() >= 1);
+        let b = m.bounds().unwrap();
+        for i in 0..8 {
+            let corner = [0, 1, 2].map(|k| if i >> k & 1 == 0 { b.min[k] } else { b.max[k] });
+            let near = out
+                .positions
+                .iter()
+                .any(|p| (0..3).all(|k| (p[k] - corner[k]).abs() <= 1e-4 * (b.max[k] - b.min[k])));
+            assert!(near, "corner {corner:?} kept at {target} faces");
+        }
+    }
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                simplify(&m, &opts(faces / 10, Method::FloatingCell))
+                    .unwrap()
+                    .0
+            })
+    };
+    let (a, b) = (run(1), run(2));
+    assert_eq!(a.triangles, b.triangles);
+    assert_eq!(a.positions, b.positions);
 }

@@ -57,8 +57,17 @@ pub static BACKENDS: &[BenchBackend] = &[
         band: crate::cluster::BAND,
     },
     BenchBackend {
+        name: "floating-cell",
+        about: "meshslim's floating-cell vertex clustering, Low & Tan (cpu-parallel)",
+        simplify: |m, faces| {
+            Ok(crate::simplify(m, &with_method(faces, crate::Method::FloatingCell))?.0)
+        },
+        device: cpu_name,
+        band: crate::cluster::BAND,
+    },
+    BenchBackend {
         name: "hybrid",
-        about: "meshslim's clustering to twice the target, then the rounds (cpu-parallel)",
+        about: "meshslim's clustering to three times the target, then the rounds (cpu-parallel)",
         simplify: |m, faces| Ok(crate::simplify(m, &with_method(faces, crate::Method::Hybrid))?.0),
         device: cpu_name,
         band: 0.0,

@@ -138,7 +138,11 @@ pub enum MethodArg {
     /// Uniform-grid vertex clustering: the fastest, within 5% of the target; may join nearby
     /// sheets and change topology, and closes UV seams; for previews and far LODs
     Cluster,
-    /// Clustering to twice the target, then qem's rounds to the exact target with the
+    /// Low & Tan's floating cells: clusters centred on the most important vertices (tips,
+    /// creases), so features survive where a uniform grid cuts them; within 5% of the target,
+    /// slower than cluster, topology and UV seams as cluster
+    FloatingCell,
+    /// Clustering to three times the target, then qem's rounds to the exact target with the
     /// clusters' quadrics: near-qem error in a fraction of the time on large scans; closes UV
     /// seams (cpu-parallel)
     Hybrid,
@@ -149,6 +153,7 @@ impl MethodArg {
         match self {
             MethodArg::Qem => crate::Method::Qem,
             MethodArg::Cluster => crate::Method::Cluster,
+            MethodArg::FloatingCell => crate::Method::FloatingCell,
             MethodArg::Hybrid => crate::Method::Hybrid,
         }
     }

@@ -1,0 +1,239 @@
+//! Floating cells (Low & Tan, "Model Simplification Using Vertex-Clustering", 1997): vertices
+//! graded by importance; the most important unclaimed vertex becomes a cell centre and claims
+//! the unclaimed vertices within a radius. Run as parallel rounds: a vertex becomes a centre
+//! when it outranks every unclaimed vertex within twice the radius, found through a hash grid
+//! of cells twice the radius wide (the sorted cell keys of the uniform grid, searched by
+//! binary search). Two centres of one round are then more than twice the radius apart, so
+//! their claims never meet, and the rounds pick the centres the sequential greedy picks
+//! (tests/cluster.rs checks it). Each centre's radius is the nominal one spread by ±10%
+//! ([`radius`]); "within twice the radius" is then within the sum of the two radii.
+
+use super::grid::Grid;
+use super::stages::{self, Csr};
+use crate::cpu::common::{V3, dot, length, sub, tie_rank, xyz};
+use crate::mesh::morton::morton3;
+use rayon::prelude::*;
+
+/// Low & Tan's grade: `cos(θ/2)` for the widest angle θ between two edges at the vertex (a
+/// flat or straight-through vertex has θ near 180° and grades near 0, a tip or a crease
+/// corner grades high), times the longest edge there (a vertex among large faces stands for
+/// more surface). Gathered over the vertex's faces.
+pub fn grades(positions: &[[f32; 4]], faces: &[[u32; 3]], csr: &Csr) -> Vec<f32> {
+    (0..positions.len() as u32)
+        .into_par_iter()
+        .with_min_len(1024)
+        .map_init(Vec::new, |dirs: &mut Vec<V3>, v| {
+            let pv = xyz(positions[v as usize]);
+            dirs.clear();
+            let mut longest = 0.0f32;
+            for &f in csr.faces_of(v) {
+                for u in faces[f as usize] {
+                    if u == v {
+                        continue;
+                    }
+                    let e = sub(xyz(positions[u as usize]), pv);
+                    let l = length(e);
+                    if l > 0.0 {
+                        longest = longest.max(l);
+                        dirs.push([e[0] / l, e[1] / l, e[2] / l]);
+                    }
+                }
+            }
+            // The widest angle has the least cosine.
+            let mut least = 1.0f32;
+            for i in 0..dirs.len() {
+                for j in i + 1..dirs.len() {
+                    least = least.min(dot(dirs[i], dirs[j]));
+                }
+            }
+            // cos(θ/2) = sqrt((1 + cos θ) / 2).
+            ((1.0 + least.clamp(-1.0, 1.0)) * 0.5).sqrt() * longest
+        })
+        .collect()
+}
+
+/// Each vertex's rank, all distinct: the grade's top bits (a non-negative f32 orders as its
+/// bits), then a hash of the id to break ties among equal grades without a monotone id wave
+/// (as the rounds' `tie_rank`), then the id.
+pub fn ranks(grades: &[f32]) -> Vec<u64> {
+    grades
+        .par_iter()
+        .enumerate()
+        .map(|(v, g)| {
+            let g = g.max(0.0).to_bits() >> 8;
+            ((g as u64) << 40) | ((tie_rank(v as u32) as u64 & 0xff) << 32) | v as u64
+        })
+        .collect()
+}
+
+const UNCLAIMED: u32 = u32::MAX;
+
+/// Centres' radii spread over ±[`JITTER`]/2 about the nominal radius, by a hash of the centre:
+/// with one radius for all, a regular mesh's count jumps as the radius crosses a spacing of
+/// its lattice (a 40×40-a-side cube from 3,120 to 1,762 faces between two radii 5% apart,
+/// nothing in the ±5% band of 1,920 between); spread radii cross it one centre at a time.
+pub const JITTER: f32 = 0.2;
+
+/// The radius of centre `v` for the nominal radius `r`.
+#[inline]
+pub fn radius(r: f32, v: u32) -> f32 {
+    let u = tie_rank(v ^ 0x9e37_79b9) as f32 / u32::MAX as f32;
+    r * (1.0 + JITTER * (u - 0.5))
+}
+
+/// The 3×3×3 cells around a cell, nearest first: the vertex's own cell most often holds a
+/// vertex that outranks it, and the search stops at the first.
+const AROUND: [[i32; 3]; 27] = {
+    let mut out = [[0i32; 3]; 27];
+    let mut k = 0;
+    let mut ring = 0;
+    while ring <= 3 {
+        let mut i: i32 = 0;
+        while i < 27 {
+            let d = [i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1];
+            if d[0].abs() + d[1].abs() + d[2].abs() == ring {
+                out[k] = d;
+                k += 1;
+            }
+            i += 1;
+        }
+        ring += 1;
+    }
+    out
+};
+
+/// Every vertex's centre (a centre is its own) after the rounds, and the rounds taken.
+/// Locked vertices are centres of themselves alone.
+pub fn claim(
+    positions: &[[f32; 4]],
+    ranks: &[u64],
+    locked: &[bool],
+    lo: V3,
+    hi: V3,
+    r: f32,
+) -> (Vec<u32>, usize) {
+    let n = positions.len();
+    // Two centres are independent beyond the sum of their radii, at most twice the largest.
+    let r_max = r * (1.0 + 0.5 * JITTER);
+    let grid = Grid::new(lo, hi, 2.0 * r_max);
+    let keys = stages::cell_keys(&grid, positions, &vec![false; n]);
+    let (sorted, members) = stages::radix_sort(&keys);
+    let mut cells = stages::cell_ranges(&sorted, members);
+    // Each cell's members by rank, highest first: a vertex looking for one that outranks it
+    // stops at the first that does not.
+    let vertex_cell = &cells.vertex_cell;
+    cells
+        .members
+        .par_sort_unstable_by_key(|&v| (vertex_cell[v as usize], u64::MAX - ranks[v as usize]));
+    let mut centre: Vec<u32> = (0..n as u32)
+        .map(|v| if locked[v as usize] { v } else { UNCLAIMED })
+        .collect();
+    let mut live: Vec<u32> = (0..n as u32).filter(|&v| !locked[v as usize]).collect();
+    // The cells around `p` (3×3×3), as ranges of `cells.members`.
+    let around = |start: &[u32], p: V3| {
+        let c = grid.coords(p);
+        let mut out = [(0u32, 0u32); 27];
+        let mut k = 0;
+        for d in AROUND {
+            let q = [0, 1, 2].map(|i| c[i] as i32 + d[i]);
+            if (0..3).any(|i| q[i] < 0 || q[i] >= grid.dims[i] as i32) {
+                continue;
+            }
+            let key = morton3(q[0] as u32, q[1] as u32, q[2] as u32);
+            if let Ok(i) = cells.key.binary_search(&key) {
+                out[k] = (start[i], start[i + 1]);
+                k += 1;
+            }
+        }
+        (out, k)
+    };
+    let mut rounds = 0;
+    while !live.is_empty() {
+        rounds += 1;
+        // `fc_decide`: a live vertex outranked by no live vertex within 2r becomes a centre.
+        let new: Vec<u32> = live
+            .par_iter()
+            .with_min_len(256)
+            .copied()
+            .filter(|&v| {
+                let p = xyz(positions[v as usize]);
+                let (ranges, k) = around(&cells.start, p);
+                let rank = ranks[v as usize];
+                let rv = radius(r, v);
+                !ranges[..k].iter().any(|&(a, b)| {
+                    cells.members[a as usize..b as usize]
+                        .iter()
+                        .take_while(|&&u| ranks[u as usize] > rank)
+                        .any(|&u| {
+                            centre[u as usize] == UNCLAIMED && {
+                                let d = sub(xyz(positions[u as usize]), p);
+                                let reach = rv + radius(r, u);
+                                dot(d, d) <= reach * reach
+                            }
+                        })
+                })
+            })
+            .collect();
+        // `fc_claim`: each new centre claims the live vertices within r; the balls of one
+        // round's centres are disjoint (checked), so the claims are the same in any order.
+        let claims: Vec<(u32, u32)> = new
+            .par_iter()
+            .flat_map_iter(|&c| {
+                let p = xyz(positions[c as usize]);
+                let (ranges, k) = around(&cells.start, p);
+                let rc = radius(r, c);
+                let mut out = vec![(c, c)];
+                for &(a, b) in &ranges[..k] {
+                    for &u in &cells.members[a as usize..b as usize] {
+                        if u != c && centre[u as usize] == UNCLAIMED {
+                            let d = sub(xyz(positions[u as usize]), p);
+                            if dot(d, d) <= rc * rc {
+                                out.push((u, c));
+                            }
+                        }
+                    }
+                }
+                out
+            })
+            .collect();
+        for (u, c) in claims {
+            assert_eq!(
+                centre[u as usize], UNCLAIMED,
+                "floating cells: vertex {u} claimed twice in one round"
+            );
+            centre[u as usize] = c;
+        }
+        live.retain(|&v| centre[v as usize] == UNCLAIMED);
+        // Keep only unclaimed vertices in the cells' lists (in rank order): later rounds scan
+        // nothing else, and claimed high-ranked vertices would be scanned again every round.
+        let mut at = 0usize;
+        let mut begin = 0u32;
+        for c in 0..cells.key.len() {
+            let end = cells.start[c + 1];
+            for i in begin as usize..end as usize {
+                let u = cells.members[i];
+                if centre[u as usize] == UNCLAIMED {
+                    cells.members[at] = u;
+                    at += 1;
+                }
+            }
+            begin = end;
+            cells.start[c + 1] = at as u32;
+        }
+        cells.members.truncate(at);
+    }
+    (centre, rounds)
+}
+
+/// Per vertex its cluster (centres numbered in vertex order), and the cluster count.
+pub fn clusters_of(centre: &[u32]) -> (Vec<u32>, usize) {
+    let mut id = vec![u32::MAX; centre.len()];
+    let mut n = 0u32;
+    for (v, &c) in centre.iter().enumerate() {
+        if c == v as u32 {
+            id[v] = n;
+            n += 1;
+        }
+    }
+    (centre.iter().map(|&c| id[c as usize]).collect(), n as usize)
+}
