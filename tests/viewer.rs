@@ -362,3 +362,37 @@ fn standing_figures_are_drawn_upright_in_their_files_up_axis() {
     );
     assert!(h > 2 * w, "STL, Z up: {w}x{h} pixels, not standing");
 }
+
+#[test]
+fn clustering_results_are_drawn_too() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let model = Model::from_mesh(
+        "noisy sphere".into(),
+        meshslim::mesh::noisy_sphere(4, 0.01, 5),
+    )
+    .unwrap();
+    let size = (160, 120);
+    for method in [
+        meshslim::Method::Cluster,
+        meshslim::Method::FloatingCell,
+        meshslim::Method::Hybrid,
+    ] {
+        let frame =
+            meshslim::viewer::screenshot_with(&model, 0.2, method, Style::default(), size).unwrap();
+        // 1024 faces: hybrid exactly (or one below), the clusterings within 5%.
+        assert!(
+            (972..=1076).contains(&frame.faces),
+            "{method:?}: {} faces drawn",
+            frame.faces
+        );
+        let img = Pixmap::decode_png(&frame.png).expect("a valid PNG");
+        let covered = img
+            .data()
+            .chunks_exact(4)
+            .filter(|px| !is_background(px))
+            .count();
+        assert!(covered > 160 * 120 / 10, "{method:?}: the sphere is drawn");
+    }
+}

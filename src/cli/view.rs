@@ -46,6 +46,11 @@ pub struct ViewArgs {
     #[arg(long, value_name = "R", value_parser = parse_ratio, allow_negative_numbers = true)]
     pub ratio: Option<f64>,
 
+    /// The algorithm for --ratio (and the window's starting choice): qem, cluster,
+    /// floating-cell or hybrid, as `meshslim simplify --method`
+    #[arg(long, value_enum, default_value_t = super::simplify::MethodArg::Qem)]
+    pub method: super::simplify::MethodArg,
+
     /// What the surface shows
     #[arg(long, value_enum, default_value_t = crate::viewer::Mode::Shaded)]
     pub mode: crate::viewer::Mode,
@@ -118,8 +123,15 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
             None => crate::viewer::Start::Nothing,
         };
         let size = args.size.unwrap_or((1280, 800));
-        crate::viewer::run_window(start, args.ratio.unwrap_or(0.1), style, size, args.up)
-            .map_err(lib)?;
+        crate::viewer::run_window(
+            start,
+            args.ratio.unwrap_or(0.1),
+            args.method.method(),
+            style,
+            size,
+            args.up,
+        )
+        .map_err(lib)?;
         return Ok(ExitCode::SUCCESS);
     };
     let Some(input) = &args.input else {
@@ -141,7 +153,13 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     let size = args.size.unwrap_or((1024, 768));
     let frame = progress
         .spinner("simplifying and rendering on the GPU".to_string(), || {
-            crate::viewer::screenshot(&model, args.ratio.unwrap_or(1.0), style, size)
+            crate::viewer::screenshot_with(
+                &model,
+                args.ratio.unwrap_or(1.0),
+                args.method.method(),
+                style,
+                size,
+            )
         })
         .map_err(lib)?;
     crate::io::write_atomic(&png, |w| w.write_all(&frame.png))

@@ -136,6 +136,8 @@ pub struct ViewerApp {
     pub ratio: f64,
     pub(super) faces_text: String,
     pub backend: Backend,
+    /// The algorithm (the clustering methods run on the CPU).
+    pub method: crate::Method,
     pub fly: bool,
     /// Fly speed in diagonals per second.
     pub fly_speed: f32,
@@ -213,6 +215,7 @@ impl ViewerApp {
             } else {
                 Backend::CpuParallel
             },
+            method: crate::Method::Qem,
             fly: false,
             fly_speed: 0.5,
             views: Vec::new(),
@@ -290,6 +293,14 @@ impl ViewerApp {
 
     pub fn adapter(&self) -> &str {
         &self.gpu.adapter
+    }
+
+    /// Sets the algorithm; a clustering method moves a `gpu` backend to `cpu-parallel`.
+    pub fn set_method(&mut self, method: crate::Method) {
+        self.method = method;
+        if method != crate::Method::Qem && self.backend == Backend::Gpu {
+            self.backend = Backend::CpuParallel;
+        }
     }
 
     pub fn has_gpu_backend(&self) -> bool {

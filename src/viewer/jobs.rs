@@ -47,14 +47,20 @@ impl ViewerApp {
             }
         };
         let backend = self.backend;
+        let method = self.method;
         let device = self.gpu.device.clone();
         let sim = self.gpu.sim.clone();
-        let label = format!("simplifying to {target} faces ({})", backend.name());
+        let label = format!(
+            "simplifying to {target} faces ({}, {})",
+            method.name(),
+            backend.name()
+        );
         self.spawn(
             label,
             move |cancel, progress, phase| {
                 let mut opts = SimplifyOptions::with_faces(target);
                 opts.backend = backend;
+                opts.method = method;
                 opts.cancel = cancel;
                 scene::simplify(
                     &device,

@@ -35,6 +35,18 @@ pub struct Frame {
 /// Simplifies `model` to `ratio` on the GPU (1 = as is) and renders one `size` frame of the
 /// result in `style`, framed to fit, straight from the simplifier's buffers; returns a PNG.
 pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> Result<Frame> {
+    screenshot_with(model, ratio, crate::Method::Qem, style, size)
+}
+
+/// As [`screenshot`], simplified by `method` (the clustering methods on the CPU's cores, their
+/// result uploaded and drawn by the same renderer).
+pub fn screenshot_with(
+    model: &Model,
+    ratio: f64,
+    method: crate::Method,
+    style: Style,
+    size: (u32, u32),
+) -> Result<Frame> {
     // Checked before the GPU work: a texture mode without a texture fails at once.
     if style.mode == Mode::Texture && !(model.mesh.uvs.is_some() && model.texture.is_some()) {
         return Err(Error::InvalidOption(format!(
@@ -48,7 +60,12 @@ pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> 
     let mut style = style;
     let (scene, faces) = if ratio < 1.0 {
         let mut opts = SimplifyOptions::with_ratio(model.up.face_count(), ratio)?;
-        opts.backend = Backend::Gpu;
+        opts.method = method;
+        opts.backend = if method == crate::Method::Qem {
+            Backend::Gpu
+        } else {
+            Backend::CpuParallel
+        };
         let s = scene::simplify(
             &ctx.device,
             Some(sim),
@@ -117,6 +134,7 @@ pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> 
 pub fn run_window(
     start: Start,
     ratio: f64,
+    method: crate::Method,
     style: Style,
     size: (u32, u32),
     up: Option<camera::Up>,
@@ -144,6 +162,7 @@ pub fn run_window(
                 .unwrap_or(Start::Nothing);
             let mut app = ViewerApp::new(cc, start)?;
             app.set_ratio(ratio);
+            app.set_method(method);
             app.set_style(style);
             app.set_up(up);
             Ok(Box::new(app))

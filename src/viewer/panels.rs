@@ -122,9 +122,40 @@ impl ViewerApp {
             }
         });
         ui.horizontal(|ui| {
+            use crate::Method;
+            ui.label("method");
+            let methods = [
+                (
+                    Method::Qem,
+                    "edge collapse: best surface, exact target, topology kept",
+                ),
+                (
+                    Method::Cluster,
+                    "uniform grid: fastest, within 5%, topology may change",
+                ),
+                (
+                    Method::FloatingCell,
+                    "floating cells: keeps tips and corners, within 5%, topology may change",
+                ),
+                (
+                    Method::Hybrid,
+                    "grid to 3x the target, then edge collapse: near-qem quality, faster",
+                ),
+            ];
+            for (m, about) in methods {
+                ui.selectable_value(&mut self.method, m, m.name())
+                    .on_hover_text(about);
+            }
+            // Clustering runs on the CPU's cores.
+            if self.method != Method::Qem && self.backend == Backend::Gpu {
+                self.backend = Backend::CpuParallel;
+            }
+        });
+        ui.horizontal(|ui| {
             ui.label("backend");
             for b in [Backend::Gpu, Backend::CpuParallel, Backend::Cpu] {
-                let enabled = b != Backend::Gpu || self.gpu.sim.is_some();
+                let enabled = b != Backend::Gpu
+                    || (self.gpu.sim.is_some() && self.method == crate::Method::Qem);
                 ui.add_enabled_ui(enabled, |ui| {
                     ui.selectable_value(&mut self.backend, b, b.name());
                 });

@@ -311,7 +311,7 @@ pub fn simplify(
     let t = Instant::now();
     phase(&format!("simplifying ({})", opts.backend.name()));
     let (gpu, positions, indices, mesh, report, uvs) = match opts.backend {
-        Backend::Gpu => {
+        Backend::Gpu if opts.method == crate::Method::Qem => {
             let sim = sim.ok_or_else(|| Error::Gpu("the GPU backend is not available".into()))?;
             let up = &model.up;
             let mut rounds = GpuRounds::new(sim, up, SELECTION_PASSES)?;
