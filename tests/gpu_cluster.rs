@@ -405,3 +405,33 @@ fn the_gpu_build_equals_the_cpu_build() {
         }
     }
 }
+
+/// Timings, not a check: `cargo test --release --test gpu_cluster -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn time_a_build_on_icosphere_7() {
+    let Some(ctx) = gpu_context() else { return };
+    let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
+    let m = meshslim::mesh::icosphere(7);
+    let (pos, lo, hi) = points(&m);
+    let locked = locked_of(pos.len(), false);
+    let t = std::time::Instant::now();
+    let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
+    let setup = t.elapsed().as_secs_f64();
+    for h in [0.01f32, 0.003] {
+        let grid = Grid::new(lo, hi, h);
+        let t = std::time::Instant::now();
+        let g = gpu.build(&grid).unwrap();
+        let gpu_s = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        let d = driver_build(&pos, &m.triangles, &locked, &grid);
+        let cpu_s = t.elapsed().as_secs_f64();
+        assert_eq!(g.faces, d.faces);
+        eprintln!(
+            "icosphere(7), {} faces, h = {h}: {} faces; gpu build {gpu_s:.3} s (upload and \
+             vertex→face lists {setup:.3} s once), cpu driver build {cpu_s:.3} s",
+            m.triangles.len(),
+            g.faces.len()
+        );
+    }
+}
