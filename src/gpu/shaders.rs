@@ -82,6 +82,41 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/dispatch_args.wgsl"),
     ),
     ("draw_args", include_str!("../../shaders/draw_args.wgsl")),
+    // The clustering build (src/cluster/gpu_schedule.rs describes these stages).
+    ("cell_keys", include_str!("../../shaders/cell_keys.wgsl")),
+    (
+        "radix_count",
+        include_str!("../../shaders/radix_count.wgsl"),
+    ),
+    (
+        "radix_scatter",
+        include_str!("../../shaders/radix_scatter.wgsl"),
+    ),
+    ("cell_heads", include_str!("../../shaders/cell_heads.wgsl")),
+    (
+        "cell_ranges",
+        include_str!("../../shaders/cell_ranges.wgsl"),
+    ),
+    (
+        "cluster_quadrics",
+        include_str!("../../shaders/cluster_quadrics.wgsl"),
+    ),
+    (
+        "cluster_faces_mark",
+        include_str!("../../shaders/cluster_faces_mark.wgsl"),
+    ),
+    (
+        "cluster_faces_fill",
+        include_str!("../../shaders/cluster_faces_fill.wgsl"),
+    ),
+    (
+        "cluster_faces_dedupe",
+        include_str!("../../shaders/cluster_faces_dedupe.wgsl"),
+    ),
+    (
+        "cluster_faces_compact",
+        include_str!("../../shaders/cluster_faces_compact.wgsl"),
+    ),
 ];
 
 /// The source of `shaders/<stem>.wgsl`.
@@ -98,6 +133,9 @@ pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
 pub const MESH: &str = include_str!("../../shaders/mesh.wgsl");
 /// Corner attribute accessors, for the stages that also bind `face_extra`.
 pub const SEAMS: &str = include_str!("../../shaders/seams.wgsl");
+/// The clustering stages' structs and constants, for the stages that bind `ClusterParams` or
+/// `RadixParams`.
+pub const CLUSTER: &str = include_str!("../../shaders/cluster.wgsl");
 
 /// The full source of a stage: the common definitions, the mesh and seam accessors when the
 /// stage binds the buffers they read, then the stage.
@@ -108,6 +146,9 @@ pub fn source(stage_source: &str) -> String {
             .any(|access| stage_source.contains(&format!("var<storage, {access}> {var}:")))
     };
     let mut src = COMMON.to_string();
+    if stage_source.contains(": ClusterParams;") || stage_source.contains(": RadixParams;") {
+        src = format!("{src}\n{CLUSTER}");
+    }
     if binds("indices") && binds("vertex_faces") {
         src = format!("{src}\n{MESH}");
         if binds("face_extra") {
@@ -123,8 +164,17 @@ pub fn source(stage_source: &str) -> String {
 pub(crate) fn declared_bindings(
     stage: &crate::parallel::schedule::Stage,
 ) -> std::result::Result<Vec<(String, crate::parallel::schedule::Access)>, String> {
+    shader_bindings(stage.shader)
+}
+
+/// The bindings `shaders/<shader>.wgsl` declares, by binding number: each variable's name and
+/// access. Shared by the rounds' schedule test and the clustering schedule's.
+#[cfg(test)]
+pub(crate) fn shader_bindings(
+    shader: &str,
+) -> std::result::Result<Vec<(String, crate::parallel::schedule::Access)>, String> {
     use crate::parallel::schedule::Access;
-    let src = stage_source(stage.shader).ok_or("no such shader file")?;
+    let src = stage_source(shader).ok_or("no such shader file")?;
     let module = naga::front::wgsl::parse_str(&source(src)).map_err(|e| e.message().to_string())?;
     let mut vars: Vec<(u32, String, Access)> = Vec::new();
     for (_, v) in module.global_variables.iter() {
@@ -226,7 +276,8 @@ mod tests {
             let name = entry.file_name().into_string().unwrap();
             let stem = name.trim_end_matches(".wgsl");
             assert!(
-                ["common", "mesh", "seams"].contains(&stem) || stage_source(stem).is_some(),
+                ["common", "mesh", "seams", "cluster"].contains(&stem)
+                    || stage_source(stem).is_some(),
                 "shaders/{name} is not listed in SOURCES"
             );
         }
@@ -303,5 +354,51 @@ mod tests {
         assert_eq!(size("EdgeCandidate"), size_of::<EdgeCandidate>());
         assert_eq!(size("FaceExtra"), size_of::<FaceExtra>());
         assert_eq!(size("DrawArgs"), size_of::<DrawArgs>());
+        let module = parse(
+            "cluster_quadrics",
+            stage_source("cluster_quadrics").unwrap(),
+        );
+        let size = |name: &str| {
+            let (_, ty) = module
+                .types
+                .iter()
+                .find(|(_, t)| t.name.as_deref() == Some(name))
+                .unwrap_or_else(|| panic!("no struct {name} in cluster.wgsl"));
+            ty.inner.size(module.to_ctx()) as usize
+        };
+        assert_eq!(size("ClusterParams"), size_of::<ClusterParams>());
+        assert_eq!(size("RadixParams"), size_of::<RadixParams>());
+        assert_eq!(size("ClusterPlaced"), size_of::<ClusterPlaced>());
+    }
+
+    /// The constants of shaders/cluster.wgsl against their Rust twins.
+    #[test]
+    fn cluster_constants_match_their_rust_twins() {
+        let module = parse(
+            "cluster_quadrics",
+            stage_source("cluster_quadrics").unwrap(),
+        );
+        let value = |name: &str| -> u32 {
+            let (_, c) = module
+                .constants
+                .iter()
+                .find(|(_, c)| c.name.as_deref() == Some(name))
+                .unwrap_or_else(|| panic!("no const {name} in cluster.wgsl"));
+            match module.global_expressions[c.init] {
+                naga::Expression::Literal(naga::Literal::U32(v)) => v,
+                ref e => panic!("const {name} is not a u32 literal: {e:?}"),
+            }
+        };
+        let pairs = [
+            ("SINGLETON", crate::cluster::grid::SINGLETON),
+            ("SORT_BLOCK", SORT_BLOCK),
+            ("PLACE_SINGLE", place::SINGLE),
+            ("PLACE_SOLVE", place::SOLVE),
+            ("PLACE_MEMBER", place::MEMBER),
+            ("PLACE_CENTROID", place::CENTROID),
+        ];
+        for (name, rust) in pairs {
+            assert_eq!(value(name), rust, "const {name}: WGSL against Rust");
+        }
     }
 }

@@ -189,3 +189,59 @@ pub struct DrawArgs {
     pub base_vertex: i32,
     pub first_instance: u32,
 }
+
+/// Keys one workgroup of the radix sort takes (256 threads × 4 contiguous keys). Keep in sync
+/// with `SORT_BLOCK` in shaders/cluster.wgsl.
+pub const SORT_BLOCK: u32 = WG * 4;
+
+/// Which candidate placed a cluster's vertex (`ClusterPlaced::how`), as
+/// `crate::cluster::stages::Placement`. Keep in sync with the `PLACE_*` constants in
+/// shaders/cluster.wgsl.
+pub mod place {
+    pub const SINGLE: u32 = 0;
+    pub const SOLVE: u32 = 1;
+    pub const MEMBER: u32 = 2;
+    pub const CENTROID: u32 = 3;
+}
+
+/// The clustering stages' constants, a uniform. Keep in sync with `ClusterParams` in
+/// shaders/cluster.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct ClusterParams {
+    /// The grid's corner (xyz) and cell size (w).
+    pub lo_h: [f32; 4],
+    /// Cells an axis (xyz); w unused.
+    pub dims: [u32; 4],
+    pub vertex_count: u32,
+    pub face_count: u32,
+    pub _pad: [u32; 2],
+}
+
+/// One pass of the radix sort, a uniform (one buffer per pass, so a build records every pass
+/// in one command buffer). Keep in sync with `RadixParams` in shaders/cluster.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct RadixParams {
+    /// Keys sorted.
+    pub n: u32,
+    /// Blocks of [`SORT_BLOCK`] keys: `n.div_ceil(SORT_BLOCK)`.
+    pub blocks: u32,
+    /// Bit of the pass's 8-bit digit: 8 × pass.
+    pub shift: u32,
+    pub _pad: u32,
+}
+
+/// A cluster's vertex as `cluster_quadrics` writes it (its quadric, relative to `pos`, goes to
+/// a buffer of [`Quadric`] beside). Keep in sync with `ClusterPlaced` in shaders/cluster.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct ClusterPlaced {
+    /// Position (xyz) in the normalized frame; w is 0.
+    pub pos: [f32; 4],
+    /// The member whose attributes the vertex takes.
+    pub attr: u32,
+    /// One of [`place`].
+    pub how: u32,
+    pub _pad: [u32; 2],
+}

@@ -1,0 +1,523 @@
+//! `--method cluster` on the gpu backend: one clustering build at a given grid as WGSL compute
+//! passes (described in `gpu_schedule.rs`, twinned in `twins.rs`): cell keys, a stable LSD radix
+//! sort of (key, vertex), the cells, one gathered quadric and placed vertex per cell, and the
+//! faces between three cells with exact repeats dropped. The mesh is uploaded once with its
+//! vertex→face lists and face planes ([`GpuClusterMesh::new`]); each build then records every
+//! pass in one command buffer and reads back two counts, then the result.
+
+use crate::cluster::grid::Grid;
+use crate::cluster::stages::gpu_schedule::{self as sched, CBuf, CCount, CGrid, CStage, CStep};
+use crate::cluster::stages::twins::{self, ClusterBuild};
+use crate::error::{Error, Result};
+use crate::gpu::context::{checked_buffer, checked_buffer_init};
+use crate::gpu::shaders::{source, stage_source};
+use crate::gpu::types::*;
+use crate::parallel::schedule::Access;
+use std::collections::HashMap;
+use std::time::Instant;
+
+const SU: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
+    .union(wgpu::BufferUsages::COPY_DST)
+    .union(wgpu::BufferUsages::COPY_SRC);
+const UNIFORM: wgpu::BufferUsages = wgpu::BufferUsages::UNIFORM.union(wgpu::BufferUsages::COPY_DST);
+
+/// Radix passes at most: 32-bit keys, 8 bits a pass.
+const MAX_PASSES: usize = 4;
+
+/// The clustering stages' pipelines, made once per device.
+pub struct GpuClusterer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    pipelines: HashMap<&'static str, wgpu::ComputePipeline>,
+    max_workgroups: u32,
+    /// Seconds spent compiling the shaders.
+    pub pipeline_seconds: f64,
+}
+
+/// Waits for an error scope and turns what it caught into an error.
+fn check(scope: wgpu::ErrorScopeGuard, doing: &str) -> Result<()> {
+    match pollster::block_on(scope.pop()) {
+        Some(e) => Err(Error::Gpu(format!("{doing}: {e}"))),
+        None => Ok(()),
+    }
+}
+
+impl GpuClusterer {
+    /// Compiles every stage of [`sched::STAGES`] on `device` (borrowed: a viewer or the rounds
+    /// may share it). Errors are caught by error scopes, not the device's handler, which the
+    /// rounds' simplifier owns.
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<GpuClusterer> {
+        let t = Instant::now();
+        let limits = device.limits();
+        let most = sched::STAGES
+            .iter()
+            .map(|s| {
+                s.bindings
+                    .iter()
+                    .filter(|b| b.access != Access::Uniform)
+                    .count()
+            })
+            .max()
+            .unwrap_or(0) as u32;
+        if limits.max_storage_buffers_per_shader_stage < most {
+            return Err(Error::Gpu(format!(
+                "the device binds at most {} storage buffers per stage; clustering needs {most}",
+                limits.max_storage_buffers_per_shader_stage
+            )));
+        }
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut modules = HashMap::new();
+        let mut pipelines = HashMap::new();
+        for stage in sched::STAGES {
+            let module = modules.entry(stage.shader).or_insert_with(|| {
+                device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(stage.shader),
+                    source: wgpu::ShaderSource::Wgsl(
+                        source(stage_source(stage.shader).unwrap_or_default()).into(),
+                    ),
+                })
+            });
+            let label = format!("meshslim.{}", stage.entry);
+            let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(&label),
+                layout: None,
+                module,
+                entry_point: Some(stage.entry),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            pipelines.insert(stage.entry, p);
+        }
+        check(scope, "creating the clustering pipelines")?;
+        Ok(GpuClusterer {
+            device: device.clone(),
+            queue: queue.clone(),
+            pipelines,
+            max_workgroups: limits.max_compute_workgroups_per_dimension,
+            pipeline_seconds: t.elapsed().as_secs_f64(),
+        })
+    }
+}
+
+/// The process's clustering pipelines on the shared device ([`crate::gpu::shared_context`]),
+/// made on first use.
+pub fn shared() -> Result<&'static GpuClusterer> {
+    static CLUSTERER: std::sync::OnceLock<std::result::Result<GpuClusterer, String>> =
+        std::sync::OnceLock::new();
+    let ctx = crate::gpu::shared_context()?;
+    CLUSTERER
+        .get_or_init(|| GpuClusterer::new(&ctx.device, &ctx.queue).map_err(|e| e.to_string()))
+        .as_ref()
+        .map_err(|e| Error::Gpu(e.trim_start_matches("GPU: ").to_string()))
+}
+
+/// One clustering of `positions` (normalized frame, w = 1) and `faces` at `grid`, on the
+/// shared device; `locked` vertices are clusters of their own. The same result as the CPU
+/// driver's build with its gather (`twins::run` is the stage-by-stage reference). For several
+/// builds of one mesh, make a [`GpuClusterMesh`] once and call its `build`.
+pub fn build_gpu(
+    positions: &[[f32; 4]],
+    faces: &[[u32; 3]],
+    locked: &[bool],
+    grid: &Grid,
+) -> Result<ClusterBuild> {
+    GpuClusterMesh::new(shared()?, positions, faces, locked)?.build(grid)
+}
+
+/// A part of a build, recorded on its own (the tests read the buffers after each).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Part {
+    Keys,
+    /// Radix pass `n`; the halves swap after it.
+    SortPass(u32),
+    Cells,
+    Quadrics,
+    Faces,
+}
+
+/// The mesh on the GPU with its vertex→face lists and face planes, and every working buffer of
+/// a build.
+pub struct GpuClusterMesh<'a> {
+    sim: &'a GpuClusterer,
+    nv: usize,
+    nf: usize,
+    any_locked: bool,
+    cluster: ClusterParams,
+    /// The half holding the sort's current keys and values.
+    cur: usize,
+    /// The radix pass a [`CBuf::Radix`] binding takes.
+    pass: usize,
+    halves: [[wgpu::Buffer; 2]; 2],
+    radix: Vec<wgpu::Buffer>,
+    scans: [wgpu::Buffer; 3],
+    bufs: HashMap<CBuf, wgpu::Buffer>,
+    /// Upload, vertex→face lists and face planes: seconds.
+    pub setup_seconds: f64,
+}
+
+impl<'a> GpuClusterMesh<'a> {
+    /// Uploads the mesh, allocates the build's buffers (checked against the device's limits)
+    /// and builds the vertex→face lists and face planes.
+    pub fn new(
+        sim: &'a GpuClusterer,
+        positions: &[[f32; 4]],
+        faces: &[[u32; 3]],
+        locked: &[bool],
+    ) -> Result<GpuClusterMesh<'a>> {
+        assert_eq!(positions.len(), locked.len(), "a locked flag per vertex");
+        let t = Instant::now();
+        let dev = &sim.device;
+        let scope = dev.push_error_scope(wgpu::ErrorFilter::Validation);
+        let (nv, nf) = (positions.len(), faces.len());
+        let (v, f) = (nv as u64, nf as u64);
+        let blocks = (nv as u32).div_ceil(SORT_BLOCK) as u64;
+        let mk = |label: &str, size: u64, usage| {
+            checked_buffer(dev, &format!("meshslim.{label}"), size, usage)
+        };
+        let init = |label: &str, data: &[u8]| {
+            checked_buffer_init(dev, &format!("meshslim.{label}"), data, data.len(), SU)
+        };
+        let locked_u32: Vec<u32> = locked.iter().map(|&l| l as u32).collect();
+        let longest_scan = (256 * blocks + 1).max(v + 1).max(f + 1);
+        let mut bufs = HashMap::new();
+        for (buf, label, size, usage) in [
+            (CBuf::Cluster, "cluster", 48, UNIFORM),
+            (
+                CBuf::Params,
+                "params",
+                std::mem::size_of::<Params>() as u64,
+                UNIFORM,
+            ),
+            (
+                CBuf::BlockSums,
+                "block_sums",
+                4 * (longest_scan.div_ceil(1024) + 1),
+                SU,
+            ),
+            (
+                CBuf::DigitCounts,
+                "digit_counts",
+                4 * (256 * blocks + 1),
+                SU,
+            ),
+            (CBuf::CellHead, "cell_head", 4 * (v + 1), SU),
+            (CBuf::CellStart, "cell_start", 4 * (v + 1), SU),
+            (CBuf::VertexCell, "vertex_cell", 4 * v, SU),
+            (CBuf::CellKey, "cell_key", 4 * v, SU),
+            (CBuf::Offsets, "offsets", 4 * (v + 1), SU),
+            (CBuf::Cursor, "cursor", 4 * v, SU),
+            (CBuf::VertexFaces, "vertex_faces", 12 * f, SU),
+            (CBuf::FaceNormals, "face_normals", 16 * f, SU),
+            (CBuf::ClusterPlaced, "cluster_placed", 32 * v, SU),
+            (CBuf::ClusterQuadric, "cluster_quadric", 48 * v, SU),
+            (CBuf::FaceKey, "face_key", 12 * f, SU),
+            (CBuf::FaceKeep, "face_keep", 4 * (f + 1), SU),
+            (CBuf::BucketOffsets, "bucket_offsets", 4 * (v + 1), SU),
+            (CBuf::BucketCursor, "bucket_cursor", 4 * v, SU),
+            (CBuf::BucketFaces, "bucket_faces", 4 * f, SU),
+            (CBuf::ClusterFaces, "cluster_faces", 12 * f, SU),
+            (CBuf::FaceOrigin, "face_origin", 4 * f, SU),
+        ] {
+            bufs.insert(buf, mk(label, size, usage)?);
+        }
+        bufs.insert(
+            CBuf::Positions,
+            init("positions", bytemuck::cast_slice(positions))?,
+        );
+        bufs.insert(CBuf::Indices, init("indices", bytemuck::cast_slice(faces))?);
+        bufs.insert(
+            CBuf::Locked,
+            init("locked", bytemuck::cast_slice(&locked_u32))?,
+        );
+        let half = |s: &str| -> Result<[wgpu::Buffer; 2]> {
+            Ok([
+                mk(&format!("sort_keys{s}"), 4 * v, SU)?,
+                mk(&format!("sort_vals{s}"), 4 * v, SU)?,
+            ])
+        };
+        let halves = [half("")?, half("_out")?];
+        let radix = (0..MAX_PASSES)
+            .map(|p| mk(&format!("radix{p}"), 16, UNIFORM))
+            .collect::<Result<Vec<_>>>()?;
+        let scans = [
+            mk("scan_v", 16, UNIFORM)?,
+            mk("scan_f", 16, UNIFORM)?,
+            mk("scan_d", 16, UNIFORM)?,
+        ];
+        let q = &sim.queue;
+        let sp = |n: u64| ScanParams {
+            n: n as u32,
+            _pad: [0; 3],
+        };
+        q.write_buffer(&scans[0], 0, bytemuck::bytes_of(&sp(v)));
+        q.write_buffer(&scans[1], 0, bytemuck::bytes_of(&sp(f)));
+        q.write_buffer(&scans[2], 0, bytemuck::bytes_of(&sp(256 * blocks)));
+        let params = Params {
+            vertex_count: nv as u32,
+            face_count: nf as u32,
+            ..Default::default()
+        };
+        q.write_buffer(&bufs[&CBuf::Params], 0, bytemuck::bytes_of(&params));
+        for (p, b) in radix.iter().enumerate() {
+            q.write_buffer(b, 0, bytemuck::bytes_of(&twins::radix_params(nv, p as u32)));
+        }
+        let mut m = GpuClusterMesh {
+            sim,
+            nv,
+            nf,
+            any_locked: locked.contains(&true),
+            cluster: ClusterParams::default(),
+            cur: 0,
+            pass: 0,
+            halves,
+            radix,
+            scans,
+            bufs,
+            setup_seconds: 0.0,
+        };
+        let mut enc = dev.create_command_encoder(&Default::default());
+        m.record(&mut enc, sched::MESH);
+        q.submit([enc.finish()]);
+        check(scope, "uploading the mesh for clustering")?;
+        m.setup_seconds = t.elapsed().as_secs_f64();
+        Ok(m)
+    }
+
+    /// Sets the grid of the next build (and rewinds the sort to `cell_keys`' half).
+    pub fn set_grid(&mut self, grid: &Grid) {
+        self.cluster = twins::cluster_params(grid, self.nv, self.nf);
+        self.cur = 0;
+        let c = &self.bufs[&CBuf::Cluster];
+        self.sim
+            .queue
+            .write_buffer(c, 0, bytemuck::bytes_of(&self.cluster));
+    }
+
+    /// Radix passes the current grid's keys need.
+    pub fn passes(&self) -> u32 {
+        twins::radix_passes(&self.cluster, self.any_locked)
+    }
+
+    /// Records `part` into `enc`.
+    fn record_part(&mut self, enc: &mut wgpu::CommandEncoder, part: Part) {
+        match part {
+            Part::Keys => self.record(enc, sched::KEYS),
+            Part::SortPass(p) => {
+                self.pass = p as usize;
+                self.record(enc, sched::SORT_PASS);
+                self.cur = 1 - self.cur;
+            }
+            Part::Cells => self.record(enc, sched::CELLS),
+            Part::Quadrics => self.record(enc, sched::QUADRICS),
+            Part::Faces => self.record(enc, sched::FACES),
+        }
+    }
+
+    /// Runs one part alone and waits for it (after [`Self::set_grid`]).
+    pub fn run_part(&mut self, part: Part) -> Result<()> {
+        let scope = self
+            .sim
+            .device
+            .push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut enc = self.sim.device.create_command_encoder(&Default::default());
+        self.record_part(&mut enc, part);
+        self.sim.queue.submit([enc.finish()]);
+        self.wait()?;
+        check(scope, "running a clustering stage")
+    }
+
+    fn wait(&self) -> Result<()> {
+        self.sim
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| Error::Gpu(format!("waiting for the device: {e}")))
+    }
+
+    /// One clustering at `grid`: every pass in one command buffer, then the result read back.
+    pub fn build(&mut self, grid: &Grid) -> Result<ClusterBuild> {
+        let scope = self
+            .sim
+            .device
+            .push_error_scope(wgpu::ErrorFilter::Validation);
+        self.set_grid(grid);
+        let mut enc = self
+            .sim
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("meshslim.cluster_build"),
+            });
+        self.record_part(&mut enc, Part::Keys);
+        for p in 0..self.passes() {
+            self.record_part(&mut enc, Part::SortPass(p));
+        }
+        for part in [Part::Cells, Part::Quadrics, Part::Faces] {
+            self.record_part(&mut enc, part);
+        }
+        self.sim.queue.submit([enc.finish()]);
+        let (nv, nf) = (self.nv as u64, self.nf as u64);
+        let counts = self.read_many(&[(CBuf::CellHead, 4 * nv, 4), (CBuf::FaceKeep, 4 * nf, 4)])?;
+        let cells = u32::from_le_bytes(counts[0][..4].try_into().unwrap_or_default()) as u64;
+        let kept = u32::from_le_bytes(counts[1][..4].try_into().unwrap_or_default()) as u64;
+        assert!(cells <= nv && kept <= nf, "counts within their buffers");
+        let data = self.read_many(&[
+            (CBuf::ClusterPlaced, 0, 32 * cells),
+            (CBuf::ClusterQuadric, 0, 48 * cells),
+            (CBuf::ClusterFaces, 0, 12 * kept),
+            (CBuf::FaceOrigin, 0, 4 * kept),
+            (CBuf::VertexCell, 0, 4 * nv),
+        ])?;
+        check(scope, "clustering on the GPU")?;
+        let pod = |i: usize| -> &[u8] { &data[i] };
+        Ok(ClusterBuild::from_buffers(
+            &bytemuck::pod_collect_to_vec::<u8, ClusterPlaced>(pod(0)),
+            &bytemuck::pod_collect_to_vec::<u8, Quadric>(pod(1)),
+            &bytemuck::pod_collect_to_vec::<u8, u32>(pod(2)),
+            &bytemuck::pod_collect_to_vec::<u8, u32>(pod(3)),
+            bytemuck::pod_collect_to_vec::<u8, u32>(pod(4)),
+        ))
+    }
+
+    /// The buffer bound for `buf`; `scan` is the prefix sum's (count, data) when one runs.
+    fn buffer(&self, buf: CBuf, scan: Option<(CCount, CBuf)>) -> &wgpu::Buffer {
+        match buf {
+            CBuf::SortKeys => &self.halves[self.cur][0],
+            CBuf::SortVals => &self.halves[self.cur][1],
+            CBuf::SortKeysOut => &self.halves[1 - self.cur][0],
+            CBuf::SortValsOut => &self.halves[1 - self.cur][1],
+            CBuf::Radix => &self.radix[self.pass],
+            CBuf::ScanCount => match scan.map(|s| s.0) {
+                Some(CCount::Faces) => &self.scans[1],
+                Some(CCount::Digits) => &self.scans[2],
+                _ => &self.scans[0],
+            },
+            CBuf::ScanData => {
+                let data = scan.map_or(CBuf::CellHead, |s| s.1);
+                &self.bufs[&data]
+            }
+            other => &self.bufs[&other],
+        }
+    }
+
+    fn record(&mut self, enc: &mut wgpu::CommandEncoder, steps: &[CStep]) {
+        for step in steps {
+            match *step {
+                CStep::Clear(buf) => enc.clear_buffer(self.buffer(buf, None), 0, None),
+                CStep::Run(stage) => self.dispatch(enc, stage, None),
+                CStep::PrefixSum { count, data } => {
+                    for stage in [
+                        &sched::PREFIX_SUM_REDUCE,
+                        &sched::PREFIX_SUM_SPINE,
+                        &sched::PREFIX_SUM_APPLY,
+                    ] {
+                        self.dispatch(enc, stage, Some((count, data)));
+                    }
+                }
+            }
+        }
+    }
+
+    fn count(&self, c: CCount) -> u32 {
+        match c {
+            CCount::Vertices => self.nv as u32,
+            CCount::Faces => self.nf as u32,
+            CCount::Digits => 256 * (self.nv as u32).div_ceil(SORT_BLOCK),
+        }
+    }
+
+    /// One compute pass of `stage` over its grid (split over y beyond the per-dimension limit).
+    fn dispatch(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        stage: &'static CStage,
+        scan: Option<(CCount, CBuf)>,
+    ) {
+        let pipeline = &self.sim.pipelines[stage.entry];
+        let layout = pipeline.get_bind_group_layout(0);
+        let entries: Vec<wgpu::BindGroupEntry> = stage
+            .bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: self.buffer(b.buf, scan).as_entire_binding(),
+            })
+            .collect();
+        let bg = self
+            .sim
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(stage.entry),
+                layout: &layout,
+                entries: &entries,
+            });
+        let groups = match stage.grid {
+            CGrid::Each(c) => self.count(c).div_ceil(WG),
+            CGrid::SortBlocks => (self.nv as u32).div_ceil(SORT_BLOCK),
+            CGrid::ScanBlocks => scan.map_or(0, |s| self.count(s.0)).div_ceil(SCAN_BLOCK),
+            CGrid::One => 1,
+        }
+        .max(1);
+        let max_x = self.sim.max_workgroups;
+        let (x, y) = if groups <= max_x {
+            (groups, 1)
+        } else {
+            (max_x, groups.div_ceil(max_x))
+        };
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(stage.entry),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+
+    /// The first `bytes` of a working buffer as the schedule names it (the sort's names as the
+    /// halves stand now): what the tests diff against the twins.
+    pub fn read_buffer(&self, buf: CBuf, bytes: u64) -> Result<Vec<u8>> {
+        Ok(self.read_many(&[(buf, 0, bytes)])?.remove(0))
+    }
+
+    /// `(buffer, byte offset, bytes)` ranges read back through one staging buffer, one wait.
+    fn read_many(&self, ranges: &[(CBuf, u64, u64)]) -> Result<Vec<Vec<u8>>> {
+        let dev = &self.sim.device;
+        let total: u64 = ranges.iter().map(|r| r.2.next_multiple_of(4)).sum();
+        let staging = dev.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("meshslim.cluster_download"),
+            size: total.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = dev.create_command_encoder(&Default::default());
+        let mut at = 0;
+        for &(buf, offset, bytes) in ranges {
+            let size = bytes.next_multiple_of(4);
+            if size > 0 {
+                enc.copy_buffer_to_buffer(self.buffer(buf, None), offset, &staging, at, size);
+            }
+            at += size;
+        }
+        self.sim.queue.submit([enc.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        staging.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait()?;
+        rx.recv()
+            .map_err(|_| Error::Gpu("the device dropped a read-back".into()))?
+            .map_err(|e| Error::Gpu(format!("mapping a read-back buffer: {e}")))?;
+        let view = staging
+            .get_mapped_range(..)
+            .map_err(|e| Error::Gpu(format!("reading back: {e}")))?;
+        let mut out = Vec::with_capacity(ranges.len());
+        let mut at = 0usize;
+        for &(_, _, bytes) in ranges {
+            out.push(view[at..at + bytes as usize].to_vec());
+            at += bytes.next_multiple_of(4) as usize;
+        }
+        drop(view);
+        staging.unmap();
+        Ok(out)
+    }
+}

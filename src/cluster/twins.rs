@@ -1,0 +1,487 @@
+//! CPU twins of the clustering build's WGSL stages (`shaders/<stage>.wgsl`, described in
+//! `gpu_schedule.rs`), each taking the same buffers in the same order as slices and written as a
+//! loop over invocation ids. Integer buffers come out equal to the GPU's after every stage
+//! (the radix sort is stable, so each pass's output is unique; a bucket's fill order is the one
+//! thing left to timing, and the dedupe sorts it); floats agree to rounding. `run` chains them
+//! into the whole build: the reference the tests diff the GPU against stage by stage.
+
+use crate::cluster::grid::{Grid, SINGLETON};
+use crate::cluster::stages::{self, Csr, Placed, Placement, Surface};
+use crate::cpu::common::xyz;
+use crate::cpu::prefix_sum::prefix_sum;
+use crate::gpu::types::{ClusterParams, ClusterPlaced, Quadric, RadixParams, SORT_BLOCK, place};
+
+/// The uniform of a build at `grid`.
+pub fn cluster_params(grid: &Grid, vertices: usize, faces: usize) -> ClusterParams {
+    ClusterParams {
+        lo_h: [grid.lo[0], grid.lo[1], grid.lo[2], grid.h],
+        dims: [grid.dims[0], grid.dims[1], grid.dims[2], 0],
+        vertex_count: vertices as u32,
+        face_count: faces as u32,
+        _pad: [0; 2],
+    }
+}
+
+pub fn grid_of(c: &ClusterParams) -> Grid {
+    Grid {
+        lo: [c.lo_h[0], c.lo_h[1], c.lo_h[2]],
+        h: c.lo_h[3],
+        dims: [c.dims[0], c.dims[1], c.dims[2]],
+    }
+}
+
+/// Radix passes of 8 bits the largest possible key needs: the far corner's Morton key (Morton
+/// order grows with each coordinate), or SINGLETON when a vertex is locked.
+pub fn radix_passes(c: &ClusterParams, any_locked: bool) -> u32 {
+    let max = if any_locked {
+        SINGLETON
+    } else {
+        crate::mesh::morton::morton3(c.dims[0] - 1, c.dims[1] - 1, c.dims[2] - 1)
+    };
+    (32 - max.leading_zeros()).div_ceil(8)
+}
+
+/// The uniform of radix pass `pass` over `n` keys.
+pub fn radix_params(n: usize, pass: u32) -> RadixParams {
+    RadixParams {
+        n: n as u32,
+        blocks: (n as u32).div_ceil(SORT_BLOCK),
+        shift: 8 * pass,
+        _pad: 0,
+    }
+}
+
+/// Per vertex: its cell's key ([`SINGLETON`] when locked) and its id.
+pub fn cell_keys(
+    cluster: &ClusterParams,
+    positions: &[[f32; 4]], // per vertex
+    locked: &[u32],         // per vertex
+    sort_keys: &mut [u32],  // per vertex
+    sort_vals: &mut [u32],  // per vertex
+) {
+    let grid = grid_of(cluster);
+    for v in 0..cluster.vertex_count as usize {
+        sort_keys[v] = if locked[v] != 0 {
+            SINGLETON
+        } else {
+            grid.key(xyz(positions[v]))
+        };
+        sort_vals[v] = v as u32;
+    }
+}
+
+fn digit(radix: &RadixParams, k: u32) -> usize {
+    ((k >> radix.shift) & 255) as usize
+}
+
+/// Per block: the count of each digit, digit-major.
+pub fn radix_count(
+    radix: &RadixParams,
+    keys: &[u32],             // per vertex
+    digit_counts: &mut [u32], // 256 per block + 1
+) {
+    let (n, blocks) = (radix.n as usize, radix.blocks as usize);
+    for b in 0..blocks {
+        let mut hist = [0u32; 256];
+        for &k in &keys[b * SORT_BLOCK as usize..n.min((b + 1) * SORT_BLOCK as usize)] {
+            hist[digit(radix, k)] += 1;
+        }
+        for d in 0..256 {
+            digit_counts[d * blocks + b] = hist[d];
+        }
+    }
+}
+
+/// Per block: each key to its digit's scanned start plus its rank among the block's keys of
+/// that digit, in block order (stable).
+pub fn radix_scatter(
+    radix: &RadixParams,
+    keys: &[u32],         // per vertex
+    vals: &[u32],         // per vertex
+    digit_counts: &[u32], // 256 per block + 1, scanned
+    keys_out: &mut [u32], // per vertex
+    vals_out: &mut [u32], // per vertex
+) {
+    let (n, blocks) = (radix.n as usize, radix.blocks as usize);
+    for b in 0..blocks {
+        let mut rank = [0u32; 256];
+        for i in b * SORT_BLOCK as usize..n.min((b + 1) * SORT_BLOCK as usize) {
+            let d = digit(radix, keys[i]);
+            let slot = (digit_counts[d * blocks + b] + rank[d]) as usize;
+            rank[d] += 1;
+            keys_out[slot] = keys[i];
+            vals_out[slot] = vals[i];
+        }
+    }
+}
+
+/// Per sorted slot: 1 where a cell starts.
+pub fn cell_heads(cluster: &ClusterParams, sort_keys: &[u32], cell_head: &mut [u32]) {
+    for i in 0..cluster.vertex_count as usize {
+        let k = sort_keys[i];
+        cell_head[i] = (i == 0 || k != sort_keys[i - 1] || k == SINGLETON) as u32;
+    }
+}
+
+/// Per sorted slot: cell starts, keys, and each vertex's cell, from the scanned heads.
+pub fn cell_ranges(
+    cluster: &ClusterParams,
+    cell_head: &[u32],       // per vertex + 1, scanned
+    sort_keys: &[u32],       // per vertex, sorted
+    sort_vals: &[u32],       // per vertex, sorted
+    cell_start: &mut [u32],  // per cell + 1
+    vertex_cell: &mut [u32], // per vertex
+    cell_key: &mut [u32],    // per cell
+) {
+    let n = cluster.vertex_count as usize;
+    for i in 0..n {
+        let before = cell_head[i];
+        let head = cell_head[i + 1] - before;
+        if head == 1 {
+            cell_start[before as usize] = i as u32;
+            cell_key[before as usize] = sort_keys[i];
+        }
+        vertex_cell[sort_vals[i] as usize] = before + head - 1;
+        if i == n - 1 {
+            cell_start[cell_head[n] as usize] = n as u32;
+        }
+    }
+}
+
+/// Per cluster (a whole cell): [`stages::cluster_quadric`] with no border planes, about the
+/// cell's centre (or its one member).
+#[allow(clippy::too_many_arguments)] // the shader's bindings, in its order
+pub fn cluster_quadrics(
+    cluster: &ClusterParams,
+    positions: &[[f32; 4]],               // per vertex
+    indices: &[u32],                      // per face × 3
+    offsets: &[u32],                      // per vertex + 1
+    vertex_faces: &[u32],                 // per corner
+    face_normals: &[[f32; 4]],            // per face
+    sort_vals: &[u32],                    // per vertex, sorted
+    cell_head: &[u32],                    // per vertex + 1, scanned
+    cell_start: &[u32],                   // per cell + 1
+    cell_key: &[u32],                     // per cell
+    cluster_placed: &mut [ClusterPlaced], // per cell
+    cluster_quadric: &mut [Quadric],      // per cell
+) {
+    let grid = grid_of(cluster);
+    let csr = Csr {
+        offsets: offsets.to_vec(),
+        vertex_faces: vertex_faces.to_vec(),
+    };
+    let border = vec![false; cluster.vertex_count as usize];
+    let surface = Surface {
+        positions,
+        faces: bytemuck::cast_slice(&indices[..3 * cluster.face_count as usize]),
+        planes: face_normals,
+        csr: &csr,
+        border: &border,
+        border_weight: 0.0,
+    };
+    for k in 0..cell_head[cluster.vertex_count as usize] as usize {
+        let members = &sort_vals[cell_start[k] as usize..cell_start[k + 1] as usize];
+        let (lo, hi) = if cell_key[k] == SINGLETON {
+            let p = xyz(positions[members[0] as usize]);
+            (p, p)
+        } else {
+            grid.cell_box(cell_key[k])
+        };
+        let centre = [0, 1, 2].map(|i| 0.5 * (lo[i] + hi[i]));
+        let p = stages::cluster_quadric(&surface, members, centre, lo, hi);
+        cluster_placed[k] = ClusterPlaced {
+            pos: [p.pos[0], p.pos[1], p.pos[2], 0.0],
+            attr: p.attr,
+            how: match p.how {
+                Placement::Single => place::SINGLE,
+                Placement::Solve => place::SOLVE,
+                Placement::Member => place::MEMBER,
+                Placement::Centroid => place::CENTROID,
+            },
+            _pad: [0; 2],
+        };
+        cluster_quadric[k] = p.quadric;
+    }
+}
+
+/// Per face: the rotated clusters, kept when three differ, counted in its first cluster's bucket.
+pub fn cluster_faces_mark(
+    cluster: &ClusterParams,
+    indices: &[u32],           // per face × 3
+    vertex_cell: &[u32],       // per vertex
+    face_key: &mut [u32],      // per face × 3
+    face_keep: &mut [u32],     // per face + 1
+    bucket_counts: &mut [u32], // per vertex + 1
+) {
+    for f in 0..cluster.face_count as usize {
+        let [a, b, c] = [0, 1, 2].map(|k| vertex_cell[indices[3 * f + k] as usize]);
+        let r = if a < b && a < c {
+            [a, b, c]
+        } else if b < c {
+            [b, c, a]
+        } else {
+            [c, a, b]
+        };
+        face_key[3 * f..3 * f + 3].copy_from_slice(&r);
+        let keep = a != b && b != c && a != c;
+        if keep {
+            bucket_counts[r[0] as usize] += 1;
+        }
+        face_keep[f] = keep as u32;
+    }
+}
+
+/// Per kept face: into its bucket, here in face order (on the GPU in timing order).
+pub fn cluster_faces_fill(
+    cluster: &ClusterParams,
+    face_key: &[u32],          // per face × 3
+    face_keep: &[u32],         // per face + 1
+    bucket_offsets: &[u32],    // per vertex + 1, scanned
+    bucket_cursor: &mut [u32], // per vertex
+    bucket_faces: &mut [u32],  // per kept face
+) {
+    for f in 0..cluster.face_count as usize {
+        if face_keep[f] == 0 {
+            continue;
+        }
+        let a = face_key[3 * f] as usize;
+        bucket_faces[(bucket_offsets[a] + bucket_cursor[a]) as usize] = f as u32;
+        bucket_cursor[a] += 1;
+    }
+}
+
+/// Per cluster: its bucket sorted by (b, c, face), each face equal to the one before unkept.
+pub fn cluster_faces_dedupe(
+    cluster: &ClusterParams,
+    face_key: &[u32],         // per face × 3
+    bucket_offsets: &[u32],   // per vertex + 1, scanned
+    bucket_faces: &mut [u32], // per kept face
+    face_keep: &mut [u32],    // per face + 1
+) {
+    let bc = |f: u32| (face_key[3 * f as usize + 1], face_key[3 * f as usize + 2]);
+    for k in 0..cluster.vertex_count as usize {
+        let bucket = &mut bucket_faces[bucket_offsets[k] as usize..bucket_offsets[k + 1] as usize];
+        bucket.sort_unstable_by_key(|&f| (bc(f), f));
+        for w in bucket.windows(2) {
+            if bc(w[0]) == bc(w[1]) {
+                face_keep[w[1] as usize] = 0;
+            }
+        }
+    }
+}
+
+/// Per kept face: its clusters and input id to its slot.
+pub fn cluster_faces_compact(
+    cluster: &ClusterParams,
+    face_key: &[u32],          // per face × 3
+    face_keep: &[u32],         // per face + 1, scanned
+    cluster_faces: &mut [u32], // per kept face × 3
+    face_origin: &mut [u32],   // per kept face
+) {
+    for f in 0..cluster.face_count as usize {
+        let s = face_keep[f] as usize;
+        if face_keep[f + 1] as usize == s {
+            continue;
+        }
+        cluster_faces[3 * s..3 * s + 3].copy_from_slice(&face_key[3 * f..3 * f + 3]);
+        face_origin[s] = f as u32;
+    }
+}
+
+/// One clustering, as the CPU driver's build returns it: per cluster its vertex, the kept faces
+/// (input face id, clusters) in face order, each vertex's cluster, the counts.
+pub struct ClusterBuild {
+    pub placed: Vec<Placed>,
+    pub faces: Vec<(u32, [u32; 3])>,
+    pub vertex_cluster: Vec<u32>,
+    pub clusters: usize,
+    /// Cells: clusters are whole cells here, so the same as `clusters`.
+    pub cells: usize,
+}
+
+impl ClusterBuild {
+    /// From the buffers `cluster_quadrics` and `cluster_faces_compact` write.
+    pub fn from_buffers(
+        placed: &[ClusterPlaced],
+        quadrics: &[Quadric],
+        cluster_faces: &[u32],
+        face_origin: &[u32],
+        vertex_cell: Vec<u32>,
+    ) -> ClusterBuild {
+        assert_eq!(placed.len(), quadrics.len(), "a quadric per cluster");
+        assert_eq!(
+            cluster_faces.len(),
+            3 * face_origin.len(),
+            "three clusters a face"
+        );
+        let placed: Vec<Placed> = placed
+            .iter()
+            .zip(quadrics)
+            .map(|(p, q)| Placed {
+                pos: xyz(p.pos),
+                quadric: *q,
+                attr: p.attr,
+                how: match p.how {
+                    place::SINGLE => Placement::Single,
+                    place::SOLVE => Placement::Solve,
+                    place::MEMBER => Placement::Member,
+                    _ => Placement::Centroid,
+                },
+            })
+            .collect();
+        let faces = face_origin
+            .iter()
+            .zip(cluster_faces.chunks_exact(3))
+            .map(|(&f, t)| (f, [t[0], t[1], t[2]]))
+            .collect();
+        ClusterBuild {
+            clusters: placed.len(),
+            cells: placed.len(),
+            placed,
+            faces,
+            vertex_cluster: vertex_cell,
+        }
+    }
+}
+
+/// Every buffer of a build on the CPU, as each stage leaves it: what the tests diff.
+#[derive(Default)]
+pub struct CpuBuild {
+    pub cluster: ClusterParams,
+    pub offsets: Vec<u32>,
+    pub vertex_faces: Vec<u32>,
+    pub face_normals: Vec<[f32; 4]>,
+    /// `cell_keys`' keys and values.
+    pub keys: (Vec<u32>, Vec<u32>),
+    /// After each radix pass: the scanned digit counts and the keys and values it wrote.
+    pub passes: Vec<(Vec<u32>, Vec<u32>, Vec<u32>)>,
+    /// Scanned.
+    pub cell_head: Vec<u32>,
+    pub cell_start: Vec<u32>,
+    pub vertex_cell: Vec<u32>,
+    pub cell_key: Vec<u32>,
+    pub cluster_placed: Vec<ClusterPlaced>,
+    pub cluster_quadric: Vec<Quadric>,
+    pub face_key: Vec<u32>,
+    /// After the dedupe, before its scan.
+    pub face_keep: Vec<u32>,
+    pub bucket_offsets: Vec<u32>,
+    /// After the dedupe.
+    pub bucket_faces: Vec<u32>,
+    pub cluster_faces: Vec<u32>,
+    pub face_origin: Vec<u32>,
+}
+
+/// The whole build through the twins, stage by stage.
+pub fn run(positions: &[[f32; 4]], faces: &[[u32; 3]], locked: &[bool], grid: &Grid) -> CpuBuild {
+    let (nv, nf) = (positions.len(), faces.len());
+    let indices: &[u32] = bytemuck::cast_slice(faces);
+    let c = cluster_params(grid, nv, nf);
+    let csr = Csr::new(nv, faces);
+    let mut b = CpuBuild {
+        cluster: c,
+        face_normals: stages::face_planes(positions, faces),
+        ..Default::default()
+    };
+    let locked: Vec<u32> = locked.iter().map(|&l| l as u32).collect();
+    let (mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv]);
+    cell_keys(&c, positions, &locked, &mut keys, &mut vals);
+    b.keys = (keys.clone(), vals.clone());
+    let mut sums = Vec::new();
+    for pass in 0..radix_passes(&c, locked.contains(&1)) {
+        let r = radix_params(nv, pass);
+        let mut counts = vec![0u32; 256 * r.blocks as usize + 1];
+        radix_count(&r, &keys, &mut counts);
+        prefix_sum(256 * r.blocks, &mut counts, &mut sums);
+        let (mut k2, mut v2) = (vec![0u32; nv], vec![0u32; nv]);
+        radix_scatter(&r, &keys, &vals, &counts, &mut k2, &mut v2);
+        (keys, vals) = (k2, v2);
+        b.passes.push((counts, keys.clone(), vals.clone()));
+    }
+    b.cell_head = vec![0u32; nv + 1];
+    cell_heads(&c, &keys, &mut b.cell_head);
+    let cells = prefix_sum(nv as u32, &mut b.cell_head, &mut sums) as usize;
+    b.cell_start = vec![0u32; cells + 1];
+    b.vertex_cell = vec![0u32; nv];
+    b.cell_key = vec![0u32; cells];
+    cell_ranges(
+        &c,
+        &b.cell_head,
+        &keys,
+        &vals,
+        &mut b.cell_start,
+        &mut b.vertex_cell,
+        &mut b.cell_key,
+    );
+    b.cluster_placed = vec![ClusterPlaced::default(); cells];
+    b.cluster_quadric = vec![Quadric::default(); cells];
+    cluster_quadrics(
+        &c,
+        positions,
+        indices,
+        &csr.offsets,
+        &csr.vertex_faces,
+        &b.face_normals,
+        &vals,
+        &b.cell_head,
+        &b.cell_start,
+        &b.cell_key,
+        &mut b.cluster_placed,
+        &mut b.cluster_quadric,
+    );
+    b.face_key = vec![0u32; 3 * nf];
+    b.face_keep = vec![0u32; nf + 1];
+    b.bucket_offsets = vec![0u32; nv + 1];
+    cluster_faces_mark(
+        &c,
+        indices,
+        &b.vertex_cell,
+        &mut b.face_key,
+        &mut b.face_keep,
+        &mut b.bucket_offsets,
+    );
+    let kept = prefix_sum(nv as u32, &mut b.bucket_offsets, &mut sums) as usize;
+    b.bucket_faces = vec![0u32; kept];
+    let mut cursor = vec![0u32; nv];
+    cluster_faces_fill(
+        &c,
+        &b.face_key,
+        &b.face_keep,
+        &b.bucket_offsets,
+        &mut cursor,
+        &mut b.bucket_faces,
+    );
+    cluster_faces_dedupe(
+        &c,
+        &b.face_key,
+        &b.bucket_offsets,
+        &mut b.bucket_faces,
+        &mut b.face_keep,
+    );
+    let mut scanned = b.face_keep.clone();
+    let out = prefix_sum(nf as u32, &mut scanned, &mut sums) as usize;
+    b.cluster_faces = vec![0u32; 3 * out];
+    b.face_origin = vec![0u32; out];
+    cluster_faces_compact(
+        &c,
+        &b.face_key,
+        &scanned,
+        &mut b.cluster_faces,
+        &mut b.face_origin,
+    );
+    (b.offsets, b.vertex_faces) = (csr.offsets, csr.vertex_faces);
+    b
+}
+
+impl CpuBuild {
+    /// The build's result, as the GPU's is read back.
+    pub fn result(&self) -> ClusterBuild {
+        ClusterBuild::from_buffers(
+            &self.cluster_placed,
+            &self.cluster_quadric,
+            &self.cluster_faces,
+            &self.face_origin,
+            self.vertex_cell.clone(),
+        )
+    }
+}

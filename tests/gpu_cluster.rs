@@ -1,0 +1,437 @@
+//! `--method cluster` on the gpu backend (lavapipe in CI): every stage's buffers against its CPU
+//! twin (src/cluster/twins.rs) on generated meshes, integers exactly and floats within 1e-4, and
+//! the whole GPU build against the CPU driver's. With CI=true a missing adapter fails.
+
+mod common;
+
+use common::gpu_context;
+use meshslim::Mesh;
+use meshslim::cluster::grid::Grid;
+use meshslim::cluster::stages::gpu::{GpuClusterMesh, GpuClusterer, Part};
+use meshslim::cluster::stages::gpu_schedule::CBuf;
+use meshslim::cluster::stages::{self, Placement, twins};
+use meshslim::cpu::common::quadric_eval;
+use meshslim::gpu::types::{ClusterPlaced, Quadric, SORT_BLOCK};
+use meshslim::mesh::prepare::{frame_of, normalize};
+
+fn pod<T: bytemuck::Pod>(bytes: Vec<u8>) -> Vec<T> {
+    bytemuck::pod_collect_to_vec(&bytes)
+}
+
+/// Within `tol` of the larger magnitude, or of `scale` when both are smaller (a sum's entry that
+/// cancels to near zero is as exact as the sum's largest term allows).
+fn close(a: f32, b: f32, tol: f32, scale: f32) -> bool {
+    (a - b).abs() <= tol * a.abs().max(b.abs()).max(scale).max(1e-30)
+}
+
+/// The mesh's positions in the unit-diagonal frame, as the clustering driver makes them, and
+/// their box.
+fn points(m: &Mesh) -> (Vec<[f32; 4]>, [f32; 3], [f32; 3]) {
+    let (center, scale) = frame_of(m);
+    let pos: Vec<[f32; 4]> = m
+        .positions
+        .iter()
+        .map(|&p| {
+            let q = normalize(p, center, scale);
+            [q[0] as f32, q[1] as f32, q[2] as f32, 1.0]
+        })
+        .collect();
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for p in &pos {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    (pos, lo, hi)
+}
+
+/// Meshes, each with the cell sizes to cluster it at and whether to lock some vertices (every
+/// 7th: singleton keys, the fourth radix pass).
+fn cases() -> Vec<(&'static str, Mesh, Vec<f32>, bool)> {
+    let mut torus = meshslim::mesh::torus(1.0, 0.3, 96, 48);
+    meshslim::mesh::add_noise(&mut torus, 0.002, 7);
+    vec![
+        (
+            "icosphere",
+            meshslim::mesh::icosphere(5),
+            vec![0.08, 0.02, 0.004],
+            false,
+        ),
+        ("noisy_torus", torus, vec![0.05, 0.01], false),
+        ("grid", meshslim::mesh::grid(60), vec![0.1, 0.03], false),
+        (
+            "icosphere_locked",
+            meshslim::mesh::icosphere(4),
+            vec![0.05],
+            true,
+        ),
+    ]
+}
+
+fn locked_of(n: usize, lock: bool) -> Vec<bool> {
+    (0..n).map(|v| lock && v % 7 == 0).collect()
+}
+
+fn check_placed(
+    label: &str,
+    g: &[ClusterPlaced],
+    c: &[ClusterPlaced],
+    gq: &[Quadric],
+    cq: &[Quadric],
+) {
+    assert_eq!(g.len(), c.len(), "{label}: clusters");
+    let mut kinds_differ = 0;
+    for k in 0..g.len() {
+        let (a, b) = (g[k], c[k]);
+        assert!(
+            (0..3).all(|i| close(a.pos[i], b.pos[i], 1e-4, 1e-3)),
+            "{label}: cluster {k} at {:?} on the GPU, {:?} on the CPU",
+            a.pos,
+            b.pos
+        );
+        if (a.attr, a.how) != (b.attr, b.how) {
+            kinds_differ += 1;
+        }
+        let scale = cq[k].q.iter().flatten().fold(0f32, |m, x| m.max(x.abs()));
+        let flat = |q: &Quadric| q.q.iter().flatten().copied().collect::<Vec<f32>>();
+        let (fa, fb) = (flat(&gq[k]), flat(&cq[k]));
+        assert!(
+            fa.iter().zip(&fb).all(|(&x, &y)| close(x, y, 1e-4, scale)),
+            "{label}: cluster {k}'s quadric {fa:?} on the GPU, {fb:?} on the CPU"
+        );
+    }
+    assert_eq!(
+        kinds_differ, 0,
+        "{label}: placements or attribute members differ"
+    );
+}
+
+#[test]
+fn each_cluster_stage_matches_its_cpu_twin() {
+    let Some(ctx) = gpu_context() else { return };
+    let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
+    for (name, m, sizes, lock) in cases() {
+        let (pos, lo, hi) = points(&m);
+        let locked = locked_of(pos.len(), lock);
+        let (nv, nf) = (pos.len(), m.triangles.len());
+        let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
+        let rd =
+            |g: &GpuClusterMesh, b: CBuf, bytes: usize| g.read_buffer(b, bytes as u64).unwrap();
+        for h in sizes {
+            let grid = Grid::new(lo, hi, h);
+            let label = format!("{name} at h = {h} ({:?} cells an axis)", grid.dims);
+            let cpu = twins::run(&pos, &m.triangles, &locked, &grid);
+            // adjacency_* and face_planes, from the upload.
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::Offsets, 4 * (nv + 1))),
+                cpu.offsets,
+                "{label}: offsets"
+            );
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::VertexFaces, 12 * nf)),
+                cpu.vertex_faces,
+                "{label}: vertex_faces"
+            );
+            let normals: Vec<[f32; 4]> = pod(rd(&gpu, CBuf::FaceNormals, 16 * nf));
+            for (f, (a, b)) in normals.iter().zip(&cpu.face_normals).enumerate() {
+                assert!(
+                    (0..4).all(|i| close(a[i], b[i], 1e-4, 1e-6)),
+                    "{label}: face_normals[{f}]"
+                );
+            }
+            gpu.set_grid(&grid);
+            gpu.run_part(Part::Keys).unwrap();
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::SortKeys, 4 * nv)),
+                cpu.keys.0,
+                "{label}: cell_keys' keys"
+            );
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::SortVals, 4 * nv)),
+                cpu.keys.1,
+                "{label}: cell_keys' values"
+            );
+            assert_eq!(
+                gpu.passes() as usize,
+                cpu.passes.len(),
+                "{label}: radix passes"
+            );
+            let blocks = (nv as u32).div_ceil(SORT_BLOCK) as usize;
+            for (p, (counts, keys, vals)) in cpu.passes.iter().enumerate() {
+                gpu.run_part(Part::SortPass(p as u32)).unwrap();
+                let what = |s: &str| format!("{label}: radix pass {p}, {s}");
+                assert_eq!(
+                    &pod::<u32>(rd(&gpu, CBuf::DigitCounts, 4 * (256 * blocks + 1))),
+                    counts,
+                    "{}",
+                    what("digit counts")
+                );
+                assert_eq!(
+                    &pod::<u32>(rd(&gpu, CBuf::SortKeys, 4 * nv)),
+                    keys,
+                    "{}",
+                    what("keys")
+                );
+                assert_eq!(
+                    &pod::<u32>(rd(&gpu, CBuf::SortVals, 4 * nv)),
+                    vals,
+                    "{}",
+                    what("values")
+                );
+            }
+            // The sort is the CPU driver's stable sort by (key, id).
+            let (sorted, members) = stages::radix_sort(&cpu.keys.0);
+            let last = match cpu.passes.last() {
+                Some(p) => (&p.1, &p.2),
+                None => (&cpu.keys.0, &cpu.keys.1),
+            };
+            assert_eq!(
+                (&sorted, &members),
+                last,
+                "{label}: the driver's radix_sort"
+            );
+            gpu.run_part(Part::Cells).unwrap();
+            let cells = cpu.cell_key.len();
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::CellHead, 4 * (nv + 1))),
+                cpu.cell_head,
+                "{label}: cell_head"
+            );
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::CellStart, 4 * (cells + 1))),
+                cpu.cell_start,
+                "{label}: cell_start"
+            );
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::VertexCell, 4 * nv)),
+                cpu.vertex_cell,
+                "{label}: vertex_cell"
+            );
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::CellKey, 4 * cells)),
+                cpu.cell_key,
+                "{label}: cell_key"
+            );
+            let driver = stages::cell_ranges(&sorted, members);
+            assert_eq!(
+                (&driver.start, &driver.key, &driver.vertex_cell),
+                (&cpu.cell_start, &cpu.cell_key, &cpu.vertex_cell),
+                "{label}: the driver's cell_ranges"
+            );
+            gpu.run_part(Part::Quadrics).unwrap();
+            check_placed(
+                &label,
+                &pod(rd(&gpu, CBuf::ClusterPlaced, 32 * cells)),
+                &cpu.cluster_placed,
+                &pod(rd(&gpu, CBuf::ClusterQuadric, 48 * cells)),
+                &cpu.cluster_quadric,
+            );
+            gpu.run_part(Part::Faces).unwrap();
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::FaceKey, 12 * nf)),
+                cpu.face_key,
+                "{label}: face_key"
+            );
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::BucketOffsets, 4 * (nv + 1))),
+                cpu.bucket_offsets,
+                "{label}: bucket_offsets"
+            );
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::BucketFaces, 4 * cpu.bucket_faces.len())),
+                cpu.bucket_faces,
+                "{label}: bucket_faces"
+            );
+            let mut scanned = cpu.face_keep.clone();
+            meshslim::cpu::prefix_sum::prefix_sum(nf as u32, &mut scanned, &mut Vec::new());
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::FaceKeep, 4 * (nf + 1))),
+                scanned,
+                "{label}: face_keep (scanned)"
+            );
+            let kept = cpu.face_origin.len();
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::ClusterFaces, 12 * kept)),
+                cpu.cluster_faces,
+                "{label}: cluster_faces"
+            );
+            assert_eq!(
+                pod::<u32>(rd(&gpu, CBuf::FaceOrigin, 4 * kept)),
+                cpu.face_origin,
+                "{label}: face_origin"
+            );
+            // The faces are the CPU driver's `cluster_faces`.
+            let driver = stages::cluster_faces(&m.triangles, &cpu.vertex_cell, cells, false);
+            assert_eq!(
+                cpu.result().faces,
+                driver,
+                "{label}: the driver's cluster_faces"
+            );
+            assert!(kept > 0, "{label}: some faces survive");
+        }
+    }
+}
+
+/// The CPU driver's `cluster` build (cluster/mod.rs `Work::build` without a gather: quadrics
+/// scattered from the faces about each cell's centre, then `place`), written out from the public
+/// stages because `Work` is private to the driver.
+fn driver_build(
+    pos: &[[f32; 4]],
+    faces: &[[u32; 3]],
+    locked: &[bool],
+    grid: &Grid,
+) -> twins::ClusterBuild {
+    let keys = stages::cell_keys(grid, pos, locked);
+    let (sorted, members) = stages::radix_sort(&keys);
+    let cells = stages::cell_ranges(&sorted, members);
+    let clusters = stages::Clusters::whole_cells(&cells);
+    let boxes: Vec<([f32; 3], [f32; 3])> = (0..clusters.len())
+        .map(|k| {
+            let key = cells.key[clusters.cell[k] as usize];
+            if key == stages::SINGLETON {
+                let m = cells.members[cells.start[clusters.cell[k] as usize] as usize];
+                let p = [pos[m as usize][0], pos[m as usize][1], pos[m as usize][2]];
+                (p, p)
+            } else {
+                grid.cell_box(key)
+            }
+        })
+        .collect();
+    let centre = |k: usize| [0, 1, 2].map(|i| 0.5 * (boxes[k].0[i] + boxes[k].1[i]));
+    let origins: Vec<[f32; 3]> = (0..clusters.len()).map(centre).collect();
+    let q = stages::scatter_quadrics(pos, faces, &clusters.vertex_cluster, &origins);
+    let placed: Vec<stages::Placed> = (0..clusters.len())
+        .map(|k| {
+            let members: Vec<u32> = clusters.members(&cells, None, k).collect();
+            stages::place(pos, q[k], &members, centre(k), boxes[k].0, boxes[k].1)
+        })
+        .collect();
+    let out = stages::cluster_faces(faces, &clusters.vertex_cluster, clusters.len(), false);
+    twins::ClusterBuild {
+        placed,
+        faces: out,
+        clusters: clusters.len(),
+        cells: cells.key.len(),
+        vertex_cluster: clusters.vertex_cluster,
+    }
+}
+
+#[test]
+fn the_gpu_build_equals_the_cpu_build() {
+    let Some(ctx) = gpu_context() else { return };
+    let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
+    for (name, m, sizes, lock) in cases() {
+        let (pos, lo, hi) = points(&m);
+        let locked = locked_of(pos.len(), lock);
+        let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
+        for h in sizes {
+            let grid = Grid::new(lo, hi, h);
+            let label = format!("{name} at h = {h}");
+            let g = gpu.build(&grid).unwrap();
+            let again = gpu.build(&grid).unwrap();
+            assert_eq!(g.faces, again.faces, "{label}: the same faces twice");
+            assert!(
+                g.placed
+                    .iter()
+                    .zip(&again.placed)
+                    .all(|(a, b)| a.pos == b.pos && a.quadric == b.quadric),
+                "{label}: the same vertices twice, bit for bit"
+            );
+            let twin = twins::run(&pos, &m.triangles, &locked, &grid).result();
+            assert_eq!(g.faces, twin.faces, "{label}: faces against the twins");
+            assert_eq!(
+                g.vertex_cluster, twin.vertex_cluster,
+                "{label}: vertex_cluster"
+            );
+            assert_eq!(
+                (g.clusters, g.cells),
+                (twin.clusters, twin.cells),
+                "{label}: counts"
+            );
+            let twins::ClusterBuild {
+                placed,
+                faces,
+                vertex_cluster,
+                ..
+            } = driver_build(&pos, &m.triangles, &locked, &grid);
+            assert_eq!(g.faces, faces, "{label}: faces against the driver's build");
+            assert_eq!(
+                g.vertex_cluster, vertex_cluster,
+                "{label}: clusters against the driver's"
+            );
+            assert_eq!(g.placed.len(), placed.len(), "{label}: clusters");
+            // The driver scatters its quadrics (face order, in chunks) where the GPU gathers
+            // (cluster by cluster): the same sums in another order, so the quadrics agree to f32
+            // rounding, and the regularised solve (eps = 1e-3 of the trace) stretches that up to
+            // a thousandfold along a cell's flat directions. So a vertex must lie within 1% of a
+            // cell of the driver's when both picked the same candidate, and cost, on the driver's
+            // quadric, no more than 1e-4 of the cluster's error scale (its planes' area times
+            // h²) above the driver's own choice. On a flat sheet every candidate costs zero and
+            // rounding picks among them: there only the cost can agree.
+            let (mut worst_move, mut worst_cost, mut flips) = (0f32, 0f32, 0);
+            for (k, (a, b)) in g.placed.iter().zip(&placed).enumerate() {
+                assert_eq!(
+                    a.how == Placement::Single,
+                    b.how == Placement::Single,
+                    "{label}: cluster {k}"
+                );
+                let d = [0, 1, 2].map(|i| a.pos[i] - b.pos[i]);
+                let moved = d.iter().fold(0f32, |m, x| m.max(x.abs())) / grid.h;
+                let own = quadric_eval(&b.quadric, [0.0; 3]);
+                let scale = b.quadric.q[2][2] * grid.h * grid.h;
+                let cost = (quadric_eval(&b.quadric, d) - own) / scale.max(1e-30);
+                if a.how == b.how {
+                    worst_move = worst_move.max(moved);
+                } else {
+                    flips += 1;
+                }
+                worst_cost = worst_cost.max(cost);
+            }
+            eprintln!(
+                "{label}: worst move {worst_move:e} cells, worst extra cost {worst_cost:e}, \
+                 {flips} of {} placed by another candidate",
+                placed.len()
+            );
+            assert!(
+                worst_move <= 1e-2,
+                "{label}: a vertex {worst_move} cells from the driver's"
+            );
+            assert!(
+                worst_cost <= 1e-4,
+                "{label}: a vertex costs {worst_cost} more than the driver's"
+            );
+        }
+    }
+}
+
+/// Timings, not a check: `cargo test --release --test gpu_cluster -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn time_a_build_on_icosphere_7() {
+    let Some(ctx) = gpu_context() else { return };
+    let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
+    let m = meshslim::mesh::icosphere(7);
+    let (pos, lo, hi) = points(&m);
+    let locked = locked_of(pos.len(), false);
+    let t = std::time::Instant::now();
+    let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
+    let setup = t.elapsed().as_secs_f64();
+    for h in [0.01f32, 0.003] {
+        let grid = Grid::new(lo, hi, h);
+        let t = std::time::Instant::now();
+        let g = gpu.build(&grid).unwrap();
+        let gpu_s = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        let d = driver_build(&pos, &m.triangles, &locked, &grid);
+        let cpu_s = t.elapsed().as_secs_f64();
+        assert_eq!(g.faces, d.faces);
+        eprintln!(
+            "icosphere(7), {} faces, h = {h}: {} faces; gpu build {gpu_s:.3} s (upload and \
+             vertex→face lists {setup:.3} s once), cpu driver build {cpu_s:.3} s",
+            m.triangles.len(),
+            g.faces.len()
+        );
+    }
+}
