@@ -187,7 +187,7 @@ fn max_error_bounds_the_cell() {
 
 #[test]
 fn clustering_on_the_gpu_backend_is_refused_with_a_clear_message() {
-    let mut o = opts(100, Method::Cluster);
+    let mut o = opts(100, Method::FloatingCell);
     o.backend = Backend::Gpu;
     match simplify(&icosphere(3), &o) {
         Err(Error::InvalidOption(msg)) => assert!(msg.contains("cpu-parallel"), "{msg}"),

@@ -6,10 +6,11 @@ mod common;
 
 use common::gpu_context;
 use meshslim::Mesh;
+use meshslim::cluster::gpu::{GpuClusterMesh, GpuClusterer, Part};
+use meshslim::cluster::gpu_schedule::CBuf;
 use meshslim::cluster::grid::Grid;
-use meshslim::cluster::stages::gpu::{GpuClusterMesh, GpuClusterer, Part};
-use meshslim::cluster::stages::gpu_schedule::CBuf;
-use meshslim::cluster::stages::{self, Placement, twins};
+use meshslim::cluster::stages::{self, Placement};
+use meshslim::cluster::twins;
 use meshslim::cpu::common::quadric_eval;
 use meshslim::gpu::types::{ClusterPlaced, Quadric, SORT_BLOCK};
 use meshslim::mesh::prepare::{frame_of, normalize};
@@ -406,32 +407,39 @@ fn the_gpu_build_equals_the_cpu_build() {
     }
 }
 
-/// Timings, not a check: `cargo test --release --test gpu_cluster -- --ignored --nocapture`.
+/// `meshslim simplify --method cluster --backend gpu` against `cpu-parallel`: the same search,
+/// so the same grid and the same faces; vertices within a few percent of a cell (the CPU driver
+/// sums its quadrics in face order, the GPU cluster by cluster).
 #[test]
-#[ignore]
-fn time_a_build_on_icosphere_7() {
-    let Some(ctx) = gpu_context() else { return };
-    let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
-    let m = meshslim::mesh::icosphere(7);
-    let (pos, lo, hi) = points(&m);
-    let locked = locked_of(pos.len(), false);
-    let t = std::time::Instant::now();
-    let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
-    let setup = t.elapsed().as_secs_f64();
-    for h in [0.01f32, 0.003] {
-        let grid = Grid::new(lo, hi, h);
-        let t = std::time::Instant::now();
-        let g = gpu.build(&grid).unwrap();
-        let gpu_s = t.elapsed().as_secs_f64();
-        let t = std::time::Instant::now();
-        let d = driver_build(&pos, &m.triangles, &locked, &grid);
-        let cpu_s = t.elapsed().as_secs_f64();
-        assert_eq!(g.faces, d.faces);
-        eprintln!(
-            "icosphere(7), {} faces, h = {h}: {} faces; gpu build {gpu_s:.3} s (upload and \
-             vertex→face lists {setup:.3} s once), cpu driver build {cpu_s:.3} s",
-            m.triangles.len(),
-            g.faces.len()
-        );
+fn simplify_on_the_gpu_writes_the_cpu_parallel_faces() {
+    if common::gpu_context().is_none() {
+        return;
+    }
+    let mut m = meshslim::mesh::icosphere(5);
+    meshslim::mesh::add_noise(&mut m, 0.01, 5);
+    for target in [2000, 300] {
+        let run = |backend| {
+            let mut o = meshslim::SimplifyOptions::with_faces(target);
+            o.method = meshslim::Method::Cluster;
+            o.backend = backend;
+            meshslim::simplify(&m, &o).unwrap()
+        };
+        let (cpu, rc) = run(meshslim::Backend::CpuParallel);
+        let (gpu, rg) = run(meshslim::Backend::Gpu);
+        assert_eq!(rg.backend, meshslim::Backend::Gpu);
+        assert_eq!(cpu.triangles, gpu.triangles, "target {target}");
+        let (cc, cg) = (rc.clustering.unwrap(), rg.clustering.unwrap());
+        assert_eq!(cg.cell_size, cc.cell_size);
+        let cell = cc.cell_size * 2.0 * 3f64.sqrt(); // the box's diagonal is 2√3
+        for (a, b) in cpu.positions.iter().zip(&gpu.positions) {
+            let d = (0..3)
+                .map(|i| (a[i] - b[i]) as f64)
+                .map(|x| x * x)
+                .sum::<f64>();
+            assert!(
+                d.sqrt() <= 0.05 * cell,
+                "{a:?} against {b:?} at target {target}"
+            );
+        }
     }
 }

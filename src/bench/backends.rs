@@ -57,6 +57,17 @@ pub static BACKENDS: &[BenchBackend] = &[
         band: crate::cluster::BAND,
     },
     BenchBackend {
+        name: "cluster-gpu",
+        about: "meshslim's uniform-grid vertex clustering as WGSL compute passes (wgpu)",
+        simplify: |m, faces| {
+            let mut o = with_method(faces, crate::Method::Cluster);
+            o.backend = crate::Backend::Gpu;
+            Ok(crate::simplify(m, &o)?.0)
+        },
+        device: gpu_name,
+        band: crate::cluster::BAND,
+    },
+    BenchBackend {
         name: "floating-cell",
         about: "meshslim's floating-cell vertex clustering, Low & Tan (cpu-parallel)",
         simplify: |m, faces| {
@@ -110,10 +121,14 @@ pub fn gpu_name() -> String {
     .clone()
 }
 
-/// Every backend this machine can run: all of [`BACKENDS`], less `gpu` without an adapter.
+/// Every backend this machine can run: all of [`BACKENDS`], less the GPU ones (`gpu`,
+/// `cluster-gpu`) without an adapter.
 pub fn available_backends() -> Vec<&'static BenchBackend> {
     let gpu = crate::gpu::shared().is_ok();
-    BACKENDS.iter().filter(|b| gpu || b.name != "gpu").collect()
+    BACKENDS
+        .iter()
+        .filter(|b| gpu || !matches!(b.name, "gpu" | "cluster-gpu"))
+        .collect()
 }
 
 /// The backend called `name` in [`BACKENDS`].

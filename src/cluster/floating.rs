@@ -9,10 +9,18 @@
 //! ([`radius`]); "within twice the radius" is then within the sum of the two radii.
 
 use super::grid::Grid;
-use super::stages::{self, Csr};
+use super::stages::{self, Csr, Placed};
+use super::{
+    Built, ClusterReport, Points, Work, check_backend, clustered_report, land, output, prepare,
+    tally,
+};
 use crate::cpu::common::{V3, dot, length, sub, tie_rank, xyz};
+use crate::error::Result;
+use crate::mesh::Mesh;
 use crate::mesh::morton::morton3;
+use crate::options::{Method, SimplifyOptions, SimplifyReport};
 use rayon::prelude::*;
+use std::time::Instant;
 
 /// Low & Tan's grade: `cos(θ/2)` for the widest angle θ between two edges at the vertex (a
 /// flat or straight-through vertex has θ near 180° and grades near 0, a tip or a crease
@@ -236,4 +244,92 @@ pub fn clusters_of(centre: &[u32]) -> (Vec<u32>, usize) {
         }
     }
     (centre.iter().map(|&c| id[c as usize]).collect(), n as usize)
+}
+
+/// One floating-cell clustering at radius `r`, and the rounds its centres took.
+fn build_floating(work: &Work, ranks: &[u64], r: f32) -> (Built, usize) {
+    let pts = work.pts;
+    let (centre, rounds) = claim(&pts.positions, ranks, &work.locked, pts.lo, pts.hi, r);
+    let (vertex_cluster, n) = clusters_of(&centre);
+    let centres: Vec<u32> = (0..centre.len() as u32)
+        .filter(|&v| centre[v as usize] == v)
+        .collect();
+    let origins: Vec<V3> = centres
+        .iter()
+        .map(|&c| xyz(pts.positions[c as usize]))
+        .collect();
+    let quadrics = stages::scatter_quadrics(&pts.positions, &pts.faces, &vertex_cluster, &origins);
+    let (order, start) =
+        crate::mesh::prepare::counting_sort(n, centre.len(), |v| vertex_cluster[v]);
+    let placed: Vec<Placed> = (0..n)
+        .into_par_iter()
+        .with_min_len(256)
+        .map(|k| {
+            let members = &order[start[k] as usize..start[k + 1] as usize];
+            let o = origins[k];
+            // The vertex stays in the centre's box of half-side r (a locked centre: itself).
+            let half = if work.locked[centres[k] as usize] {
+                0.0
+            } else {
+                r
+            };
+            let lo = o.map(|x| x - half);
+            let hi = o.map(|x| x + half);
+            stages::place(&pts.positions, quadrics[k], members, o, lo, hi)
+        })
+        .collect();
+    let faces = stages::cluster_faces(&pts.faces, &vertex_cluster, n, false);
+    let built = Built {
+        placed,
+        faces,
+        vertex_cluster,
+        clusters: n,
+        cells: n,
+    };
+    (built, rounds)
+}
+
+/// `--method floating-cell`.
+pub fn simplify_floating(
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport)> {
+    let backend = check_backend(opts)?;
+    let t = Instant::now();
+    let mut pts = Points::new(mesh);
+    let work = prepare(&mut pts, opts, false);
+    let ranks = {
+        let csr = Csr::new(work.pts.positions.len(), &work.pts.faces);
+        ranks(&grades(&work.pts.positions, &work.pts.faces, &csr))
+    };
+    progress(0.2);
+    let mut report = ClusterReport {
+        method: Method::FloatingCell,
+        ..Default::default()
+    };
+    // Centres are at least r apart, about one per 1.5 r² of surface, two faces each.
+    let target = opts.target_faces;
+    let first = (4.0 / 3.0 * work.pts.area / target.max(1) as f64).sqrt();
+    // A member is within its centre's radius (at most 1.1 r) of the centre, the vertex within
+    // the box of that half-side about it.
+    let cap = opts
+        .max_error
+        .map(|e| e / ((1.0 + 3f64.sqrt()) * (1.0 + 0.5 * JITTER as f64)));
+    let mut rounds = 0;
+    let (r, built, stop) = land(target, None, first, None, cap, &mut report, &mut |r| {
+        let (b, n) = build_floating(&work, &ranks, r as f32);
+        rounds = n;
+        Ok((r as f32 as f64, b))
+    })?;
+    opts.cancel.check()?;
+    progress(0.9);
+    tally(&mut report, &built);
+    report.split_clusters = 0;
+    report.cell_size = r;
+    report.centre_rounds = Some(rounds);
+    let (out, _) = output(mesh, work.pts, &built);
+    report.seconds = t.elapsed().as_secs_f64();
+    let report = clustered_report(mesh, opts, backend, &out, &built, stop, report);
+    Ok((out, report))
 }

@@ -5,9 +5,9 @@
 //! vertex→face lists and face planes ([`GpuClusterMesh::new`]); each build then records every
 //! pass in one command buffer and reads back two counts, then the result.
 
+use crate::cluster::gpu_schedule::{self as sched, CBuf, CCount, CGrid, CStage, CStep};
 use crate::cluster::grid::Grid;
-use crate::cluster::stages::gpu_schedule::{self as sched, CBuf, CCount, CGrid, CStage, CStep};
-use crate::cluster::stages::twins::{self, ClusterBuild};
+use crate::cluster::twins::{self, ClusterBuild};
 use crate::error::{Error, Result};
 use crate::gpu::context::{checked_buffer, checked_buffer_init};
 use crate::gpu::shaders::{source, stage_source};

@@ -9,8 +9,17 @@
 //! simplifier's do). `qem` keeps seams.
 
 pub mod floating;
+// `cluster` on the gpu backend: the build's stage descriptions, their CPU twins (the GPU's
+// gather order; the CPU driver scatters its quadrics instead) and the GPU driver.
+pub mod gpu;
+pub mod gpu_schedule;
 pub mod grid;
+mod hybrid;
 pub mod stages;
+pub mod twins;
+
+pub use floating::simplify_floating;
+pub use hybrid::{HYBRID_FACTOR, HYBRID_MIN_SHARE, HYBRID_SKIP, simplify_hybrid};
 
 use crate::cpu::common::{V3, xyz};
 use crate::error::{Error, Result};
@@ -25,19 +34,6 @@ use std::time::Instant;
 
 /// `cluster` lands within this share of the target.
 pub const BAND: f64 = 0.05;
-/// `hybrid` clusters to this many times the target, then the rounds take over: at 2 the mean
-/// error at 10% was 1.33× the greedy's on horse and 1.25× on igea, at 3 1.16× and 1.11×
-/// (the 1M scan, oversampled, 1.07× at 2); the rounds' time about doubles from 2 to 3
-/// (docs/PERFORMANCE.md, "hybrid")...
-pub const HYBRID_FACTOR: f64 = 3.0;
-/// ...but to no fewer than this share of the input's faces: cells coarse enough for 2% of the
-/// 1M scan left errors the rounds could not undo (mean 1.38× the greedy's at 1%, against
-/// 1.10× from 5%; docs/PERFORMANCE.md, "hybrid").
-pub const HYBRID_MIN_SHARE: f64 = 0.05;
-/// ...unless that is more than this share of the input: merging only pairs of vertices costs a
-/// clustering without saving rounds, so the rounds start from the input.
-pub const HYBRID_SKIP: f64 = 0.5;
-
 /// The points clustering works on, in the unit-diagonal frame.
 struct Points<'m> {
     positions: Vec<[f32; 4]>,
@@ -118,6 +114,8 @@ struct Work<'a, 'm> {
     /// Per point: clustered with nobody (a locked border; a hybrid cluster that made a
     /// non-manifold edge, taken apart).
     locked: Vec<bool>,
+    /// `--backend gpu`: the points on the device, each build run there by the same stages.
+    gpu: Option<std::sync::Mutex<gpu::GpuClusterMesh<'static>>>,
 }
 
 struct Gather {
@@ -127,7 +125,20 @@ struct Gather {
 }
 
 impl Work<'_, '_> {
-    fn build(&self, grid: &Grid) -> Built {
+    fn build(&self, grid: &Grid) -> Result<Built> {
+        if let Some(g) = &self.gpu {
+            let b = g
+                .lock()
+                .map_err(|_| Error::Internal("the GPU clustering lock is poisoned".into()))?
+                .build(grid)?;
+            return Ok(Built {
+                placed: b.placed,
+                faces: b.faces,
+                vertex_cluster: b.vertex_cluster,
+                clusters: b.clusters,
+                cells: b.cells,
+            });
+        }
         let keys = stages::cell_keys(grid, &self.pts.positions, &self.locked);
         let (sorted, members) = stages::radix_sort(&keys);
         drop(keys);
@@ -200,13 +211,13 @@ impl Work<'_, '_> {
             clusters.len(),
             self.gather.is_some(),
         );
-        Built {
+        Ok(Built {
             placed,
             faces,
             clusters: clusters.len(),
             vertex_cluster: clusters.vertex_cluster,
             cells: cells.key.len(),
-        }
+        })
     }
 }
 
@@ -214,42 +225,6 @@ impl Work<'_, '_> {
 /// (occupied cells ≈ 1.5 area / h², two faces a cell).
 fn estimate(area: f64, faces: usize) -> f32 {
     (3.0 * area / faces.max(1) as f64).sqrt() as f32
-}
-
-/// `hybrid` takes clusters on non-manifold edges apart at most this many times.
-const MAX_REPAIRS: usize = 4;
-
-/// The clusters at either end of an edge that more than two faces share, or that two faces
-/// run the same way (a fold), sorted.
-fn pinched_clusters(b: &Built) -> Vec<u32> {
-    let mut half: Vec<(u64, bool)> = b
-        .faces
-        .par_iter()
-        .flat_map_iter(|(_, t)| {
-            (0..3).map(move |i| {
-                let (a, c) = (t[i], t[(i + 1) % 3]);
-                (((a.min(c) as u64) << 32) | a.max(c) as u64, a < c)
-            })
-        })
-        .collect();
-    half.par_sort_unstable();
-    let mut bad = Vec::new();
-    let mut i = 0;
-    while i < half.len() {
-        let mut j = i + 1;
-        while j < half.len() && half[j].0 == half[i].0 {
-            j += 1;
-        }
-        let pinched = j - i > 2 || (j - i == 2 && half[i].1 == half[i + 1].1);
-        if pinched {
-            bad.push((half[i].0 >> 32) as u32);
-            bad.push(half[i].0 as u32);
-        }
-        i = j;
-    }
-    bad.sort_unstable();
-    bad.dedup();
-    bad
 }
 
 /// Builds at most this many times to land in the band.
@@ -265,7 +240,7 @@ fn cluster_to(
     max_error: Option<f64>,
     floor: Option<usize>,
     report: &mut ClusterReport,
-) -> (Grid, Built, StopReason) {
+) -> Result<(Grid, Built, StopReason)> {
     let pts = work.pts;
     let (lo, hi) = (pts.lo, pts.hi);
     let h0 = estimate(pts.area, target) as f64;
@@ -287,9 +262,9 @@ fn cluster_to(
     let cap = max_error.map(|e| e / 3f64.sqrt());
     let (h, built, stop) = land(target, floor, first, Some(&probed), cap, report, &mut |h| {
         let g = Grid::new(lo, hi, h as f32);
-        (g.h as f64, work.build(&g))
-    });
-    (Grid::new(lo, hi, h as f32), built, stop)
+        Ok((g.h as f64, work.build(&g)?))
+    })?;
+    Ok((Grid::new(lo, hi, h as f32), built, stop))
 }
 
 /// Builds at sizes corrected by each build's own count until one lands: the first at `first`,
@@ -303,8 +278,8 @@ fn land(
     probed: Option<&[(f64, f64)]>,
     cap: Option<f64>,
     report: &mut ClusterReport,
-    build: &mut dyn FnMut(f64) -> (f64, Built),
-) -> (f64, Built, StopReason) {
+    build: &mut dyn FnMut(f64) -> Result<(f64, Built)>,
+) -> Result<(f64, Built, StopReason)> {
     let t = target.max(1) as f64;
     let mut h = first;
     let mut stop = StopReason::TargetReached;
@@ -321,7 +296,7 @@ fn land(
             h = cap;
             stop = StopReason::MaxError;
         }
-        let (used, built) = build(h);
+        let (used, built) = build(h)?;
         report.builds += 1;
         let n = built.faces.len() as f64;
         let done = stop == StopReason::MaxError || ok(n);
@@ -378,7 +353,7 @@ fn land(
     if stop == StopReason::TargetReached && floor.is_none() && (n - t).abs() > BAND * t {
         stop = StopReason::ClusterBand;
     }
-    (h, built, stop)
+    Ok((h, built, stop))
 }
 
 /// The probes' count at `h`, interpolated in log-log between the nearest two.
@@ -522,6 +497,7 @@ fn prepare<'a, 'm>(pts: &'a mut Points<'m>, opts: &SimplifyOptions, split: bool)
         gather: gather.filter(|_| split),
         border_weight: opts.border_weight as f32,
         locked,
+        gpu: None,
     }
 }
 
@@ -545,12 +521,15 @@ fn border_vertices(csr: &Csr, faces: &[[u32; 3]]) -> Vec<bool> {
         .collect()
 }
 
+/// The backend a clustering method runs on: `cluster` on the GPU when asked (`auto` takes the
+/// CPU: on lavapipe a build is 4-12x slower, docs/PERFORMANCE.md), the others on the CPU.
 fn check_backend(opts: &SimplifyOptions) -> Result<Backend> {
     match opts.backend {
         Backend::Cpu | Backend::CpuParallel | Backend::Auto => Ok(Backend::CpuParallel),
+        Backend::Gpu if opts.method == Method::Cluster => Ok(Backend::Gpu),
         Backend::Gpu => Err(Error::InvalidOption(format!(
             "--method {} runs on the CPU only so far (backend cpu-parallel); the gpu backend \
-             runs --method qem",
+             runs --method qem and cluster",
             opts.method.name()
         ))),
         #[allow(unreachable_patterns)]
@@ -567,110 +546,27 @@ pub fn simplify_cluster(
     let backend = check_backend(opts)?;
     let t = Instant::now();
     let mut pts = Points::new(mesh);
-    let work = prepare(&mut pts, opts, false);
+    let mut work = prepare(&mut pts, opts, false);
+    if backend == Backend::Gpu {
+        let g = gpu::GpuClusterMesh::new(
+            gpu::shared()?,
+            &work.pts.positions,
+            &work.pts.faces,
+            &work.locked,
+        )?;
+        work.gpu = Some(std::sync::Mutex::new(g));
+    }
     progress(0.2);
     let mut report = ClusterReport {
         method: Method::Cluster,
         ..Default::default()
     };
     let (grid, built, stop) =
-        cluster_to(&work, opts.target_faces, opts.max_error, None, &mut report);
+        cluster_to(&work, opts.target_faces, opts.max_error, None, &mut report)?;
     opts.cancel.check()?;
     progress(0.9);
     tally(&mut report, &built);
     report.cell_size = grid.h as f64;
-    let (out, _) = output(mesh, work.pts, &built);
-    report.seconds = t.elapsed().as_secs_f64();
-    let report = clustered_report(mesh, opts, backend, &out, &built, stop, report);
-    Ok((out, report))
-}
-
-/// One floating-cell clustering at radius `r`, and the rounds its centres took.
-fn build_floating(work: &Work, ranks: &[u64], r: f32) -> (Built, usize) {
-    let pts = work.pts;
-    let (centre, rounds) = floating::claim(&pts.positions, ranks, &work.locked, pts.lo, pts.hi, r);
-    let (vertex_cluster, n) = floating::clusters_of(&centre);
-    let centres: Vec<u32> = (0..centre.len() as u32)
-        .filter(|&v| centre[v as usize] == v)
-        .collect();
-    let origins: Vec<V3> = centres
-        .iter()
-        .map(|&c| xyz(pts.positions[c as usize]))
-        .collect();
-    let quadrics = stages::scatter_quadrics(&pts.positions, &pts.faces, &vertex_cluster, &origins);
-    let (order, start) =
-        crate::mesh::prepare::counting_sort(n, centre.len(), |v| vertex_cluster[v]);
-    let placed: Vec<Placed> = (0..n)
-        .into_par_iter()
-        .with_min_len(256)
-        .map(|k| {
-            let members = &order[start[k] as usize..start[k + 1] as usize];
-            let o = origins[k];
-            // The vertex stays in the centre's box of half-side r (a locked centre: itself).
-            let half = if work.locked[centres[k] as usize] {
-                0.0
-            } else {
-                r
-            };
-            let lo = o.map(|x| x - half);
-            let hi = o.map(|x| x + half);
-            stages::place(&pts.positions, quadrics[k], members, o, lo, hi)
-        })
-        .collect();
-    let faces = stages::cluster_faces(&pts.faces, &vertex_cluster, n, false);
-    let built = Built {
-        placed,
-        faces,
-        vertex_cluster,
-        clusters: n,
-        cells: n,
-    };
-    (built, rounds)
-}
-
-/// `--method floating-cell`.
-pub fn simplify_floating(
-    mesh: &Mesh,
-    opts: &SimplifyOptions,
-    progress: &mut dyn FnMut(f32),
-) -> Result<(Mesh, SimplifyReport)> {
-    let backend = check_backend(opts)?;
-    let t = Instant::now();
-    let mut pts = Points::new(mesh);
-    let work = prepare(&mut pts, opts, false);
-    let ranks = {
-        let csr = Csr::new(work.pts.positions.len(), &work.pts.faces);
-        floating::ranks(&floating::grades(
-            &work.pts.positions,
-            &work.pts.faces,
-            &csr,
-        ))
-    };
-    progress(0.2);
-    let mut report = ClusterReport {
-        method: Method::FloatingCell,
-        ..Default::default()
-    };
-    // Centres are at least r apart, about one per 1.5 r² of surface, two faces each.
-    let target = opts.target_faces;
-    let first = (4.0 / 3.0 * work.pts.area / target.max(1) as f64).sqrt();
-    // A member is within its centre's radius (at most 1.1 r) of the centre, the vertex within
-    // the box of that half-side about it.
-    let cap = opts
-        .max_error
-        .map(|e| e / ((1.0 + 3f64.sqrt()) * (1.0 + 0.5 * floating::JITTER as f64)));
-    let mut rounds = 0;
-    let (r, built, stop) = land(target, None, first, None, cap, &mut report, &mut |r| {
-        let (b, n) = build_floating(&work, &ranks, r as f32);
-        rounds = n;
-        (r as f32 as f64, b)
-    });
-    opts.cancel.check()?;
-    progress(0.9);
-    tally(&mut report, &built);
-    report.split_clusters = 0;
-    report.cell_size = r;
-    report.centre_rounds = Some(rounds);
     let (out, _) = output(mesh, work.pts, &built);
     report.seconds = t.elapsed().as_secs_f64();
     let report = clustered_report(mesh, opts, backend, &out, &built, stop, report);
@@ -704,81 +600,4 @@ fn clustered_report(
         blocked: None,
         clustering: Some(report),
     }
-}
-
-/// `--method hybrid`.
-pub fn simplify_hybrid(
-    mesh: &Mesh,
-    opts: &SimplifyOptions,
-    progress: &mut dyn FnMut(f32),
-) -> Result<(Mesh, SimplifyReport)> {
-    let backend = check_backend(opts)?;
-    let opts = &SimplifyOptions {
-        backend,
-        ..opts.clone()
-    };
-    let t = Instant::now();
-    let intermediate = ((opts.target_faces as f64 * HYBRID_FACTOR)
-        .max(HYBRID_MIN_SHARE * mesh.triangles.len() as f64))
-    .round() as usize;
-    let mut report = ClusterReport {
-        method: Method::Hybrid,
-        ..Default::default()
-    };
-    let (up, built_error) = if intermediate as f64 >= HYBRID_SKIP * mesh.triangles.len() as f64
-        || opts.target_faces == 0
-    {
-        (crate::parallel::Upload::new(mesh), 0.0)
-    } else {
-        let mut pts = Points::new(mesh);
-        let mut work = prepare(&mut pts, opts, true);
-        let (grid, mut built, _) = cluster_to(
-            &work,
-            intermediate,
-            None,
-            Some(opts.target_faces),
-            &mut report,
-        );
-        // Splitting cells by connectivity keeps separate sheets apart, but a sheet folded
-        // inside one cell can still pinch into a non-manifold edge: take the clusters on one
-        // apart (their members each their own cluster) and build again, until none is left.
-        for _ in 0..MAX_REPAIRS {
-            let bad = pinched_clusters(&built);
-            if bad.is_empty() {
-                break;
-            }
-            for (v, &k) in built.vertex_cluster.iter().enumerate() {
-                if bad.binary_search(&k).is_ok() {
-                    work.locked[v] = true;
-                }
-            }
-            built = work.build(&grid);
-            report.builds += 1;
-            report.repaired_clusters += bad.len();
-        }
-        tally(&mut report, &built);
-        report.cell_size = grid.h as f64;
-        report.intermediate_faces = Some(built.faces.len());
-        let (clustered, quadrics) = output(mesh, work.pts, &built);
-        let frame = (work.pts.center, work.pts.scale);
-        (
-            crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics),
-            max_error(&built),
-        )
-    };
-    report.seconds = t.elapsed().as_secs_f64();
-    opts.cancel.check()?;
-    let mut runner = crate::cpu::CpuRounds::new(&up, crate::parallel::SELECTION_PASSES);
-    let (out, mut r) = crate::parallel::simplify_rounds(
-        &mut runner,
-        &up,
-        mesh,
-        opts,
-        progress,
-        Default::default(),
-    )?;
-    r.max_collapse_error = r.max_collapse_error.max(built_error);
-    r.collapses = mesh.positions.len().saturating_sub(out.positions.len());
-    r.clustering = Some(report);
-    Ok((out, r))
 }

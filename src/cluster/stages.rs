@@ -611,13 +611,3 @@ pub fn cluster_faces(
         .filter_map(|(k, d)| (!d).then_some(k))
         .collect()
 }
-
-// `cluster` on the gpu backend: the build's stage descriptions, their CPU twins and the GPU
-// driver. Declared here rather than in cluster/mod.rs while that file is being reworked; moving
-// these three declarations there (without the paths) changes nothing but the modules' paths.
-#[path = "gpu.rs"]
-pub mod gpu;
-#[path = "gpu_schedule.rs"]
-pub mod gpu_schedule;
-#[path = "twins.rs"]
-pub mod twins;
