@@ -76,8 +76,8 @@ fn json_and_plot_have_every_backend_at_every_ratio() {
                     "{backend} at {ratio}: {field} missing or null:\n{row:#}"
                 );
             }
-            // The device that ran it: the CPU, or the GPU adapter for the gpu backend.
-            if backend == "gpu" {
+            // The device that ran it: the CPU, or the GPU adapter for the GPU backends.
+            if backend == "gpu" || backend == "cluster-gpu" {
                 assert_ne!(row["device"], cpu, "{row:#}");
             } else {
                 assert_eq!(row["device"], cpu);
