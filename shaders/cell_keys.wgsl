@@ -1,5 +1,6 @@
 // Per vertex: the Morton key of its grid cell (SINGLETON when locked) and its id, the pairs the
-// radix sort orders. Relies on the same f32 arithmetic as Grid::key (subtract, divide, truncate).
+// radix sort orders. Relies on the same f32 arithmetic as Grid::key (subtract, multiply by the
+// inverse cell size, truncate): correctly rounded in Vulkan, so every device finds the same cell.
 
 @group(0) @binding(0) var<uniform> cluster: ClusterParams;
 @group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>; // per vertex
@@ -24,7 +25,7 @@ fn cell_keys(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     }
     var key = SINGLETON;
     if (locked[v] == 0u) {
-        let q = max((positions[v].xyz - cluster.lo_h.xyz) / cluster.lo_h.w, vec3<f32>(0.0));
+        let q = max((positions[v].xyz - cluster.lo_h.xyz) * cluster.inv_h, vec3<f32>(0.0));
         let c = min(vec3<u32>(q), cluster.dims.xyz - vec3<u32>(1u));
         key = spread3(c.x) | (spread3(c.y) << 1u) | (spread3(c.z) << 2u);
     }

@@ -16,7 +16,7 @@ struct ClusterParams {
     dims: vec4<u32>,
     vertex_count: u32,
     face_count: u32,
-    _pad0: u32,
+    inv_h: f32,
     _pad1: u32,
 }
 

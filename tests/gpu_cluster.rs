@@ -302,14 +302,19 @@ fn driver_build(
         .collect();
     let centre = |k: usize| [0, 1, 2].map(|i| 0.5 * (boxes[k].0[i] + boxes[k].1[i]));
     let origins: Vec<[f32; 3]> = (0..clusters.len()).map(centre).collect();
-    let q = stages::scatter_quadrics(pos, faces, &clusters.vertex_cluster, &origins);
+    let (q, marked) = stages::scatter_quadrics(pos, faces, &clusters.vertex_cluster, &origins);
     let placed: Vec<stages::Placed> = (0..clusters.len())
         .map(|k| {
             let members: Vec<u32> = clusters.members(&cells, None, k).collect();
             stages::place(pos, q[k], &members, centre(k), boxes[k].0, boxes[k].1)
         })
         .collect();
-    let out = stages::cluster_faces(faces, &clusters.vertex_cluster, clusters.len(), false);
+    let out = stages::dedupe_faces(marked, clusters.len(), false);
+    // The faces the scatter marks are the ones `cluster_faces` finds on its own.
+    assert_eq!(
+        out,
+        stages::cluster_faces(faces, &clusters.vertex_cluster, clusters.len(), false)
+    );
     twins::ClusterBuild {
         placed,
         faces: out,

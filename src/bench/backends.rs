@@ -78,7 +78,7 @@ pub static BACKENDS: &[BenchBackend] = &[
     },
     BenchBackend {
         name: "hybrid",
-        about: "meshslim's clustering to three times the target, then the rounds (cpu-parallel)",
+        about: "meshslim's clustering to 2x the target + 20k faces, then the rounds (cpu-parallel)",
         simplify: |m, faces| Ok(crate::simplify(m, &with_method(faces, crate::Method::Hybrid))?.0),
         device: cpu_name,
         band: 0.0,

@@ -142,7 +142,7 @@ pub enum MethodArg {
     /// creases), so features survive where a uniform grid cuts them; within 5% of the target,
     /// slower than cluster, topology and UV seams as cluster
     FloatingCell,
-    /// Clustering to three times the target, then qem's rounds to the exact target with the
+    /// Clustering to twice the target plus 20,000 faces, then qem's rounds to the exact target with the
     /// clusters' quadrics: near-qem error in a fraction of the time on large scans; closes UV
     /// seams (cpu-parallel)
     Hybrid,

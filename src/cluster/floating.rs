@@ -258,7 +258,8 @@ fn build_floating(work: &Work, ranks: &[u64], r: f32) -> (Built, usize) {
         .iter()
         .map(|&c| xyz(pts.positions[c as usize]))
         .collect();
-    let quadrics = stages::scatter_quadrics(&pts.positions, &pts.faces, &vertex_cluster, &origins);
+    let (quadrics, marked) =
+        stages::scatter_quadrics(&pts.positions, &pts.faces, &vertex_cluster, &origins);
     let (order, start) =
         crate::mesh::prepare::counting_sort(n, centre.len(), |v| vertex_cluster[v]);
     let placed: Vec<Placed> = (0..n)
@@ -278,7 +279,7 @@ fn build_floating(work: &Work, ranks: &[u64], r: f32) -> (Built, usize) {
             stages::place(&pts.positions, quadrics[k], members, o, lo, hi)
         })
         .collect();
-    let faces = stages::cluster_faces(&pts.faces, &vertex_cluster, n, false);
+    let faces = stages::dedupe_faces(marked, n, false);
     let built = Built {
         placed,
         faces,

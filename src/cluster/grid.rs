@@ -17,6 +17,10 @@ pub const MAX_CELLS: u32 = 1024;
 pub struct Grid {
     pub lo: V3,
     pub h: f32,
+    /// `1 / h`: cells are found by multiplying, which Vulkan rounds correctly where a division
+    /// may be off by 2.5 ulp (the GPU must find the same cells), and which is several times
+    /// cheaper than dividing (the counting pass took 0.016 s of 0.09 s on the 1M scan).
+    pub inv_h: f32,
     pub dims: [u32; 3],
 }
 
@@ -29,12 +33,18 @@ impl Grid {
             .max(extent / (MAX_CELLS - 1) as f32)
             .max(f32::MIN_POSITIVE);
         let dims = [0, 1, 2].map(|i| (((hi[i] - lo[i]) / h).floor() as u32 + 1).min(MAX_CELLS));
-        Grid { lo, h, dims }
+        Grid {
+            lo,
+            h,
+            inv_h: 1.0 / h,
+            dims,
+        }
     }
 
     #[inline]
     pub fn coords(&self, p: V3) -> [u32; 3] {
-        [0, 1, 2].map(|i| (((p[i] - self.lo[i]) / self.h).max(0.0) as u32).min(self.dims[i] - 1))
+        [0, 1, 2]
+            .map(|i| (((p[i] - self.lo[i]) * self.inv_h).max(0.0) as u32).min(self.dims[i] - 1))
     }
 
     #[inline]
@@ -73,27 +83,42 @@ pub fn probe_sampled(
     faces: &[[u32; 3]],
     stride: usize,
 ) -> Vec<usize> {
-    grids
-        .iter()
-        .map(|g| {
-            let key = |v: u32| {
-                if locked[v as usize] {
-                    SINGLETON | v
-                } else {
-                    g.key(xyz(positions[v as usize]))
+    assert!(grids.len() <= 4, "a probe counts four grids at most");
+    // Runs of 64 faces, one run in `stride`: a file's faces are often not in spatial order,
+    // and single faces `stride` apart read their corners from all over memory (0.016 s for the
+    // 1M scan's sample, against 0.004 s in runs).
+    const RUN: usize = 64;
+    let sampled: Vec<usize> = (0..faces.len())
+        .step_by(RUN * stride)
+        .flat_map(|a| a..(a + RUN).min(faces.len()))
+        .collect();
+    // One pass for all four grids: each sampled face's corners read once.
+    let counts = sampled
+        .par_iter()
+        .with_min_len(4096)
+        .fold(
+            || [0usize; 4],
+            |mut acc, &i| {
+                let t = faces[i];
+                let p = t.map(|v| xyz(positions[v as usize]));
+                for (g, a) in grids.iter().zip(acc.iter_mut()) {
+                    let k = [0, 1, 2].map(|c| {
+                        if locked[t[c] as usize] {
+                            SINGLETON | t[c]
+                        } else {
+                            g.key(p[c])
+                        }
+                    });
+                    *a += (k[0] != k[1] && k[1] != k[2] && k[0] != k[2]) as usize;
                 }
-            };
-            let n = faces.len().div_ceil(stride);
-            (0..n)
-                .into_par_iter()
-                .with_min_len(4096)
-                .filter(|&i| {
-                    let [a, b, c] = faces[i * stride].map(key);
-                    a != b && b != c && a != c
-                })
-                .count()
-                * stride
-        })
+                acc
+            },
+        )
+        .reduce(|| [0usize; 4], |a, b| [0, 1, 2, 3].map(|i| a[i] + b[i]));
+    let scale = faces.len() as f64 / sampled.len().max(1) as f64;
+    counts[..grids.len()]
+        .iter()
+        .map(|&c| (c as f64 * scale).round() as usize)
         .collect()
 }
 

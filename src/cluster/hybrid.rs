@@ -11,11 +11,15 @@ use crate::options::{Method, SimplifyOptions, SimplifyReport};
 use rayon::prelude::*;
 use std::time::Instant;
 
-/// `hybrid` clusters to this many times the target, then the rounds take over: at 2 the mean
-/// error at 10% was 1.33× the greedy's on horse and 1.25× on igea, at 3 1.16× and 1.11×
-/// (the 1M scan, oversampled, 1.07× at 2); the rounds' time about doubles from 2 to 3
-/// (docs/PERFORMANCE.md, "hybrid")...
-pub const HYBRID_FACTOR: f64 = 3.0;
+/// `hybrid` clusters to this many times the target...
+pub const HYBRID_FACTOR: f64 = 2.0;
+/// ...plus this many faces: how much clustering costs in error depends on how coarse its cells
+/// are against the surface's features, that is on the faces it keeps, not on the ratio. At 2×
+/// the target alone the mean error at 10% was 1.07× the greedy's on the oversampled 1M scan but
+/// 1.33× on horse and 1.25× on igea; at 3× the 1M scan's hybrid fell below meshoptimizer's
+/// speed; 2× + 20,000 gave 1.06×, 1.09× and 1.13× with the 1M scan 1.18× meshoptimizer's
+/// speed (docs/PERFORMANCE.md, "Clustering").
+pub const HYBRID_EXTRA: f64 = 20_000.0;
 /// ...but to no fewer than this share of the input's faces: cells coarse enough for 2% of the
 /// 1M scan left errors the rounds could not undo (mean 1.38× the greedy's at 1%, against
 /// 1.10× from 5%; docs/PERFORMANCE.md, "hybrid").
@@ -72,7 +76,7 @@ pub fn simplify_hybrid(
         ..opts.clone()
     };
     let t = Instant::now();
-    let intermediate = ((opts.target_faces as f64 * HYBRID_FACTOR)
+    let intermediate = ((opts.target_faces as f64 * HYBRID_FACTOR + HYBRID_EXTRA)
         .max(HYBRID_MIN_SHARE * mesh.triangles.len() as f64))
     .round() as usize;
     let mut report = ClusterReport {

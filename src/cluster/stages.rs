@@ -83,9 +83,10 @@ pub fn cell_keys(grid: &Grid, positions: &[[f32; 4]], locked: &[bool]) -> Vec<u3
 }
 
 /// `radix_sort`: the vertex ids `0..n` ordered by key, stable (so by (key, id)): least
-/// significant digit first, 8 bits a pass, as many passes as the largest key needs. Each pass
-/// is what the GPU's `radix_count`, `prefix_sum` and `radix_scatter` do over blocks; the order
-/// is unique, so the GPU's buffers match these after every pass.
+/// significant digit first, as many passes as the largest key needs. The order is unique, so
+/// this is the GPU's result whatever the digit: the GPU sorts 8 bits a pass (twins.rs has its
+/// pass-for-pass twin), this 11 (2,048 counters stay in the L1 cache): 2 passes for the 1M
+/// scan's 22-bit keys at 10%, where 8-bit digits took 3.
 pub fn radix_sort(keys: &[u32]) -> (Vec<u32>, Vec<u32>) {
     let max = keys.iter().copied().max().unwrap_or(0);
     let bits = 32 - max.leading_zeros();
@@ -93,17 +94,19 @@ pub fn radix_sort(keys: &[u32]) -> (Vec<u32>, Vec<u32>) {
     let mut v: Vec<u32> = (0..keys.len() as u32).collect();
     let mut k2 = vec![0u32; keys.len()];
     let mut v2 = vec![0u32; keys.len()];
-    for pass in 0..bits.div_ceil(8) {
-        let shift = 8 * pass;
-        let mut start = [0u32; 257];
+    const DIGIT: u32 = 11;
+    const MASK: u32 = (1 << DIGIT) - 1;
+    for pass in 0..bits.div_ceil(DIGIT) {
+        let shift = DIGIT * pass;
+        let mut start = vec![0u32; MASK as usize + 2];
         for &x in &k {
-            start[((x >> shift) & 0xff) as usize + 1] += 1;
+            start[((x >> shift) & MASK) as usize + 1] += 1;
         }
-        for d in 0..256 {
+        for d in 0..=MASK as usize {
             start[d + 1] += start[d];
         }
         for (&x, &id) in k.iter().zip(&v) {
-            let d = ((x >> shift) & 0xff) as usize;
+            let d = ((x >> shift) & MASK) as usize;
             let at = start[d] as usize;
             k2[at] = x;
             v2[at] = id;
@@ -391,67 +394,67 @@ const SCATTER_CHUNKS: usize = 4;
 /// relative to each cluster's `origin`. Faces are summed in [`SCATTER_CHUNKS`] fixed chunks,
 /// each in face order, and the chunks added in order: deterministic for any thread count. It
 /// saves building the lists (0.02 s of 0.13 s on the 1M scan); the GPU gathers instead, the
-/// same sums in another order, equal to f32 rounding.
+/// same sums in another order, equal to f32 rounding. The same pass marks the faces that
+/// survive (`cluster_faces_mark`, in face order): reading every face's clusters twice cost
+/// 0.02 s more on the 1M scan, whose faces are not in spatial order.
 pub fn scatter_quadrics(
     positions: &[[f32; 4]],
     faces: &[[u32; 3]],
     vertex_cluster: &[u32],
     origins: &[V3],
-) -> Vec<Quadric> {
+) -> (Vec<Quadric>, Vec<(u32, [u32; 3])>) {
     let n = origins.len();
     let chunk = faces.len().div_ceil(SCATTER_CHUNKS).max(1);
-    let parts: Vec<Vec<Quadric>> = faces
+    let parts: Vec<(Vec<Quadric>, Vec<(u32, [u32; 3])>)> = faces
         .par_chunks(chunk)
-        .map(|part| {
+        .enumerate()
+        .map(|(ci, part)| {
             let mut acc = vec![Quadric::default(); n];
-            for t in part {
+            let mut kept = Vec::new();
+            for (i, t) in part.iter().enumerate() {
                 let k = t.map(|v| vertex_cluster[v as usize]);
-                if k[0] == k[1] && k[1] == k[2] {
-                    // Inside one cluster: the plane three times.
-                    add_plane(
-                        &mut acc[k[0] as usize],
-                        positions,
-                        t,
-                        origins[k[0] as usize],
-                        3.0,
-                    );
+                if let Some(r) = rotated(k) {
+                    kept.push(((ci * chunk + i) as u32, r));
+                }
+                let p = t.map(|v| xyz(positions[v as usize]));
+                let c = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+                let l = length(c);
+                if l <= 0.0 {
                     continue;
                 }
-                for i in 0..3 {
-                    add_plane(
-                        &mut acc[k[i] as usize],
-                        positions,
-                        t,
-                        origins[k[i] as usize],
-                        1.0,
-                    );
+                let n = scale(c, 1.0 / l);
+                let area = 0.5 * l;
+                let mut add = |k: u32, times: f32| {
+                    let d = dot(n, sub(origins[k as usize], p[0]));
+                    let q = &mut acc[k as usize];
+                    *q = quadric_add(q, &quadric_from_plane(n, d, times * area));
+                };
+                if k[0] == k[1] && k[1] == k[2] {
+                    // Inside one cluster: the plane three times.
+                    add(k[0], 3.0);
+                } else {
+                    for &ki in &k {
+                        add(ki, 1.0);
+                    }
                 }
             }
-            acc
+            (acc, kept)
         })
         .collect();
-    let mut parts = parts.into_iter();
-    let mut sum = parts.next().unwrap_or_else(|| vec![Quadric::default(); n]);
-    for part in parts {
-        sum.par_iter_mut()
-            .zip(part)
-            .with_min_len(4096)
-            .for_each(|(s, p)| *s = quadric_add(s, &p));
+    let mut kept = Vec::with_capacity(parts.iter().map(|p| p.1.len()).sum());
+    let mut sum: Option<Vec<Quadric>> = None;
+    for (part, marks) in parts {
+        kept.extend(marks);
+        match &mut sum {
+            None => sum = Some(part),
+            Some(sum) => sum
+                .par_iter_mut()
+                .zip(part)
+                .with_min_len(4096)
+                .for_each(|(s, p)| *s = quadric_add(s, &p)),
+        }
     }
-    sum
-}
-
-/// Adds face `t`'s plane, weighted by `times` its area, relative to `o`.
-#[inline]
-fn add_plane(q: &mut Quadric, positions: &[[f32; 4]], t: &[u32; 3], o: V3, times: f32) {
-    let p = t.map(|v| xyz(positions[v as usize]));
-    let c = cross(sub(p[1], p[0]), sub(p[2], p[0]));
-    let l = length(c);
-    if l > 0.0 {
-        let n = scale(c, 1.0 / l);
-        let d = dot(n, sub(o, p[0]));
-        *q = quadric_add(q, &quadric_from_plane(n, d, times * 0.5 * l));
-    }
+    (sum.unwrap_or_else(|| vec![Quadric::default(); n]), kept)
 }
 
 /// Σ over members and their faces of the face planes (and border planes), relative to `o`.
@@ -548,21 +551,32 @@ pub fn cluster_faces(
         .par_iter()
         .enumerate()
         .with_min_len(4096)
-        .filter_map(|(f, t)| {
-            let [a, b, c] = t.map(|v| vertex_cluster[v as usize]);
-            if a == b || b == c || a == c {
-                return None;
-            }
-            let r = if a < b && a < c {
-                [a, b, c]
-            } else if b < c {
-                [b, c, a]
-            } else {
-                [c, a, b]
-            };
-            Some((f as u32, r))
-        })
+        .filter_map(|(f, t)| Some((f as u32, rotated(t.map(|v| vertex_cluster[v as usize]))?)))
         .collect();
+    dedupe_faces(kept, clusters, drop_pairs)
+}
+
+/// A face over clusters `[a, b, c]` if the three differ, rotated so the lowest comes first.
+#[inline]
+pub fn rotated([a, b, c]: [u32; 3]) -> Option<[u32; 3]> {
+    if a == b || b == c || a == c {
+        None
+    } else if a < b && a < c {
+        Some([a, b, c])
+    } else if b < c {
+        Some([b, c, a])
+    } else {
+        Some([c, a, b])
+    }
+}
+
+/// The second half of [`cluster_faces`]: `kept` (face id, rotated clusters), in face order,
+/// less exact repeats (and with `drop_pairs` opposite windings).
+pub fn dedupe_faces(
+    kept: Vec<(u32, [u32; 3])>,
+    clusters: usize,
+    drop_pairs: bool,
+) -> Vec<(u32, [u32; 3])> {
     // Bucket by the first cluster (stable, so face order within), then sort each small bucket
     // by (b, c, face) as `adjacency_sort` sorts a vertex's faces.
     let (order, start) =

@@ -18,7 +18,8 @@ pub fn cluster_params(grid: &Grid, vertices: usize, faces: usize) -> ClusterPara
         dims: [grid.dims[0], grid.dims[1], grid.dims[2], 0],
         vertex_count: vertices as u32,
         face_count: faces as u32,
-        _pad: [0; 2],
+        inv_h: grid.inv_h,
+        _pad: 0,
     }
 }
 
@@ -26,6 +27,7 @@ pub fn grid_of(c: &ClusterParams) -> Grid {
     Grid {
         lo: [c.lo_h[0], c.lo_h[1], c.lo_h[2]],
         h: c.lo_h[3],
+        inv_h: c.inv_h,
         dims: [c.dims[0], c.dims[1], c.dims[2]],
     }
 }

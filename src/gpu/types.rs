@@ -215,7 +215,9 @@ pub struct ClusterParams {
     pub dims: [u32; 4],
     pub vertex_count: u32,
     pub face_count: u32,
-    pub _pad: [u32; 2],
+    /// One over the cell size: cells are found by multiplying (see `Grid::inv_h`).
+    pub inv_h: f32,
+    pub _pad: u32,
 }
 
 /// One pass of the radix sort, a uniform (one buffer per pass, so a build records every pass

@@ -139,7 +139,7 @@ impl ViewerApp {
                 ),
                 (
                     Method::Hybrid,
-                    "grid to 3x the target, then edge collapse: near-qem quality, faster",
+                    "grid to 2x the target + 20k faces, then edge collapse: near-qem quality, faster",
                 ),
             ];
             for (m, about) in methods {
