@@ -385,6 +385,9 @@ pub fn place(positions: &[[f32; 4]], q: Quadric, members: &[u32], o: V3, lo: V3,
     }
 }
 
+/// Faces that survive clustering: (face id, its clusters rotated lowest first), in face order.
+pub type Marked = Vec<(u32, [u32; 3])>;
+
 /// Chunks of faces [`scatter_quadrics`] sums apart, a fixed number so the sums do not depend
 /// on the thread count.
 const SCATTER_CHUNKS: usize = 4;
@@ -402,10 +405,10 @@ pub fn scatter_quadrics(
     faces: &[[u32; 3]],
     vertex_cluster: &[u32],
     origins: &[V3],
-) -> (Vec<Quadric>, Vec<(u32, [u32; 3])>) {
+) -> (Vec<Quadric>, Marked) {
     let n = origins.len();
     let chunk = faces.len().div_ceil(SCATTER_CHUNKS).max(1);
-    let parts: Vec<(Vec<Quadric>, Vec<(u32, [u32; 3])>)> = faces
+    let parts: Vec<(Vec<Quadric>, Marked)> = faces
         .par_chunks(chunk)
         .enumerate()
         .map(|(ci, part)| {
