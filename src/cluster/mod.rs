@@ -235,8 +235,8 @@ fn estimate(area: f64, faces: usize) -> f32 {
 const MAX_BUILDS: usize = 6;
 
 /// Clusters to about `target` faces: within [`BAND`] of it, or (`floor`, the hybrid) at least
-/// `floor`. `--max-error` caps the cell so that no vertex moves farther than it. One sampled
-/// counting pass fits faces against cell size (a power law, faces ∝ h⁻² on a surface); then
+/// `floor`. `--max-error` caps the cell so that no vertex moves farther than it. One counting
+/// pass fits faces against cell size (a power law, faces ∝ h⁻² on a surface); then
 /// [`land`].
 fn cluster_to(
     work: &Work,
@@ -248,13 +248,11 @@ fn cluster_to(
     let pts = work.pts;
     let (lo, hi) = (pts.lo, pts.hi);
     let h0 = estimate(pts.area, target) as f64;
-    // About 2,000 sampled faces survive at the estimate: their count is within a few percent.
-    let stride = (target / 2000).clamp(1, 8);
     let grids: Vec<Grid> = [0.85, 0.95, 1.05, 1.15]
         .iter()
         .map(|k| Grid::new(lo, hi, (k * h0) as f32))
         .collect();
-    let counts = grid::probe_sampled(&grids, &pts.positions, &work.locked, &pts.faces, stride);
+    let counts = grid::probe(&grids, &pts.positions, &work.locked, &pts.faces);
     report.sizes_counted += grids.len();
     let probed: Vec<(f64, f64)> = grids
         .iter()
