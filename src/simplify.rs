@@ -69,16 +69,7 @@ fn run(
     match backend {
         Backend::Cpu => crate::greedy::simplify_greedy(mesh, opts, progress),
         Backend::CpuParallel => {
-            let up = crate::parallel::Upload::new(mesh);
-            let mut runner = crate::cpu::CpuRounds::new(&up, crate::parallel::SELECTION_PASSES);
-            crate::parallel::simplify_rounds(
-                &mut runner,
-                &up,
-                mesh,
-                opts,
-                progress,
-                Default::default(),
-            )
+            crate::cpu::simplify_upload(&crate::parallel::Upload::new(mesh), mesh, opts, progress)
         }
         Backend::Gpu => crate::gpu::simplify_gpu(mesh, opts, progress),
         Backend::Auto => Err(Error::Internal(

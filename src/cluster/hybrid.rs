@@ -126,15 +126,7 @@ pub fn simplify_hybrid(
     };
     report.seconds = t.elapsed().as_secs_f64();
     opts.cancel.check()?;
-    let mut runner = crate::cpu::CpuRounds::new(&up, crate::parallel::SELECTION_PASSES);
-    let (out, mut r) = crate::parallel::simplify_rounds(
-        &mut runner,
-        &up,
-        mesh,
-        opts,
-        progress,
-        Default::default(),
-    )?;
+    let (out, mut r) = crate::cpu::simplify_upload(&up, mesh, opts, progress)?;
     r.max_collapse_error = r.max_collapse_error.max(built_error);
     r.collapses = mesh.positions.len().saturating_sub(out.positions.len());
     r.clustering = Some(report);

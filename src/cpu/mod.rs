@@ -36,6 +36,18 @@ use std::marker::PhantomData;
 use std::sync::atomic::AtomicU32;
 use std::time::Instant;
 
+/// Backend `cpu-parallel` on a prepared upload: the rounds on [`CpuRounds`] to the options'
+/// target, the result and its report.
+pub fn simplify_upload(
+    up: &Upload,
+    mesh: &crate::mesh::Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(crate::mesh::Mesh, crate::options::SimplifyReport)> {
+    let mut runner = CpuRounds::new(up, crate::parallel::SELECTION_PASSES);
+    crate::parallel::simplify_rounds(&mut runner, up, mesh, opts, progress, Default::default())
+}
+
 /// Runs `body(id)` for every invocation id in `0..n`, in parallel.
 pub fn par_for(n: u32, body: impl Fn(u32) + Sync + Send) {
     (0..n).into_par_iter().with_min_len(512).for_each(body);
