@@ -246,6 +246,7 @@ pub const FACES: &[CStep] = &[
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::parallel::schedule::check::{in_house_order, snake_case};
 
     const PARTS: &[&[CStep]] = &[MESH, KEYS, SORT_PASS, CELLS, QUADRICS, FACES];
 
@@ -266,13 +267,8 @@ mod tests {
                 "{}: the cluster schedule's bindings against shaders/{}.wgsl",
                 stage.entry, stage.shader
             );
-            let rank = |a: Access| match a {
-                Access::Uniform => 0,
-                Access::Read => 1,
-                Access::ReadWrite => 2,
-            };
             assert!(
-                described.windows(2).all(|w| rank(w[0].1) <= rank(w[1].1)),
+                in_house_order(&described),
                 "{}: bindings out of the house order: {described:?}",
                 stage.entry
             );
@@ -292,20 +288,11 @@ mod tests {
             ("scan", CBuf::ScanCount),
             ("data", CBuf::ScanData),
         ];
-        let snake = |b: CBuf| {
-            let mut out = String::new();
-            for (i, c) in format!("{b:?}").chars().enumerate() {
-                if c.is_ascii_uppercase() && i > 0 {
-                    out.push('_');
-                }
-                out.push(c.to_ascii_lowercase());
-            }
-            out
-        };
+
         for s in STAGES {
             for b in s.bindings {
                 assert!(
-                    b.var == snake(b.buf) || ROLES.contains(&(b.var, b.buf)),
+                    b.var == snake_case(b.buf) || ROLES.contains(&(b.var, b.buf)),
                     "{}: binding `{}` takes {:?}",
                     s.entry,
                     b.var,

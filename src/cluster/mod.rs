@@ -144,8 +144,7 @@ impl Work<'_, '_> {
         drop(keys);
         let cells: Cells = stages::cell_ranges(&sorted, members);
         let (clusters, label) = match &self.gather {
-            Some(g) => {
-                let _ = g;
+            Some(_) => {
                 let label = stages::cell_labels(&cells, &self.pts.faces, &self.pts.positions);
                 (Clusters::split(&cells, &label), Some(label))
             }
@@ -540,8 +539,6 @@ fn check_backend(opts: &SimplifyOptions) -> Result<Backend> {
              runs --method qem and cluster",
             opts.method.name()
         ))),
-        #[allow(unreachable_patterns)]
-        _ => Ok(Backend::CpuParallel),
     }
 }
 

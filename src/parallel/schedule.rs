@@ -419,8 +419,39 @@ pub const ROUND: &[(When, &[Step])] = &[
     (When::Always, APPLY),
 ];
 
+/// Test helpers both schedules' binding tests share (the rounds' here, the clustering's in
+/// `cluster::gpu_schedule`).
+#[cfg(test)]
+pub(crate) mod check {
+    use super::Access;
+
+    /// Whether bindings come in the house order: uniform params, then read-only, then
+    /// read_write.
+    pub fn in_house_order(bindings: &[(String, Access)]) -> bool {
+        let rank = |a: Access| match a {
+            Access::Uniform => 0,
+            Access::Read => 1,
+            Access::ReadWrite => 2,
+        };
+        bindings.windows(2).all(|w| rank(w[0].1) <= rank(w[1].1))
+    }
+
+    /// A buffer enum's variant as the variable that binds it: `EdgeState` is `edge_state`.
+    pub fn snake_case(variant: impl std::fmt::Debug) -> String {
+        let mut out = String::new();
+        for (i, c) in format!("{variant:?}").chars().enumerate() {
+            if c.is_ascii_uppercase() && i > 0 {
+                out.push('_');
+            }
+            out.push(c.to_ascii_lowercase());
+        }
+        out
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::check::{in_house_order, snake_case};
     use super::*;
 
     /// Every stage's declared bindings against its shader, as naga reads it: the same variables
@@ -441,13 +472,8 @@ mod tests {
                 "{}: the schedule's bindings against shaders/{}.wgsl",
                 stage.entry, stage.shader
             );
-            let rank = |a: Access| match a {
-                Access::Uniform => 0,
-                Access::Read => 1,
-                Access::ReadWrite => 2,
-            };
             assert!(
-                described.windows(2).all(|w| rank(w[0].1) <= rank(w[1].1)),
+                in_house_order(&described),
                 "{}: bindings not in the order params, read-only, read_write: {described:?}",
                 stage.entry
             );
@@ -468,20 +494,11 @@ mod tests {
             ("scan", Buf::ScanCount),
             ("data", Buf::ScanData),
         ];
-        let snake = |b: Buf| {
-            let mut out = String::new();
-            for (i, c) in format!("{b:?}").chars().enumerate() {
-                if c.is_ascii_uppercase() && i > 0 {
-                    out.push('_');
-                }
-                out.push(c.to_ascii_lowercase());
-            }
-            out
-        };
+
         for s in STAGES {
             for b in s.bindings {
                 assert!(
-                    b.var == snake(b.buf) || ROLES.contains(&(b.var, b.buf)),
+                    b.var == snake_case(b.buf) || ROLES.contains(&(b.var, b.buf)),
                     "{}: binding `{}` takes {:?}",
                     s.entry,
                     b.var,
