@@ -1,12 +1,21 @@
 // Exclusive prefix sum of scan.n u32 values in place, the total written at data[n]: per-block
 // sums, one workgroup scanning the block sums, then each block's local scan plus its offset.
 // Relies on data holding n + 1 values and block_sums one per SCAN_BLOCK elements.
+//
+// 64 threads of 16 elements each, not 256 of 4: a workgroup barrier is the dearest step on a
+// CPU driver such as lavapipe, which runs a workgroup's invocations in SIMD chunks and switches
+// between them at each barrier; a scan of 64 entries takes six steps over two chunks, not eight
+// over 32. On the 1M-triangle scan a face-sized scan went from 0.035 s to ~0.01 s on lavapipe
+// (docs/PERFORMANCE.md); 64 threads is one wave on a GPU.
 
 @group(0) @binding(0) var<uniform> scan: ScanParams;
 @group(0) @binding(1) var<storage, read_write> data: array<u32>;       // n + 1
 @group(0) @binding(2) var<storage, read_write> block_sums: array<u32>; // per block
 
-var<workgroup> sh: array<u32, 256>;
+const SCAN_THREADS: u32 = 64u;
+const SCAN_PER_THREAD: u32 = 16u; // SCAN_BLOCK / SCAN_THREADS
+
+var<workgroup> sh: array<u32, 64>;
 
 fn load(i: u32) -> u32 {
     if (i < scan.n) {
@@ -15,14 +24,18 @@ fn load(i: u32) -> u32 {
     return 0u;
 }
 
-@compute @workgroup_size(256)
+@compute @workgroup_size(64)
 fn prefix_sum_reduce(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
                      @builtin(local_invocation_index) li: u32) {
     let block = wid.x + wid.y * nwg.x;
-    let base = block * SCAN_BLOCK + li * 4u;
-    sh[li] = load(base) + load(base + 1u) + load(base + 2u) + load(base + 3u);
+    let base = block * SCAN_BLOCK + li * SCAN_PER_THREAD;
+    var sum = 0u;
+    for (var j = 0u; j < SCAN_PER_THREAD; j = j + 1u) {
+        sum = sum + load(base + j);
+    }
+    sh[li] = sum;
     workgroupBarrier();
-    for (var s = 128u; s > 0u; s = s >> 1u) {
+    for (var s = SCAN_THREADS / 2u; s > 0u; s = s >> 1u) {
         if (li < s) {
             sh[li] = sh[li] + sh[li + s];
         }
@@ -45,20 +58,21 @@ fn prefix_sum_spine() {
     data[scan.n] = run;
 }
 
-@compute @workgroup_size(256)
+@compute @workgroup_size(64)
 fn prefix_sum_apply(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
                     @builtin(local_invocation_index) li: u32) {
     let block = wid.x + wid.y * nwg.x;
-    let base = block * SCAN_BLOCK + li * 4u;
-    let x0 = load(base);
-    let x1 = load(base + 1u);
-    let x2 = load(base + 2u);
-    let x3 = load(base + 3u);
-    let total = x0 + x1 + x2 + x3;
+    let base = block * SCAN_BLOCK + li * SCAN_PER_THREAD;
+    var x: array<u32, 16>;
+    var total = 0u;
+    for (var j = 0u; j < SCAN_PER_THREAD; j = j + 1u) {
+        x[j] = load(base + j);
+        total = total + x[j];
+    }
     sh[li] = total;
     workgroupBarrier();
-    // Hillis–Steele inclusive scan of the 256 thread sums.
-    for (var s = 1u; s < 256u; s = s << 1u) {
+    // Hillis–Steele inclusive scan of the thread sums.
+    for (var s = 1u; s < SCAN_THREADS; s = s << 1u) {
         var v = sh[li];
         if (li >= s) {
             v = v + sh[li - s];
@@ -68,11 +82,10 @@ fn prefix_sum_apply(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgrou
         workgroupBarrier();
     }
     var run = block_sums[block] + sh[li] - total;
-    if (base < scan.n) { data[base] = run; }
-    run = run + x0;
-    if (base + 1u < scan.n) { data[base + 1u] = run; }
-    run = run + x1;
-    if (base + 2u < scan.n) { data[base + 2u] = run; }
-    run = run + x2;
-    if (base + 3u < scan.n) { data[base + 3u] = run; }
+    for (var j = 0u; j < SCAN_PER_THREAD; j = j + 1u) {
+        if (base + j < scan.n) {
+            data[base + j] = run;
+        }
+        run = run + x[j];
+    }
 }
