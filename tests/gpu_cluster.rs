@@ -1,4 +1,4 @@
-//! `--method cluster` on the gpu backend (lavapipe in CI): every stage's buffers against its CPU
+//! `--method cluster` and `hybrid` on the gpu backend (lavapipe in CI): every stage's buffers against its CPU
 //! twin (src/cluster/twins.rs) on generated meshes, integers exactly and floats within 1e-4, and
 //! the whole GPU build against the CPU driver's. With CI=true a missing adapter fails.
 
@@ -446,5 +446,38 @@ fn simplify_on_the_gpu_writes_the_cpu_parallel_faces() {
                 "{a:?} against {b:?} at target {target}"
             );
         }
+    }
+}
+
+/// `--method hybrid --backend gpu`: the same clustering, then the rounds on the device from the
+/// clusters' carried quadrics (the first round skips `vertex_quadrics`), which are the CPU
+/// rounds' twins: the same mesh as `cpu-parallel`, on the exact target, manifold.
+#[test]
+fn hybrid_on_the_gpu_writes_the_cpu_parallel_mesh() {
+    if common::gpu_context().is_none() {
+        return;
+    }
+    let mut m = meshslim::mesh::icosphere(6);
+    meshslim::mesh::add_noise(&mut m, 0.002, 11);
+    for target in [4000, 600] {
+        let run = |backend| {
+            let mut o = meshslim::SimplifyOptions::with_faces(target);
+            o.method = meshslim::Method::Hybrid;
+            o.backend = backend;
+            meshslim::simplify(&m, &o).unwrap()
+        };
+        let (cpu, rc) = run(meshslim::Backend::CpuParallel);
+        let (gpu, rg) = run(meshslim::Backend::Gpu);
+        assert_eq!(rg.backend, meshslim::Backend::Gpu);
+        let (cc, cg) = (rc.clustering.unwrap(), rg.clustering.unwrap());
+        assert!(
+            cg.intermediate_faces.is_some_and(|f| f > target),
+            "target {target}: the hybrid clustered first ({:?})",
+            cg.intermediate_faces
+        );
+        assert_eq!(cg.intermediate_faces, cc.intermediate_faces);
+        assert!(gpu.triangles.len().abs_diff(target) <= 2, "target {target}");
+        assert_eq!(cpu.triangles, gpu.triangles, "target {target}");
+        assert_eq!(cpu.positions, gpu.positions, "target {target}");
     }
 }

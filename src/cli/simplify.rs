@@ -136,7 +136,8 @@ pub enum MethodArg {
     /// and UV seams kept; every backend
     Qem,
     /// Uniform-grid vertex clustering: the fastest, within 5% of the target; may join nearby
-    /// sheets and change topology, and closes UV seams; for previews and far LODs
+    /// sheets and change topology, and closes UV seams; for previews and far LODs (cpu-parallel
+    /// or gpu)
     Cluster,
     /// Low & Tan's floating cells: clusters centred on the most important vertices (tips,
     /// creases), so features survive where a uniform grid cuts them; within 5% of the target,
@@ -144,7 +145,7 @@ pub enum MethodArg {
     FloatingCell,
     /// Clustering to twice the target plus 20,000 faces, then qem's rounds to the exact target with the
     /// clusters' quadrics: near-qem error in a fraction of the time on large scans; closes UV
-    /// seams (cpu-parallel)
+    /// seams (cpu-parallel, or gpu for the rounds)
     Hybrid,
 }
 

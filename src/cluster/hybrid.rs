@@ -1,6 +1,9 @@
 //! `--method hybrid`: clustering (cells split by connectivity, clusters that pinch a
 //! non-manifold edge taken apart) to an intermediate count, then the QEM rounds to the exact
 //! target from the clusters' quadrics (Garland & Shaffer's multiphase simplification, 2002).
+//! On `--backend gpu` the rounds run on the device from the same upload; the clustering stays
+//! on the CPU on both backends: its split of cells by connectivity is a union-find, and it is a
+//! tenth of the hybrid's time (docs/PERFORMANCE.md, "Clustering").
 
 use super::{
     Built, ClusterReport, Points, check_backend, cluster_to, max_error, output, prepare, tally,
@@ -126,7 +129,13 @@ pub fn simplify_hybrid(
     };
     report.seconds = t.elapsed().as_secs_f64();
     opts.cancel.check()?;
-    let (out, mut r) = crate::cpu::simplify_upload(&up, mesh, opts, progress)?;
+    let (out, mut r) = match backend {
+        crate::options::Backend::Gpu => {
+            let (ctx, sim) = crate::gpu::shared()?;
+            crate::gpu::simplify_upload(ctx, sim, &up, mesh, opts, progress)?
+        }
+        _ => crate::cpu::simplify_upload(&up, mesh, opts, progress)?,
+    };
     r.max_collapse_error = r.max_collapse_error.max(built_error);
     r.collapses = mesh.positions.len().saturating_sub(out.positions.len());
     r.clustering = Some(report);

@@ -58,15 +58,27 @@ pub fn simplify_with(
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
-    let up = Upload::new(mesh);
-    let mut rounds = GpuRounds::new(sim, &up, SELECTION_PASSES)?;
+    simplify_upload(ctx, sim, &Upload::new(mesh), mesh, opts, progress)
+}
+
+/// The rounds on a prepared upload (`hybrid` carries its clusters' quadrics in it); `mesh` is
+/// the original the report and the output's attributes refer to.
+pub fn simplify_upload(
+    ctx: &GpuContext,
+    sim: &GpuSimplifier,
+    up: &Upload,
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport)> {
+    let mut rounds = GpuRounds::new(sim, up, SELECTION_PASSES)?;
     let report = RoundsReport {
         adapter: Some(ctx.adapter_name.clone()),
         gpu_timestamps: sim.has_timestamps(),
         pipeline_seconds: sim.pipeline_seconds,
         ..Default::default()
     };
-    let (out, mut rep) = simplify_rounds(&mut rounds, &up, mesh, opts, progress, report)?;
+    let (out, mut rep) = simplify_rounds(&mut rounds, up, mesh, opts, progress, report)?;
     if let Some(r) = rep.rounds.as_mut() {
         r.transfer_seconds = rounds.transfer_seconds;
     }

@@ -211,6 +211,8 @@ pub struct GpuRounds<'a> {
     query_stages: Vec<&'static str>,
     times: StageTimes,
     selection_passes: u32,
+    /// The upload brought the quadrics: the first round skips `SETUP_QUADRICS`.
+    carried_quadrics: bool,
     /// Upload and download seconds.
     pub transfer_seconds: f64,
     /// Submit each pass on its own and wait for it: set when the device also draws a window,
@@ -254,7 +256,12 @@ impl<'a> GpuRounds<'a> {
         let qsize = std::mem::size_of::<Quadric>() as u64;
         let half0 = Half {
             positions: init("positions", bytemuck::cast_slice(&up.positions), mesh_usage)?,
-            quadrics: mk("quadrics", nv * qsize, SU)?,
+            // Quadrics carried in (`hybrid`'s clusters) are the first round's; otherwise the
+            // first round's `vertex_quadrics` writes them.
+            quadrics: match &up.quadrics {
+                Some(q) => init("quadrics", bytemuck::cast_slice(q), SU)?,
+                None => mk("quadrics", nv * qsize, SU)?,
+            },
             flags: init("flags", bytemuck::cast_slice(&up.flags), SU)?,
             vertex_attr: init("vertex_attr", bytemuck::cast_slice(&up.vertex_attr), SU)?,
             indices: init("indices", bytemuck::cast_slice(&up.indices), mesh_usage)?,
@@ -338,6 +345,7 @@ impl<'a> GpuRounds<'a> {
             query_stages: Vec::new(),
             times: StageTimes::default(),
             selection_passes,
+            carried_quadrics: up.quadrics.is_some(),
             transfer_seconds: 0.0,
             share_queue: false,
         };
@@ -657,7 +665,8 @@ impl RoundRunner for GpuRounds<'_> {
         for &(when, steps) in schedule::ROUND {
             match when {
                 When::Always => self.record(&mut enc, p, steps),
-                When::FirstRound | When::FirstRoundQuadrics if first => {
+                When::FirstRound if first => self.record(&mut enc, p, steps),
+                When::FirstRoundQuadrics if first && !self.carried_quadrics => {
                     self.record(&mut enc, p, steps)
                 }
                 When::Trimming if p.trim != 0 => self.record(&mut enc, p, steps),
