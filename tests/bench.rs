@@ -77,7 +77,7 @@ fn json_and_plot_have_every_backend_at_every_ratio() {
                 );
             }
             // The device that ran it: the CPU, or the GPU adapter for the GPU backends.
-            if backend == "gpu" || backend == "cluster-gpu" {
+            if backend.ends_with("gpu") {
                 assert_ne!(row["device"], cpu, "{row:#}");
             } else {
                 assert_eq!(row["device"], cpu);
@@ -140,7 +140,7 @@ fn bad_usage_exits_2() {
     expect_code(&o, 2);
     assert!(
         String::from_utf8_lossy(&o.stderr)
-            .contains("cpu, cpu-parallel, gpu, cluster, cluster-gpu, floating-cell, hybrid, meshopt, meshopt-sloppy"),
+            .contains("cpu, cpu-parallel, gpu, cluster, cluster-gpu, floating-cell, hybrid, hybrid-gpu, meshopt, meshopt-sloppy"),
         "the error lists the backends"
     );
 }

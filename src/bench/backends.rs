@@ -84,6 +84,17 @@ pub static BACKENDS: &[BenchBackend] = &[
         band: 0.0,
     },
     BenchBackend {
+        name: "hybrid-gpu",
+        about: "meshslim's hybrid with the rounds as WGSL compute passes (wgpu)",
+        simplify: |m, faces| {
+            let mut o = with_method(faces, crate::Method::Hybrid);
+            o.backend = crate::Backend::Gpu;
+            Ok(crate::simplify(m, &o)?.0)
+        },
+        device: gpu_name,
+        band: 0.0,
+    },
+    BenchBackend {
         name: "meshopt",
         about: "meshoptimizer's simplify (quadric edge collapse)",
         simplify: |m, faces| Ok(meshopt_simplify(m, faces)),
@@ -127,7 +138,7 @@ pub fn available_backends() -> Vec<&'static BenchBackend> {
     let gpu = crate::gpu::shared().is_ok();
     BACKENDS
         .iter()
-        .filter(|b| gpu || !matches!(b.name, "gpu" | "cluster-gpu"))
+        .filter(|b| gpu || !b.name.ends_with("gpu"))
         .collect()
 }
 

@@ -41,8 +41,10 @@ pub struct BenchArgs {
           default_values_t = crate::bench::DEFAULT_RATIOS)]
     pub ratios: Vec<f64>,
 
-    /// Backends to run, comma-separated: cpu (meshslim's greedy), meshopt (meshoptimizer's
-    /// simplify), meshopt-sloppy (its clustering simplifySloppy) [default: all of them]
+    /// Backends to run, comma-separated: cpu (meshslim's greedy), cpu-parallel and gpu (its
+    /// rounds), cluster and cluster-gpu, floating-cell, hybrid and hybrid-gpu (--method),
+    /// meshopt (meshoptimizer's simplify), meshopt-sloppy (its clustering simplifySloppy)
+    /// [default: all of them; the *gpu ones where there is an adapter]
     #[arg(long, value_name = "B,...", value_delimiter = ',', value_parser = parse_bench_backend)]
     pub backends: Vec<&'static crate::bench::BenchBackend>,
 
