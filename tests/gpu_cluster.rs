@@ -347,6 +347,26 @@ fn the_gpu_build_equals_the_cpu_build() {
             );
             let twin = twins::run(&pos, &m.triangles, &locked, &grid).result();
             assert_eq!(g.faces, twin.faces, "{label}: faces against the twins");
+            // `cluster_mesh` (the drawable result) against its twin on the GPU's clusters.
+            let drawn = gpu.drawable([0.0; 3], 1.0).unwrap();
+            let n = g.clusters;
+            let placed: Vec<ClusterPlaced> =
+                pod(gpu.read_buffer(CBuf::ClusterPlaced, 32 * n as u64).unwrap());
+            let heads: Vec<u32> = pod(gpu
+                .read_buffer(CBuf::CellHead, 4 * (pos.len() as u64 + 1))
+                .unwrap());
+            let mut want = vec![[0f32; 4]; n];
+            let c = twins::cluster_params(&grid, pos.len(), m.triangles.len());
+            twins::cluster_mesh(&c, &heads, &placed, &mut want);
+            let got: Vec<[f32; 4]> =
+                pod(gpu.read_buffer(CBuf::MeshPositions, 16 * n as u64).unwrap());
+            assert_eq!(got, want, "{label}: cluster_mesh");
+            let idx: Vec<u32> = pod(gpu
+                .read_buffer(CBuf::ClusterFaces, 12 * g.faces.len() as u64)
+                .unwrap());
+            let flat: Vec<u32> = g.faces.iter().flat_map(|(_, t)| *t).collect();
+            assert_eq!(idx, flat, "{label}: the drawn indices are the kept faces");
+            assert!(drawn.indices.size() >= 12 * g.faces.len() as u64);
             assert_eq!(
                 g.vertex_cluster, twin.vertex_cluster,
                 "{label}: vertex_cluster"

@@ -9,8 +9,10 @@ use crate::cluster::gpu_schedule::{self as sched, CBuf, CCount, CGrid, CStage, C
 use crate::cluster::grid::Grid;
 use crate::cluster::twins::{self, ClusterBuild};
 use crate::error::{Error, Result};
+use crate::gpu::GpuMesh;
 use crate::gpu::context::{checked_buffer, checked_buffer_init};
 use crate::gpu::shaders::{source, stage_source};
+use crate::gpu::simplifier::{DRAW_ARGS_USAGE, MESH_USAGE};
 use crate::gpu::types::*;
 use crate::parallel::schedule::Access;
 use std::collections::HashMap;
@@ -151,6 +153,9 @@ pub struct GpuClusterMesh<'a> {
     radix: Vec<wgpu::Buffer>,
     scans: [wgpu::Buffer; 3],
     bufs: HashMap<CBuf, wgpu::Buffer>,
+    /// The last build's cells and kept faces, and its grid.
+    built: Option<(u32, u32)>,
+    grid: Option<Grid>,
     /// Upload, vertex→face lists and face planes: seconds.
     pub setup_seconds: f64,
 }
@@ -215,7 +220,8 @@ impl<'a> GpuClusterMesh<'a> {
             (CBuf::BucketOffsets, "bucket_offsets", 4 * (v + 1), SU),
             (CBuf::BucketCursor, "bucket_cursor", 4 * v, SU),
             (CBuf::BucketFaces, "bucket_faces", 4 * f, SU),
-            (CBuf::ClusterFaces, "cluster_faces", 12 * f, SU),
+            (CBuf::ClusterFaces, "cluster_faces", 12 * f, MESH_USAGE),
+            (CBuf::MeshPositions, "mesh_positions", 16 * v, MESH_USAGE),
             (CBuf::FaceOrigin, "face_origin", 4 * f, SU),
         ] {
             bufs.insert(buf, mk(label, size, usage)?);
@@ -273,6 +279,8 @@ impl<'a> GpuClusterMesh<'a> {
             radix,
             scans,
             bufs,
+            built: None,
+            grid: None,
             setup_seconds: 0.0,
         };
         let mut enc = dev.create_command_encoder(&Default::default());
@@ -360,6 +368,8 @@ impl<'a> GpuClusterMesh<'a> {
         let cells = u32::from_le_bytes(counts[0][..4].try_into().unwrap_or_default()) as u64;
         let kept = u32::from_le_bytes(counts[1][..4].try_into().unwrap_or_default()) as u64;
         assert!(cells <= nv && kept <= nf, "counts within their buffers");
+        self.built = Some((cells as u32, kept as u32));
+        self.grid = Some(*grid);
         let data = self.read_many(&[
             (CBuf::ClusterPlaced, 0, 32 * cells),
             (CBuf::ClusterQuadric, 0, 48 * cells),
@@ -376,6 +386,47 @@ impl<'a> GpuClusterMesh<'a> {
             &bytemuck::pod_collect_to_vec::<u8, u32>(pod(3)),
             bytemuck::pod_collect_to_vec::<u8, u32>(pod(4)),
         ))
+    }
+
+    /// The grid of the last build.
+    pub fn last_grid(&self) -> Option<Grid> {
+        self.grid
+    }
+
+    /// The last build's result as a mesh a renderer draws, made on the device (`cluster_mesh`
+    /// writes the clusters' vertices; the compacted faces are the index buffer): it shares this
+    /// mesh's buffers, so the next build rewrites it. `center` and `scale` are the frame.
+    pub fn drawable(&mut self, center: [f64; 3], scale: f64) -> Result<GpuMesh> {
+        let (_, kept) = self
+            .built
+            .ok_or_else(|| Error::Internal("a drawable clustering before any build".into()))?;
+        let scope = self
+            .sim
+            .device
+            .push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut enc = self.sim.device.create_command_encoder(&Default::default());
+        self.record(&mut enc, sched::DRAWABLE);
+        self.sim.queue.submit([enc.finish()]);
+        let args = DrawArgs {
+            index_count: 3 * kept,
+            instance_count: 1,
+            ..Default::default()
+        };
+        let draw_args = checked_buffer_init(
+            &self.sim.device,
+            "meshslim.cluster.draw_args",
+            bytemuck::bytes_of(&args),
+            std::mem::size_of::<DrawArgs>(),
+            DRAW_ARGS_USAGE,
+        )?;
+        check(scope, "making the clustering drawable")?;
+        Ok(GpuMesh {
+            positions: self.bufs[&CBuf::MeshPositions].clone(),
+            indices: self.bufs[&CBuf::ClusterFaces].clone(),
+            draw_args,
+            center,
+            scale,
+        })
     }
 
     /// The buffer bound for `buf`; `scan` is the prefix sum's (count, data) when one runs.

@@ -49,6 +49,8 @@ pub enum CBuf {
     BucketFaces,
     ClusterFaces,
     FaceOrigin,
+    /// The clusters' vertices as a renderer's vertex buffer ([`crate::gpu::GpuMesh`]).
+    MeshPositions,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -156,6 +158,10 @@ pub const CLUSTER_FACES_COMPACT: CStage = stage!(cluster_faces_compact in "clust
     cluster: Uniform Cluster, face_key: Read FaceKey, face_keep: Read FaceKeep,
     cluster_faces: ReadWrite ClusterFaces, face_origin: ReadWrite FaceOrigin);
 
+pub const CLUSTER_MESH: CStage = stage!(cluster_mesh in "cluster_mesh" over Each(Vertices);
+    cluster: Uniform Cluster, cell_head: Read CellHead, cluster_placed: Read ClusterPlaced,
+    mesh_positions: ReadWrite MeshPositions);
+
 /// Every stage, each once: the runner makes one pipeline per entry.
 pub const STAGES: &[&CStage] = &[
     &PREFIX_SUM_REDUCE,
@@ -175,6 +181,7 @@ pub const STAGES: &[&CStage] = &[
     &CLUSTER_FACES_FILL,
     &CLUSTER_FACES_DEDUPE,
     &CLUSTER_FACES_COMPACT,
+    &CLUSTER_MESH,
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -242,13 +249,15 @@ pub const FACES: &[CStep] = &[
     },
     Run(&CLUSTER_FACES_COMPACT),
 ];
+/// After a build, for a renderer: the clusters' vertices beside the compacted faces.
+pub const DRAWABLE: &[CStep] = &[Run(&CLUSTER_MESH)];
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::parallel::schedule::check::{in_house_order, snake_case};
 
-    const PARTS: &[&[CStep]] = &[MESH, KEYS, SORT_PASS, CELLS, QUADRICS, FACES];
+    const PARTS: &[&[CStep]] = &[MESH, KEYS, SORT_PASS, CELLS, QUADRICS, FACES, DRAWABLE];
 
     /// Every stage's described bindings against its shader as naga reads it (names, order,
     /// access), in the house order: uniforms, then read-only, then read_write.

@@ -115,7 +115,7 @@ struct Work<'a, 'm> {
     /// non-manifold edge, taken apart).
     locked: Vec<bool>,
     /// `--backend gpu`: the points on the device, each build run there by the same stages.
-    gpu: Option<std::sync::Mutex<gpu::GpuClusterMesh<'static>>>,
+    gpu: Option<std::sync::Mutex<gpu::GpuClusterMesh<'a>>>,
 }
 
 struct Gather {
@@ -549,17 +549,53 @@ pub fn simplify_cluster(
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
+    let on = match check_backend(opts)? {
+        Backend::Gpu => Some(gpu::shared()?),
+        _ => None,
+    };
+    let (out, report, _) = cluster_on(on, mesh, opts, progress)?;
+    Ok((out, report))
+}
+
+/// `--method cluster` on `clusterer`'s device, its result also left there as a mesh a renderer
+/// draws (the viewer's: its own device, its own pipelines).
+pub fn simplify_cluster_drawn(
+    clusterer: &gpu::GpuClusterer,
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport, Drawn)> {
+    let opts = &SimplifyOptions {
+        backend: Backend::Gpu,
+        ..opts.clone()
+    };
+    let (out, report, drawn) = cluster_on(Some(clusterer), mesh, opts, progress)?;
+    let drawn = drawn.ok_or_else(|| Error::Internal("a GPU clustering left no mesh".into()))?;
+    Ok((out, report, drawn))
+}
+
+/// A clustering's result on the device ([`crate::gpu::GpuMesh`]: one vertex per cluster, the
+/// kept faces as indices) and the same arrays on the host, in its order, for a renderer's
+/// per-vertex extras (normals, the error heatmap).
+pub struct Drawn {
+    pub gpu: crate::gpu::GpuMesh,
+    /// Per cluster, in the unit-diagonal frame (w = 1).
+    pub positions: Vec<[f32; 4]>,
+    pub indices: Vec<u32>,
+}
+
+fn cluster_on(
+    on: Option<&gpu::GpuClusterer>,
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport, Option<Drawn>)> {
     let backend = check_backend(opts)?;
     let t = Instant::now();
     let mut pts = Points::new(mesh);
     let mut work = prepare(&mut pts, opts, false);
-    if backend == Backend::Gpu {
-        let g = gpu::GpuClusterMesh::new(
-            gpu::shared()?,
-            &work.pts.positions,
-            &work.pts.faces,
-            &work.locked,
-        )?;
+    if let Some(sim) = on {
+        let g = gpu::GpuClusterMesh::new(sim, &work.pts.positions, &work.pts.faces, &work.locked)?;
         work.gpu = Some(std::sync::Mutex::new(g));
     }
     progress(0.2);
@@ -573,10 +609,32 @@ pub fn simplify_cluster(
     progress(0.9);
     tally(&mut report, &built);
     report.cell_size = grid.h as f64;
+    // `cluster_to` may have kept an earlier build than the device's last one: build the kept
+    // grid again before drawing from the device's buffers.
+    let drawn = match work.gpu.take() {
+        Some(g) => {
+            let mut g = g
+                .into_inner()
+                .map_err(|_| Error::Internal("the GPU clustering lock is poisoned".into()))?;
+            if g.last_grid() != Some(grid) {
+                g.build(&grid)?;
+            }
+            Some(Drawn {
+                gpu: g.drawable(work.pts.center, work.pts.scale)?,
+                positions: built
+                    .placed
+                    .iter()
+                    .map(|p| [p.pos[0], p.pos[1], p.pos[2], 1.0])
+                    .collect(),
+                indices: built.faces.iter().flat_map(|(_, t)| *t).collect(),
+            })
+        }
+        None => None,
+    };
     let (out, _) = output(mesh, work.pts, &built);
     report.seconds = t.elapsed().as_secs_f64();
     let report = clustered_report(mesh, opts, backend, &out, &built, stop, report);
-    Ok((out, report))
+    Ok((out, report, drawn))
 }
 
 /// The report of a clustering that ends in clustering (`cluster`, `floating-cell`).

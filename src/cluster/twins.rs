@@ -290,6 +290,19 @@ pub fn cluster_faces_compact(
     }
 }
 
+/// Per cluster: its vertex as a drawable position (w = 1).
+pub fn cluster_mesh(
+    cluster: &ClusterParams,
+    cell_head: &[u32],                // per vertex + 1, scanned
+    cluster_placed: &[ClusterPlaced], // per cell
+    mesh_positions: &mut [[f32; 4]],  // per cell
+) {
+    for k in 0..cell_head[cluster.vertex_count as usize] as usize {
+        let p = cluster_placed[k].pos;
+        mesh_positions[k] = [p[0], p[1], p[2], 1.0];
+    }
+}
+
 /// One clustering, as the CPU driver's build returns it: per cluster its vertex, the kept faces
 /// (input face id, clusters) in face order, each vertex's cluster, the counts.
 pub struct ClusterBuild {

@@ -117,6 +117,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         "cluster_faces_compact",
         include_str!("../../shaders/cluster_faces_compact.wgsl"),
     ),
+    (
+        "cluster_mesh",
+        include_str!("../../shaders/cluster_mesh.wgsl"),
+    ),
 ];
 
 /// The source of `shaders/<stem>.wgsl`.

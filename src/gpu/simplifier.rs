@@ -110,10 +110,10 @@ pub struct GpuMesh {
 
 /// Usages of a [`GpuMesh`]'s positions and indices: the rounds' storage, a renderer's vertex and
 /// index buffers, copies.
-const MESH_USAGE: wgpu::BufferUsages = SU
+pub(crate) const MESH_USAGE: wgpu::BufferUsages = SU
     .union(wgpu::BufferUsages::VERTEX)
     .union(wgpu::BufferUsages::INDEX);
-const DRAW_ARGS_USAGE: wgpu::BufferUsages = SU.union(wgpu::BufferUsages::INDIRECT);
+pub(crate) const DRAW_ARGS_USAGE: wgpu::BufferUsages = SU.union(wgpu::BufferUsages::INDIRECT);
 
 impl GpuMesh {
     /// A mesh made on the host — the input as loaded, or a CPU backend's result — with the

@@ -45,6 +45,9 @@ pub(super) struct Gpu {
     pub(super) queue: wgpu::Queue,
     pub(super) egui_renderer: Arc<egui::mutex::RwLock<egui_wgpu::Renderer>>,
     pub(super) sim: Option<Arc<GpuSimplifier>>,
+    /// `--method cluster`'s pipelines on the same device, so its result is drawn from the
+    /// buffers the build wrote.
+    pub(super) clusterer: Option<Arc<crate::cluster::gpu::GpuClusterer>>,
     pub(super) adapter: String,
 }
 
@@ -187,6 +190,11 @@ impl ViewerApp {
                 format!("gpu backend unavailable on this device ({e}); cpu backends work"),
             ),
         };
+        let clusterer = sim.as_ref().and_then(|_| {
+            crate::cluster::gpu::GpuClusterer::new(&rs.device, &rs.queue)
+                .ok()
+                .map(Arc::new)
+        });
         let renderer = Renderer::new(&rs.device, &rs.queue);
         let mut app = ViewerApp {
             gpu: Gpu {
@@ -195,6 +203,7 @@ impl ViewerApp {
                 egui_renderer: rs.renderer.clone(),
                 adapter: rs.adapter.get_info().name,
                 sim: sim.clone(),
+                clusterer,
             },
             renderer,
             model: None,
@@ -295,11 +304,21 @@ impl ViewerApp {
         &self.gpu.adapter
     }
 
-    /// Sets the algorithm; a clustering method moves a `gpu` backend to `cpu-parallel`.
+    /// Sets the algorithm; a method the gpu backend cannot draw moves it to `cpu-parallel`.
     pub fn set_method(&mut self, method: crate::Method) {
         self.method = method;
-        if method != crate::Method::Qem && self.backend == Backend::Gpu {
+        if !self.gpu_draws(method) && self.backend == Backend::Gpu {
             self.backend = Backend::CpuParallel;
+        }
+    }
+
+    /// The gpu backend runs `method` on the window's device and leaves its result there: the
+    /// rounds (`qem`) and `cluster`; the others run on the CPU's cores.
+    pub(super) fn gpu_draws(&self, method: crate::Method) -> bool {
+        match method {
+            crate::Method::Qem => self.gpu.sim.is_some(),
+            crate::Method::Cluster => self.gpu.clusterer.is_some(),
+            _ => false,
         }
     }
 

@@ -50,6 +50,7 @@ impl ViewerApp {
         let method = self.method;
         let device = self.gpu.device.clone();
         let sim = self.gpu.sim.clone();
+        let clusterer = self.gpu.clusterer.clone();
         let label = format!(
             "simplifying to {target} faces ({}, {})",
             method.name(),
@@ -64,7 +65,10 @@ impl ViewerApp {
                 opts.cancel = cancel;
                 scene::simplify(
                     &device,
-                    sim.as_deref(),
+                    scene::Pipelines {
+                        rounds: sim.as_deref(),
+                        cluster: clusterer.as_deref(),
+                    },
                     &model,
                     &opts,
                     true,

@@ -38,8 +38,9 @@ pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> 
     screenshot_with(model, ratio, crate::Method::Qem, style, size)
 }
 
-/// As [`screenshot`], simplified by `method` (the clustering methods on the CPU's cores, their
-/// result uploaded and drawn by the same renderer).
+/// As [`screenshot`], simplified by `method`: `qem` and `cluster` on the GPU, drawn from the
+/// buffers they wrote; `floating-cell` and `hybrid` on the CPU's cores, their result uploaded
+/// and drawn by the same renderer.
 pub fn screenshot_with(
     model: &Model,
     ratio: f64,
@@ -61,14 +62,17 @@ pub fn screenshot_with(
     let (scene, faces) = if ratio < 1.0 {
         let mut opts = SimplifyOptions::with_ratio(model.up.face_count(), ratio)?;
         opts.method = method;
-        opts.backend = if method == crate::Method::Qem {
+        opts.backend = if matches!(method, crate::Method::Qem | crate::Method::Cluster) {
             Backend::Gpu
         } else {
             Backend::CpuParallel
         };
         let s = scene::simplify(
             &ctx.device,
-            Some(sim),
+            scene::Pipelines {
+                rounds: Some(sim),
+                cluster: Some(crate::cluster::gpu::shared()?),
+            },
             model,
             &opts,
             false,

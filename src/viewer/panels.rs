@@ -146,16 +146,15 @@ impl ViewerApp {
                 ui.selectable_value(&mut self.method, m, m.name())
                     .on_hover_text(about);
             }
-            // Clustering runs on the CPU's cores.
-            if self.method != Method::Qem && self.backend == Backend::Gpu {
+            // floating-cell and hybrid run on the CPU's cores here.
+            if !self.gpu_draws(self.method) && self.backend == Backend::Gpu {
                 self.backend = Backend::CpuParallel;
             }
         });
         ui.horizontal(|ui| {
             ui.label("backend");
             for b in [Backend::Gpu, Backend::CpuParallel, Backend::Cpu] {
-                let enabled = b != Backend::Gpu
-                    || (self.gpu.sim.is_some() && self.method == crate::Method::Qem);
+                let enabled = b != Backend::Gpu || self.gpu_draws(self.method);
                 ui.add_enabled_ui(enabled, |ui| {
                     ui.selectable_value(&mut self.backend, b, b.name());
                 });

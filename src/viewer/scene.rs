@@ -4,6 +4,7 @@
 
 use super::camera::Up;
 use super::render::{Extras, SceneMesh, vertex_normals};
+use crate::cluster::gpu::GpuClusterer;
 use crate::error::{Error, Result};
 use crate::gpu::{GpuMesh, GpuRounds, GpuSimplifier};
 use crate::mesh::{Mesh, UvOrigin};
@@ -295,13 +296,22 @@ pub struct Simplified {
     pub error: Option<(f64, f64)>,
 }
 
-/// Simplifies `model` with `opts.backend`. The `gpu` backend runs on `sim` (the window's own
-/// device) and the result stays there: its [`GpuMesh`] is the rounds' buffers. The CPU backends'
-/// results are uploaded once so that one renderer draws them all.
+/// The pipelines made on the drawing device: the rounds' and `cluster`'s, each absent when
+/// the device could not make it.
+#[derive(Clone, Copy, Default)]
+pub struct Pipelines<'a> {
+    pub rounds: Option<&'a GpuSimplifier>,
+    pub cluster: Option<&'a GpuClusterer>,
+}
+
+/// Simplifies `model` with `opts.backend`. The `gpu` backend runs on `on`'s pipelines (the
+/// window's own device) and the result stays there: its [`GpuMesh`] is the rounds' buffers, or
+/// for `cluster` the build's. The CPU backends' results are uploaded once so that one renderer
+/// draws them all.
 /// `share_queue`: the device also draws a window (see [`GpuRounds::share_queue`]).
 pub fn simplify(
     device: &wgpu::Device,
-    sim: Option<&GpuSimplifier>,
+    on: Pipelines,
     model: &Model,
     opts: &SimplifyOptions,
     share_queue: bool,
@@ -312,7 +322,9 @@ pub fn simplify(
     phase(&format!("simplifying ({})", opts.backend.name()));
     let (gpu, positions, indices, mesh, report, uvs) = match opts.backend {
         Backend::Gpu if opts.method == crate::Method::Qem => {
-            let sim = sim.ok_or_else(|| Error::Gpu("the GPU backend is not available".into()))?;
+            let sim = on
+                .rounds
+                .ok_or_else(|| Error::Gpu("the GPU backend is not available".into()))?;
             let up = &model.up;
             let mut rounds = GpuRounds::new(sim, up, SELECTION_PASSES)?;
             rounds.share_queue = share_queue;
@@ -339,6 +351,22 @@ pub fn simplify(
             );
             let gpu = rounds.into_mesh(up)?;
             (gpu, d.positions, indices, mesh, report, uvs)
+        }
+        Backend::Gpu if opts.method == crate::Method::Cluster => {
+            let c = on
+                .cluster
+                .ok_or_else(|| Error::Gpu("GPU clustering is not available".into()))?;
+            let (mesh, report, drawn) =
+                crate::cluster::simplify_cluster_drawn(c, &model.mesh, opts, progress)?;
+            // The output's corners are the drawn faces' corners, in the same order.
+            let uvs = mesh.uvs_from(UvOrigin::BottomLeft).map(|uv| {
+                mesh.triangles
+                    .iter()
+                    .flatten()
+                    .map(|&v| uv[v as usize])
+                    .collect()
+            });
+            (drawn.gpu, drawn.positions, drawn.indices, mesh, report, uvs)
         }
         _ => {
             let (mesh, report) =
