@@ -3,10 +3,11 @@
 // digit_counts[d * blocks + b] + (i - first slot of d in the block). Stable, so the sort's output
 // after every pass is the unique one, equal to the CPU twin's. No workgroup waits on another.
 //
-// 64 threads of 16 keys each, not 256 of 4: a scan over 64 threads takes six barrier steps of
-// two SIMD-8 chunks' worth of waiting less per step on a CPU driver (lavapipe runs a workgroup's
-// invocations in chunks and switches between them at each barrier); on the 1M-triangle scan a
-// pass went from 0.09 s to ~0.02 s there (docs/PERFORMANCE.md), and 64 threads is one wave.
+// 64 threads of 16 keys each, not 256 of 4: lavapipe (a CPU driver) runs a workgroup as SIMD
+// chunks of 8 invocations and switches between all of them at every barrier, so a scan over 64
+// threads (6 steps, 8 chunks) waits far less than one over 256 (8 steps, 32 chunks). On the
+// 1M-triangle scan a scatter went from 0.09 s to 0.04 s there (docs/PERFORMANCE.md); 64
+// threads is one wave on a GPU.
 
 @group(0) @binding(0) var<uniform> radix: RadixParams;
 @group(0) @binding(1) var<storage, read> keys: array<u32>;           // per vertex

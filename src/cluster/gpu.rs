@@ -334,6 +334,20 @@ impl<'a> GpuClusterMesh<'a> {
         check(scope, "running a clustering stage")
     }
 
+    /// Runs `steps` alone and waits for them (after [`Self::set_grid`] and the parts they
+    /// read): what examples/cluster_gpu_stages.rs times stage by stage.
+    pub fn run_steps(&mut self, steps: &[CStep]) -> Result<()> {
+        let scope = self
+            .sim
+            .device
+            .push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut enc = self.sim.device.create_command_encoder(&Default::default());
+        self.record(&mut enc, steps);
+        self.sim.queue.submit([enc.finish()]);
+        self.wait()?;
+        check(scope, "running clustering steps")
+    }
+
     fn wait(&self) -> Result<()> {
         self.sim
             .device
