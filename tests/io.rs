@@ -1282,3 +1282,57 @@ fn allocation_counter_counts() {
     assert!(peak >= 3 << 20, "{peak}");
     drop(v);
 }
+
+/// A pass of the streaming read (io::sink): the faces alone, or the vertices alone, as the
+/// out-of-core clustering reads them; the same data as the whole-mesh reader's.
+#[derive(Default)]
+struct Pass {
+    vertices: bool,
+    faces: bool,
+    seen_vertices: Vec<[f32; 3]>,
+    seen_faces: Vec<[u32; 3]>,
+}
+
+impl meshslim::io::sink::Sink for Pass {
+    fn wants_vertices(&self) -> bool {
+        self.vertices
+    }
+    fn wants_faces(&self) -> bool {
+        self.faces
+    }
+    fn vertex(&mut self, v: &meshslim::io::sink::Vertex) {
+        self.seen_vertices.push(v.position);
+    }
+    fn triangle(&mut self, t: [u32; 3]) {
+        self.seen_faces.push(t);
+    }
+}
+
+#[test]
+fn ply_streams_its_vertices_and_faces_in_separate_passes() {
+    let dir = tmp();
+    let m = full_mesh();
+    for ascii in [false, true] {
+        let path = dir.path().join(format!("stream-{ascii}.ply"));
+        let o = WriteOptions {
+            ply_ascii: ascii,
+            ..Default::default()
+        };
+        io::write_with(&path, &m, &o).unwrap();
+        let whole = io::read(&path).unwrap();
+        let mut faces = Pass {
+            faces: true,
+            ..Default::default()
+        };
+        io::ply::read_into(&path, &mut faces).unwrap();
+        assert!(faces.seen_vertices.is_empty(), "the vertices were skipped");
+        assert_eq!(faces.seen_faces, whole.triangles, "ascii {ascii}");
+        let mut vertices = Pass {
+            vertices: true,
+            ..Default::default()
+        };
+        io::ply::read_into(&path, &mut vertices).unwrap();
+        assert!(vertices.seen_faces.is_empty(), "the faces were not read");
+        assert_eq!(vertices.seen_vertices, whole.positions, "ascii {ascii}");
+    }
+}

@@ -13,6 +13,7 @@
 pub mod gltf;
 pub mod obj;
 pub mod ply;
+pub mod sink;
 pub mod stl;
 
 use std::io::{BufWriter, Write};

@@ -41,5 +41,5 @@ mod read;
 mod write;
 
 pub use header::PlyEncoding;
-pub use read::read;
+pub use read::{read, read_into};
 pub use write::write_ply;

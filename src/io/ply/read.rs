@@ -8,6 +8,7 @@ use std::path::Path;
 
 use super::header::{Element, Kind, PlyEncoding, Scalar, read_header};
 use crate::error::{Error, Location, Result};
+use crate::io::sink::{MeshSink, Sink, Vertex, VertexAttributes};
 use crate::mesh::Mesh;
 
 /// Why reading a value failed; turned into an [`Error`] with the element context by the caller.
@@ -176,6 +177,14 @@ fn to_index(v: f64) -> Option<i64> {
 
 /// Reads a PLY file.
 pub fn read(path: &Path) -> Result<Mesh> {
+    let mut sink = MeshSink::default();
+    read_into(path, &mut sink)?;
+    Ok(sink.into_mesh())
+}
+
+/// Reads `path` into `sink`, element by element: what [`read`] collects into a mesh, and what
+/// the out-of-core clustering streams (its passes skip the vertices or stop after them).
+pub fn read_into(path: &Path, sink: &mut dyn Sink) -> Result<()> {
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
     let file_len = file.metadata().map_err(|e| Error::io(path, e))?.len();
     let mut r = BufReader::with_capacity(1 << 16, file);
@@ -236,7 +245,6 @@ pub fn read(path: &Path) -> Result<Mesh> {
         line_no: header.lines,
         cursor: 0,
     };
-    let mut mesh = Mesh::default();
     let mut scratch = Vec::new();
     let mut seen_vertex = false;
 
@@ -259,18 +267,14 @@ pub fn read(path: &Path) -> Result<Mesh> {
             // Nothing to read, however many elements are declared.
             continue;
         }
-        if ei == vi && !seen_vertex {
+        if seen_vertex && !sink.wants_faces() {
+            // A vertex pass: nothing after the vertices is wanted.
+            return Ok(());
+        }
+        if ei == vi && !seen_vertex && sink.wants_vertices() {
             seen_vertex = true;
-            read_vertices(
-                &mut body,
-                el,
-                &mut mesh,
-                remaining,
-                &mut scratch,
-                path,
-                &fail,
-            )?;
-        } else if el.name == "face" || el.name == "tristrips" {
+            read_vertices(&mut body, el, sink, remaining, &mut scratch, path, &fail)?;
+        } else if (el.name == "face" || el.name == "tristrips") && sink.wants_faces() {
             let strips = el.name == "tristrips";
             let li = el
                 .props
@@ -291,8 +295,7 @@ pub fn read(path: &Path) -> Result<Mesh> {
             } else {
                 remaining / 8
             };
-            mesh.triangles
-                .reserve(el.count.min(est).min(1 << 28) as usize);
+            sink.begin_faces(el.count.min(est).min(1 << 28) as usize);
             let mut poly: Vec<u32> = Vec::new();
             for i in 0..el.count {
                 for (pi, p) in el.props.iter().enumerate() {
@@ -316,7 +319,6 @@ pub fn read(path: &Path) -> Result<Mesh> {
                                 continue;
                             }
                             poly.clear();
-                            let tris = &mut mesh.triangles;
                             // Strip state: the previous two indices and the position in the strip.
                             let mut k = 0usize;
                             let mut prev = [0u32; 2];
@@ -342,7 +344,7 @@ pub fn read(path: &Path) -> Result<Mesh> {
                                             [prev[1], prev[0], idx]
                                         };
                                         if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
-                                            tris.push(t);
+                                            sink.triangle(t);
                                         }
                                     }
                                     prev = [prev[1], idx];
@@ -355,7 +357,7 @@ pub fn read(path: &Path) -> Result<Mesh> {
                             .map_err(|f| fail(&body, f, what, i))?;
                             if !strips && poly.len() >= 3 {
                                 for j in 1..poly.len() - 1 {
-                                    mesh.triangles.push([poly[0], poly[j], poly[j + 1]]);
+                                    sink.triangle([poly[0], poly[j], poly[j + 1]]);
                                 }
                             }
                         }
@@ -363,7 +365,11 @@ pub fn read(path: &Path) -> Result<Mesh> {
                 }
             }
         } else {
-            // Unknown element (or a second vertex element): skip it value by value.
+            if ei == vi {
+                seen_vertex = true;
+            }
+            // Unknown element (or a second vertex element, or one this pass skips): skip it
+            // value by value.
             if let (true, Some(size)) = (binary, el.fixed_size()) {
                 for i in 0..el.count {
                     body.bytes(size, &mut scratch, |_| ())
@@ -397,7 +403,7 @@ pub fn read(path: &Path) -> Result<Mesh> {
             }
         }
     }
-    Ok(mesh)
+    Ok(())
 }
 
 /// Turns a read failure into an error naming the element and its number.
@@ -407,7 +413,7 @@ type FailFn<'a, R> = dyn Fn(&Body<R>, Fail, &str, u64) -> Error + 'a;
 fn read_vertices<R: BufRead>(
     body: &mut Body<R>,
     el: &Element,
-    mesh: &mut Mesh,
+    sink: &mut dyn Sink,
     remaining: u64,
     scratch: &mut Vec<u8>,
     path: &Path,
@@ -445,19 +451,14 @@ fn read_vertices<R: BufRead>(
         6
     };
     let cap = el.count.min(remaining / per) as usize;
-    mesh.positions.reserve(cap);
-    let mut normals = Vec::new();
-    let mut colors = Vec::new();
-    let mut uvs = Vec::new();
-    if has_n {
-        normals.reserve(cap);
-    }
-    if has_c {
-        colors.reserve(cap);
-    }
-    if has_uv {
-        uvs.reserve(cap);
-    }
+    sink.begin_vertices(
+        cap,
+        VertexAttributes {
+            normals: has_n,
+            colors: has_c,
+            uvs: has_uv,
+        },
+    );
     let fixed = el.fixed_size().filter(|_| body.binary);
     let mut v = [0f64; 12];
     v[R + 3] = 1.0;
@@ -517,24 +518,17 @@ fn read_vertices<R: BufRead>(
                 format!("vertex {i} has a non-finite coordinate {p:?}"),
             ));
         }
-        mesh.positions.push(p);
-        if has_n {
-            normals.push([v[NX] as f32, v[NX + 1] as f32, v[NX + 2] as f32]);
-        }
-        if has_c {
-            colors.push([
+        sink.vertex(&Vertex {
+            position: p,
+            normal: [v[NX] as f32, v[NX + 1] as f32, v[NX + 2] as f32],
+            color: [
                 v[R] as f32,
                 v[R + 1] as f32,
                 v[R + 2] as f32,
                 v[R + 3] as f32,
-            ]);
-        }
-        if has_uv {
-            uvs.push([v[U] as f32, v[U + 1] as f32]);
-        }
+            ],
+            uv: [v[U] as f32, v[U + 1] as f32],
+        });
     }
-    mesh.normals = has_n.then_some(normals);
-    mesh.colors = has_c.then_some(colors);
-    mesh.uvs = has_uv.then_some(uvs);
     Ok(())
 }
