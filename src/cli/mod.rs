@@ -17,6 +17,7 @@ mod compare;
 mod error;
 mod files;
 mod info;
+mod memory;
 mod report;
 mod simplify;
 mod view;

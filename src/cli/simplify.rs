@@ -100,6 +100,18 @@ pub struct SimplifyArgs {
     #[arg(long, value_enum, default_value_t = MethodArg::Qem)]
     pub method: MethodArg,
 
+    /// Stream the input (a PLY file, --method cluster): hold its vertices and read its faces
+    /// again in blocks at each pass, so memory follows the vertices and the output, not the
+    /// faces. Chosen by itself when reading the file whole would take more than --memory.
+    /// Normals, colours and UVs are not carried when streaming
+    #[arg(long)]
+    pub stream: bool,
+
+    /// What reading the input whole may take before --method cluster streams it instead, as
+    /// 4G, 512M or bytes [default: half the machine's memory]
+    #[arg(long, value_name = "SIZE", value_parser = super::memory::parse_size)]
+    pub memory: Option<u64>,
+
     /// Print exactly one JSON object with the report on stdout, and nothing else there
     #[arg(long)]
     pub json: bool,
@@ -216,54 +228,111 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     };
     let progress = Progress::new(!(args.quiet || args.json) && std::io::stderr().is_terminal());
 
-    let t = Instant::now();
-    let mesh = load(&input, &progress)?;
-    let load_s = t.elapsed().as_secs_f64();
-
-    let mut opts = match target {
-        Target::Ratio(r) => SimplifyOptions::with_ratio(mesh.face_count(), r).map_err(lib)?,
-        Target::Faces(n) => SimplifyOptions::with_faces(n),
+    let method = args.method.method();
+    let stream = match &input {
+        Input::Builtin { .. } if args.stream => {
+            return Err(UsageError(
+                "--stream reads a file; a builtin mesh is made in memory".into(),
+            )
+            .into());
+        }
+        Input::File(path) if args.stream => Some((path.clone(), "--stream".to_string())),
+        Input::File(path)
+            if method == crate::Method::Cluster
+                && !args.lock_border
+                && args.backend.backend() != Backend::Gpu =>
+        {
+            let budget = args.memory.unwrap_or_else(super::memory::default_budget);
+            super::memory::whole_mesh_estimate(path)
+                .filter(|&need| need > budget)
+                .map(|need| {
+                    let why = format!(
+                        "reading it whole would take about {}, over the {} of --memory",
+                        super::memory::mib(need),
+                        super::memory::mib(budget)
+                    );
+                    (path.clone(), why)
+                })
+        }
+        _ => None,
     };
-    opts.max_error = args.max_error;
-    opts.lock_border = args.lock_border;
-    opts.border_weight = args.border_weight;
-    opts.max_normal_angle_deg = args.max_normal_angle;
-    opts.quality_threshold = args.quality_threshold;
     let say = |msg: String| {
         if !args.quiet {
             eprintln!("{msg}");
         }
     };
+    let mut opts = SimplifyOptions::with_faces(match target {
+        Target::Faces(n) => n,
+        Target::Ratio(_) => 0,
+    });
+    opts.max_error = args.max_error;
+    opts.lock_border = args.lock_border;
+    opts.border_weight = args.border_weight;
+    opts.max_normal_angle_deg = args.max_normal_angle;
+    opts.quality_threshold = args.quality_threshold;
     opts.backend = args.backend.backend();
-    opts.method = args.method.method();
-    // Said before the long part; the library makes the same choice (the process's one shared
-    // device), and its report says so again only if the GPU then failed.
-    let early = (opts.backend == Backend::Auto).then(|| {
-        let (_, why) = crate::simplify::auto_backend();
-        say(format!("backend auto: {why}"));
-        why
-    });
+    opts.method = method;
 
-    let t = Instant::now();
-    let result = progress.bar("simplifying", |set| {
-        crate::simplify_with_progress(&mesh, &opts, &mut |f| set(f))
-    });
-    if let Ok((_, report)) = &result
-        && let Some(note) = &report.auto
-        && Some(note) != early.as_ref()
-    {
-        say(format!("backend auto: {note}"));
-    }
-    let (simplified, report) = result
-        .map_err(lib)
-        .with_context(|| format!("cannot simplify {}", input.display()))?;
-    let simplify_s = t.elapsed().as_secs_f64();
-    // Clustering may change the topology: say how (outside the timed call).
-    let topology = report
-        .clustering
-        .is_some()
-        .then(|| super::report::TopologyChange::of(&mesh, &simplified));
-    drop(mesh);
+    let (simplified, report, load_s, simplify_s, topology, streamed) =
+        if let Some((path, why)) = stream {
+            say(format!("streaming {}: {why}", path.display()));
+            let t = Instant::now();
+            let target = match target {
+                Target::Faces(n) => crate::cluster::stream::Target::Faces(n),
+                Target::Ratio(r) => crate::cluster::stream::Target::Ratio(r),
+            };
+            let (simplified, report) = progress
+                .bar("simplifying (streamed)", |set| {
+                    crate::cluster::stream::simplify_file(&path, target, &opts, &mut |f| set(f))
+                })
+                .map_err(lib)
+                .with_context(|| format!("cannot simplify {}", path.display()))?;
+            (
+                simplified,
+                report,
+                0.0,
+                t.elapsed().as_secs_f64(),
+                None,
+                Some(why),
+            )
+        } else {
+            let t = Instant::now();
+            let mesh = load(&input, &progress)?;
+            let load_s = t.elapsed().as_secs_f64();
+            if let Target::Ratio(r) = target {
+                opts.target_faces = SimplifyOptions::with_ratio(mesh.face_count(), r)
+                    .map_err(lib)?
+                    .target_faces;
+            }
+            // Said before the long part; the library makes the same choice (the process's one
+            // shared device), and its report says so again only if the GPU then failed.
+            let early = (opts.backend == Backend::Auto).then(|| {
+                let (_, why) = crate::simplify::auto_backend();
+                say(format!("backend auto: {why}"));
+                why
+            });
+
+            let t = Instant::now();
+            let result = progress.bar("simplifying", |set| {
+                crate::simplify_with_progress(&mesh, &opts, &mut |f| set(f))
+            });
+            if let Ok((_, report)) = &result
+                && let Some(note) = &report.auto
+                && Some(note) != early.as_ref()
+            {
+                say(format!("backend auto: {note}"));
+            }
+            let (simplified, report) = result
+                .map_err(lib)
+                .with_context(|| format!("cannot simplify {}", input.display()))?;
+            let simplify_s = t.elapsed().as_secs_f64();
+            // Clustering may change the topology: say how (outside the timed call).
+            let topology = report
+                .clustering
+                .is_some()
+                .then(|| super::report::TopologyChange::of(&mesh, &simplified));
+            (simplified, report, load_s, simplify_s, topology, None)
+        };
 
     if let Ok(format) = crate::io::Format::from_path(&output) {
         for lost in crate::io::not_kept(&simplified, format) {
@@ -292,7 +361,9 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     let out = std::io::stdout();
     let mut out = out.lock();
     if args.json {
-        let json = simplify_json(&input, &output, &report, &times, topology.as_ref());
+        let mut json = simplify_json(&input, &output, &report, &times, topology.as_ref());
+        json["streamed"] = serde_json::json!(streamed);
+        json["peak_resident_bytes"] = serde_json::json!(super::memory::peak_resident_bytes());
         writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
     } else if !args.quiet {
         write_summary(
@@ -304,6 +375,14 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
             args.stats,
             topology.as_ref(),
         )?;
+        if let Some(why) = &streamed {
+            let peak =
+                super::memory::peak_resident_bytes().map_or("unknown".into(), super::memory::mib);
+            writeln!(
+                out,
+                "stream   {why}: faces read in blocks (load is in simplify); peak resident {peak}"
+            )?;
+        }
     }
     out.flush()?;
     Ok(ExitCode::SUCCESS)

@@ -299,7 +299,7 @@ pub fn simplify_floating(
     let backend = check_backend(opts)?;
     let t = Instant::now();
     let mut pts = Points::new(mesh);
-    let work = prepare(&mut pts, opts, false);
+    let work = prepare(&mut pts, opts, false)?;
     let ranks = {
         let csr = Csr::new(work.pts.positions.len(), &work.pts.faces);
         ranks(&grades(&work.pts.positions, &work.pts.faces, &csr))

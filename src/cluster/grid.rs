@@ -76,17 +76,15 @@ fn unmorton(k: u32) -> [u32; 3] {
 /// over the faces), the faces whose three corners fall in three different cells (a locked
 /// corner is a cell of its own), before connectivity splitting and before duplicates are
 /// dropped: nearly what a build at that size keeps, which the builds' own counts then correct.
-/// Each vertex's cells are found once (packed `x | y << 10 | z << 20`, not Morton-interleaved:
-/// comparing them is the same test): per corner of a 1/8 sample of the faces took as long on
-/// the 1M scan (0.012 s) and six times as long on horse.
-pub fn probe(
-    grids: &[Grid],
-    positions: &[[f32; 4]],
-    locked: &[bool],
-    faces: &[[u32; 3]],
-) -> Vec<usize> {
+/// Each vertex's cells are found once ([`probe_cells`], packed `x | y << 10 | z << 20`, not
+/// Morton-interleaved: comparing them is the same test), then the faces counted
+/// ([`probe_count`], block by block when they stream): per corner of a 1/8 sample of the faces
+/// took as long on the 1M scan (0.012 s) and six times as long on horse.
+///
+/// Each vertex's cell in each of (at most four) `grids`, for [`probe_count`].
+pub fn probe_cells(grids: &[Grid], positions: &[[f32; 4]], locked: &[bool]) -> Vec<[u32; 4]> {
     assert!(grids.len() <= 4, "a probe counts four grids at most");
-    let cells: Vec<[u32; 4]> = positions
+    positions
         .par_iter()
         .zip(locked)
         .enumerate()
@@ -103,8 +101,13 @@ pub fn probe(
             }
             k
         })
-        .collect();
-    let counts = faces
+        .collect()
+}
+
+/// Per grid of [`probe_cells`], the `faces` with three corners in three cells (the unused
+/// grids' slots count every face whose corners are not one vertex repeated: ignore them).
+pub fn probe_count(cells: &[[u32; 4]], faces: &[[u32; 3]]) -> [usize; 4] {
+    faces
         .par_iter()
         .with_min_len(4096)
         .fold(
@@ -117,8 +120,7 @@ pub fn probe(
                 acc
             },
         )
-        .reduce(|| [0usize; 4], |a, b| [0, 1, 2, 3].map(|i| a[i] + b[i]));
-    counts[..grids.len()].to_vec()
+        .reduce(|| [0usize; 4], |a, b| [0, 1, 2, 3].map(|i| a[i] + b[i]))
 }
 
 /// The size where a power law `faces = a·h^s` through `(h, faces)` points (least squares in

@@ -92,7 +92,7 @@ pub fn simplify_hybrid(
         (crate::parallel::Upload::new(mesh), 0.0)
     } else {
         let mut pts = Points::new(mesh);
-        let mut work = prepare(&mut pts, opts, true);
+        let mut work = prepare(&mut pts, opts, true)?;
         let (grid, mut built, _) = cluster_to(
             &work,
             intermediate,

@@ -16,6 +16,7 @@ pub mod gpu_schedule;
 pub mod grid;
 mod hybrid;
 pub mod stages;
+pub mod stream;
 pub mod twins;
 
 pub use floating::simplify_floating;
@@ -29,7 +30,7 @@ use crate::mesh::prepare::{denormalize, frame_of, normalize};
 use crate::options::{Backend, ClusterReport, Method, SimplifyOptions, SimplifyReport, StopReason};
 use grid::Grid;
 use rayon::prelude::*;
-use stages::{Cells, Clusters, Csr, Placed, Placement};
+use stages::{Cells, Clusters, Csr, Marked, Placed, Placement};
 use std::time::Instant;
 
 /// `cluster` lands within this share of the target.
@@ -45,15 +46,22 @@ struct Points<'m> {
     center: [f64; 3],
     scale: f64,
     area: f64,
+    /// `--stream`: the faces stay in the file and are read a block at a time (`faces` is
+    /// empty).
+    stream: Option<stream::FileFaces>,
 }
 
 impl<'m> Points<'m> {
     /// The input's vertices as they are: coincident ones share a cell anyway, and the
     /// connectivity split joins them.
     fn new(mesh: &'m Mesh) -> Points<'m> {
+        Points::of(mesh, mesh.triangles.as_slice().into())
+    }
+
+    /// `mesh`'s vertices with `faces`.
+    fn of(mesh: &Mesh, faces: std::borrow::Cow<'m, [[u32; 3]]>) -> Points<'m> {
         let (center, scale) = frame_of(mesh);
         let attr: Vec<u32> = (0..mesh.positions.len() as u32).collect();
-        let faces = mesh.triangles.as_slice().into();
         let positions: Vec<[f32; 4]> = attr
             .par_iter()
             .with_min_len(4096)
@@ -92,7 +100,22 @@ impl<'m> Points<'m> {
             center,
             scale,
             area: 0.0,
+            stream: None,
         }
+    }
+
+    /// Calls `f` with the faces in blocks, in face order, with each block's first face id: all
+    /// at once in memory, a block at a time from the file when streaming.
+    fn blocks(&self, f: &mut stream::OnBlock) -> Result<()> {
+        match &self.stream {
+            None => f(0, &self.faces),
+            Some(s) => s.blocks(f),
+        }
+    }
+
+    /// How many faces there are.
+    fn face_count(&self) -> usize {
+        self.stream.as_ref().map_or(self.faces.len(), |s| s.faces)
     }
 }
 
@@ -170,12 +193,7 @@ impl Work<'_, '_> {
             Some(_) => (None, None),
             None => {
                 let origins: Vec<V3> = (0..clusters.len()).map(centre).collect();
-                let (q, marked) = stages::scatter_quadrics(
-                    &self.pts.positions,
-                    &self.pts.faces,
-                    &clusters.vertex_cluster,
-                    &origins,
-                );
+                let (q, marked) = self.scatter(&clusters.vertex_cluster, &origins)?;
                 (Some(q), Some(marked))
             }
         };
@@ -224,6 +242,33 @@ impl Work<'_, '_> {
     }
 }
 
+impl Work<'_, '_> {
+    /// [`stages::scatter_quadrics`] over the faces' blocks (one block in memory: the same
+    /// sums), block after block, the marked faces' ids made global.
+    fn scatter(&self, vertex_cluster: &[u32], origins: &[V3]) -> Result<(Vec<Quadric>, Marked)> {
+        let mut sum: Option<Vec<Quadric>> = None;
+        let mut kept = Vec::new();
+        self.pts.blocks(&mut |first, faces| {
+            let (q, marked) =
+                stages::scatter_quadrics(&self.pts.positions, faces, vertex_cluster, origins);
+            kept.extend(marked.into_iter().map(|(f, t)| (f + first as u32, t)));
+            match &mut sum {
+                None => sum = Some(q),
+                Some(sum) => sum
+                    .par_iter_mut()
+                    .zip(q)
+                    .with_min_len(4096)
+                    .for_each(|(s, p)| *s = crate::cpu::common::quadric_add(s, &p)),
+            }
+            Ok(())
+        })?;
+        Ok((
+            sum.unwrap_or_else(|| vec![Quadric::default(); origins.len()]),
+            kept,
+        ))
+    }
+}
+
 /// The grid size a face count suggests: on a surface about `3 area / h²` faces survive
 /// (occupied cells ≈ 1.5 area / h², two faces a cell).
 fn estimate(area: f64, faces: usize) -> f32 {
@@ -251,7 +296,14 @@ fn cluster_to(
         .iter()
         .map(|k| Grid::new(lo, hi, (k * h0) as f32))
         .collect();
-    let counts = grid::probe(&grids, &pts.positions, &work.locked, &pts.faces);
+    let cells = grid::probe_cells(&grids, &pts.positions, &work.locked);
+    let mut counts = [0usize; 4];
+    pts.blocks(&mut |_, faces| {
+        let c = grid::probe_count(&cells, faces);
+        counts = [0, 1, 2, 3].map(|i| counts[i] + c[i]);
+        Ok(())
+    })?;
+    drop(cells);
     report.sizes_counted += grids.len();
     let probed: Vec<(f64, f64)> = grids
         .iter()
@@ -462,28 +514,45 @@ const AREA_STRIDE: usize = 8;
 /// The surface area in the unit-diagonal frame, estimated from every [`AREA_STRIDE`]-th face
 /// and summed in fixed chunks (the same for any thread count, as the grid search that starts
 /// from it must be).
-fn area(positions: &[[f32; 4]], faces: &[[u32; 3]]) -> f64 {
-    let sampled: Vec<[u32; 3]> = faces.iter().step_by(AREA_STRIDE).copied().collect();
-    let parts: Vec<f64> = sampled
-        .par_chunks(16384)
-        .map(|part| {
-            part.iter()
-                .map(|t| {
-                    let p = t.map(|v| xyz(positions[v as usize]));
-                    let c = crate::cpu::common::cross(
-                        crate::cpu::common::sub(p[1], p[0]),
-                        crate::cpu::common::sub(p[2], p[0]),
-                    );
-                    0.5 * crate::cpu::common::length(c) as f64
-                })
-                .sum::<f64>()
-        })
-        .collect();
-    parts.iter().sum::<f64>() * faces.len() as f64 / sampled.len().max(1) as f64
+fn area(pts: &Points) -> Result<f64> {
+    let (mut sum, mut sampled) = (0.0f64, 0usize);
+    pts.blocks(&mut |first, faces| {
+        // Every AREA_STRIDE-th face of the whole, whatever the blocks.
+        let skip = (AREA_STRIDE - first % AREA_STRIDE) % AREA_STRIDE;
+        let picked: Vec<[u32; 3]> = faces
+            .iter()
+            .skip(skip)
+            .step_by(AREA_STRIDE)
+            .copied()
+            .collect();
+        sampled += picked.len();
+        let parts: Vec<f64> = picked
+            .par_chunks(16384)
+            .map(|part| {
+                part.iter()
+                    .map(|t| {
+                        let p = t.map(|v| xyz(pts.positions[v as usize]));
+                        let c = crate::cpu::common::cross(
+                            crate::cpu::common::sub(p[1], p[0]),
+                            crate::cpu::common::sub(p[2], p[0]),
+                        );
+                        0.5 * crate::cpu::common::length(c) as f64
+                    })
+                    .sum::<f64>()
+            })
+            .collect();
+        sum += parts.iter().sum::<f64>();
+        Ok(())
+    })?;
+    Ok(sum * pts.face_count() as f64 / sampled.max(1) as f64)
 }
 
 /// `split` (hybrid): build the vertex→face lists, face planes and border vertices.
-fn prepare<'a, 'm>(pts: &'a mut Points<'m>, opts: &SimplifyOptions, split: bool) -> Work<'a, 'm> {
+fn prepare<'a, 'm>(
+    pts: &'a mut Points<'m>,
+    opts: &SimplifyOptions,
+    split: bool,
+) -> Result<Work<'a, 'm>> {
     let gather = (split || opts.lock_border).then(|| {
         let csr = Csr::new(pts.positions.len(), &pts.faces);
         let planes = stages::face_planes(&pts.positions, &pts.faces);
@@ -494,18 +563,18 @@ fn prepare<'a, 'm>(pts: &'a mut Points<'m>, opts: &SimplifyOptions, split: bool)
             border,
         }
     });
-    pts.area = area(&pts.positions, &pts.faces);
+    pts.area = area(pts)?;
     let locked = match &gather {
         Some(g) if opts.lock_border => g.border.clone(),
         _ => vec![false; pts.positions.len()],
     };
-    Work {
+    Ok(Work {
         pts,
         gather: gather.filter(|_| split),
         border_weight: opts.border_weight as f32,
         locked,
         gpu: None,
-    }
+    })
 }
 
 /// Vertices on an edge of one face.
@@ -593,7 +662,7 @@ fn cluster_on(
     let backend = check_backend(opts)?;
     let t = Instant::now();
     let mut pts = Points::new(mesh);
-    let mut work = prepare(&mut pts, opts, false);
+    let mut work = prepare(&mut pts, opts, false)?;
     if let Some(sim) = on {
         let g = gpu::GpuClusterMesh::new(sim, &work.pts.positions, &work.pts.faces, &work.locked)?;
         work.gpu = Some(std::sync::Mutex::new(g));

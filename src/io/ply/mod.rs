@@ -41,5 +41,5 @@ mod read;
 mod write;
 
 pub use header::PlyEncoding;
-pub use read::{read, read_into};
+pub use read::{header_counts, read, read_into};
 pub use write::write_ply;

@@ -182,6 +182,23 @@ pub fn read(path: &Path) -> Result<Mesh> {
     Ok(sink.into_mesh())
 }
 
+/// The counts the header declares: vertices and faces (polygons and strips before
+/// triangulation), without reading the body: what a memory estimate can go on.
+pub fn header_counts(path: &Path) -> Result<(u64, u64)> {
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut r = BufReader::with_capacity(1 << 12, file);
+    let header = read_header(&mut r, path)?;
+    let count = |names: &[&str]| -> u64 {
+        header
+            .elements
+            .iter()
+            .filter(|e| names.contains(&e.name.as_str()))
+            .map(|e| e.count)
+            .sum()
+    };
+    Ok((count(&["vertex"]), count(&["face", "tristrips"])))
+}
+
 /// Reads `path` into `sink`, element by element: what [`read`] collects into a mesh, and what
 /// the out-of-core clustering streams (its passes skip the vertices or stop after them).
 pub fn read_into(path: &Path, sink: &mut dyn Sink) -> Result<()> {

@@ -1,0 +1,65 @@
+//! Memory for `simplify --stream` and `--memory`: the machine's, the process's peak, and what
+//! the whole-mesh path would need.
+
+use std::path::Path;
+
+/// A `/proc` field in kibibytes (`MemTotal` of /proc/meminfo, `VmHWM` of /proc/self/status),
+/// in bytes; `None` where there is no /proc.
+fn proc_kib(file: &str, field: &str) -> Option<u64> {
+    let text = std::fs::read_to_string(file).ok()?;
+    let line = text.lines().find(|l| l.starts_with(field))?;
+    let kib: u64 = line[field.len()..]
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kib * 1024)
+}
+
+/// The process's peak resident memory so far.
+pub(super) fn peak_resident_bytes() -> Option<u64> {
+    proc_kib("/proc/self/status", "VmHWM:")
+}
+
+/// The default budget: half the machine's memory (4 GiB where it cannot be read).
+pub(super) fn default_budget() -> u64 {
+    proc_kib("/proc/meminfo", "MemTotal:").map_or(4 << 30, |b| b / 2)
+}
+
+/// Bytes per input face the whole-mesh `cluster` path holds at its peak: the mesh (12 B a face
+/// and 12 B a vertex, two faces a vertex) plus the clustering's 36 MiB peak on the 1M scan
+/// (`meshslim bench scan-1m.ply --backends cluster`, docs/PERFORMANCE.md), rounded up.
+const WHOLE_CLUSTER_BYTES_PER_FACE: u64 = 64;
+
+/// What `--method cluster` would hold reading `path` whole, from its header's counts; `None`
+/// for a file whose counts are not in a header (only PLY streams).
+pub(super) fn whole_mesh_estimate(path: &Path) -> Option<u64> {
+    let (_, faces) = crate::io::ply::header_counts(path).ok()?;
+    Some(faces.saturating_mul(WHOLE_CLUSTER_BYTES_PER_FACE))
+}
+
+/// `4G`, `512M`, `100k` or plain bytes (binary units).
+pub(super) fn parse_size(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (num, shift) = match t.chars().last().map(|c| c.to_ascii_uppercase()) {
+        Some('K') => (&t[..t.len() - 1], 10),
+        Some('M') => (&t[..t.len() - 1], 20),
+        Some('G') => (&t[..t.len() - 1], 30),
+        Some('T') => (&t[..t.len() - 1], 40),
+        _ => (t, 0),
+    };
+    let n: f64 = num
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a size: write e.g. 4G, 512M or 1000000"))?;
+    if !(n.is_finite() && n > 0.0) {
+        return Err(format!("{s:?}: the size must be above zero"));
+    }
+    Ok((n * (1u64 << shift) as f64) as u64)
+}
+
+/// MiB, for messages.
+pub(super) fn mib(bytes: u64) -> String {
+    format!("{:.0} MiB", bytes as f64 / (1u64 << 20) as f64)
+}

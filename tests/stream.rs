@@ -1,0 +1,181 @@
+//! `--method cluster --stream` (src/cluster/stream.rs): the faces read from the file in blocks at
+//! every pass give the clustering the whole-mesh path gives; options it cannot honour are
+//! refused with a clear message; the command line streams on request or when the budget says so.
+
+mod common;
+
+use common::{expect_code, meshslim};
+use meshslim::cluster::stream::{Target, simplify_file_in_blocks};
+use meshslim::{Backend, Error, Mesh, Method, SimplifyOptions, simplify};
+use std::path::Path;
+
+fn opts(faces: usize) -> SimplifyOptions {
+    let mut o = SimplifyOptions::with_faces(faces);
+    o.method = Method::Cluster;
+    o.backend = Backend::CpuParallel;
+    o
+}
+
+fn noisy_torus() -> Mesh {
+    let mut m = meshslim::mesh::torus(1.0, 0.3, 120, 60);
+    meshslim::mesh::add_noise(&mut m, 0.002, 9);
+    m
+}
+
+fn write(m: &Mesh, path: &Path, ascii: bool) {
+    let o = meshslim::io::WriteOptions {
+        ply_ascii: ascii,
+        ..Default::default()
+    };
+    meshslim::io::write_with(path, m, &o).unwrap();
+}
+
+#[test]
+fn streamed_clustering_is_the_whole_mesh_clustering() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = noisy_torus();
+    for (ascii, block) in [(false, 1000), (false, 7), (true, 4096)] {
+        let path = dir.path().join(format!("torus-{ascii}.ply"));
+        write(&m, &path, ascii);
+        // The file as the whole-mesh path reads it (f32 positions round trip exactly).
+        let whole = meshslim::io::read(&path).unwrap();
+        for target in [2000, 300] {
+            let label = format!("ascii {ascii}, block {block}, target {target}");
+            let (a, ra) = simplify(&whole, &opts(target)).unwrap();
+            let (b, rb) =
+                simplify_file_in_blocks(&path, Target::Faces(target), &opts(0), block, &mut |_| {})
+                    .unwrap();
+            assert_eq!(rb.input_faces, whole.triangles.len(), "{label}");
+            assert_eq!(rb.input_vertices, whole.positions.len(), "{label}");
+            assert_eq!(rb.target_faces, target, "{label}");
+            let (ca, cb) = (ra.clustering.unwrap(), rb.clustering.unwrap());
+            assert_eq!(ca.cell_size, cb.cell_size, "{label}: the same size search");
+            assert_eq!(
+                a.triangles, b.triangles,
+                "{label}: the same faces, numbered alike"
+            );
+            // The quadrics are summed block after block (another order of the same sums), so a
+            // vertex agrees to rounding, within a hundredth of a cell.
+            let cell = cb.cell_size * whole.bounds().unwrap().diagonal();
+            let mut worst = 0f64;
+            for (p, q) in a.positions.iter().zip(&b.positions) {
+                let d = (0..3)
+                    .map(|i| (p[i] - q[i]) as f64)
+                    .fold(0f64, |m, x| m.max(x.abs()));
+                worst = worst.max(d / cell);
+            }
+            eprintln!("{label}: worst move {worst:e} cells");
+            assert!(
+                worst <= 0.01,
+                "{label}: a vertex {worst} cells from the whole-mesh one"
+            );
+            assert!(b.normals.is_none() && b.uvs.is_none() && b.colors.is_none());
+        }
+    }
+}
+
+#[test]
+fn a_ratio_is_taken_of_the_files_faces() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = noisy_torus();
+    let path = dir.path().join("torus.ply");
+    write(&m, &path, false);
+    let (_, r) =
+        simplify_file_in_blocks(&path, Target::Ratio(0.1), &opts(0), 5000, &mut |_| {}).unwrap();
+    assert_eq!(
+        r.target_faces,
+        (m.triangles.len() as f64 * 0.1).round() as usize
+    );
+    let band = 0.05 * r.target_faces as f64;
+    assert!(
+        (r.output_faces as f64 - r.target_faces as f64).abs() <= band,
+        "{r:?}"
+    );
+}
+
+#[test]
+fn what_streaming_cannot_do_is_refused_with_a_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = noisy_torus();
+    let ply = dir.path().join("torus.ply");
+    let obj = dir.path().join("torus.obj");
+    write(&m, &ply, false);
+    meshslim::io::write(&obj, &m).unwrap();
+    let run = |path: &Path, o: SimplifyOptions| {
+        simplify_file_in_blocks(path, Target::Faces(500), &o, 1000, &mut |_| {})
+    };
+    let expect = |r: meshslim::Result<(Mesh, meshslim::SimplifyReport)>, needle: &str| match r {
+        Err(Error::InvalidOption(msg)) => assert!(msg.contains(needle), "{msg}"),
+        other => panic!("expected a refusal naming {needle:?}, got {other:?}"),
+    };
+    expect(run(&obj, opts(0)), "PLY");
+    let mut qem = opts(0);
+    qem.method = Method::Qem;
+    expect(run(&ply, qem), "--method cluster");
+    let mut locked = opts(0);
+    locked.lock_border = true;
+    expect(run(&ply, locked), "--lock-border");
+    // A file that is not there: the path in the error.
+    let missing = dir.path().join("missing.ply");
+    let e = run(&missing, opts(0)).unwrap_err().to_string();
+    assert!(e.contains("missing.ply"), "{e}");
+}
+
+#[test]
+fn the_command_line_streams_on_request_or_over_the_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    write(&noisy_torus(), &dir.path().join("torus.ply"), false);
+    for extra in [&["--stream"][..], &["--memory", "100k"][..]] {
+        let mut args = vec![
+            "simplify",
+            "torus.ply",
+            "out.ply",
+            "--method",
+            "cluster",
+            "--ratio",
+            "0.1",
+            "--json",
+        ];
+        args.extend(extra);
+        let o = meshslim(&args, dir.path());
+        expect_code(&o, 0);
+        let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let why = j["streamed"].as_str().unwrap_or_else(|| panic!("{j:#}"));
+        assert!(why.contains(extra[0]), "{extra:?}: {why}");
+        assert!(j["peak_resident_bytes"].as_u64().unwrap() > 0, "{j:#}");
+        assert!(j["topology"].is_null(), "the input is not held to compare");
+        let out = meshslim::io::read(&dir.path().join("out.ply")).unwrap();
+        assert_eq!(
+            out.triangles.len() as u64,
+            j["output_faces"].as_u64().unwrap()
+        );
+    }
+    // The default budget (half the machine) holds this mesh: read whole, topology reported.
+    let o = meshslim(
+        &[
+            "simplify",
+            "torus.ply",
+            "out2.ply",
+            "--method",
+            "cluster",
+            "--json",
+        ],
+        dir.path(),
+    );
+    expect_code(&o, 0);
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(j["streamed"].is_null() && !j["topology"].is_null(), "{j:#}");
+    // Bad uses: a builtin mesh, a bad size.
+    let o = meshslim(
+        &["simplify", "builtin:sphere", "o.ply", "--stream"],
+        dir.path(),
+    );
+    expect_code(&o, 2);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--stream reads a file"));
+    let o = meshslim(
+        &["simplify", "torus.ply", "o.ply", "--memory", "lots"],
+        dir.path(),
+    );
+    expect_code(&o, 2);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not a size"));
+}
