@@ -514,9 +514,12 @@ const AREA_STRIDE: usize = 8;
 /// The surface area in the unit-diagonal frame, estimated from every [`AREA_STRIDE`]-th face
 /// and summed in fixed chunks (the same for any thread count, as the grid search that starts
 /// from it must be).
-fn area(pts: &Points) -> Result<f64> {
-    let (mut sum, mut sampled) = (0.0f64, 0usize);
+/// The faces' area (from a sample of them), and how many faces there are (a streamed file's
+/// count comes from this pass).
+fn area(pts: &Points) -> Result<(f64, usize)> {
+    let (mut sum, mut sampled, mut count) = (0.0f64, 0usize, 0usize);
     pts.blocks(&mut |first, faces| {
+        count += faces.len();
         // Every AREA_STRIDE-th face of the whole, whatever the blocks.
         let skip = (AREA_STRIDE - first % AREA_STRIDE) % AREA_STRIDE;
         let picked: Vec<[u32; 3]> = faces
@@ -544,7 +547,7 @@ fn area(pts: &Points) -> Result<f64> {
         sum += parts.iter().sum::<f64>();
         Ok(())
     })?;
-    Ok(sum * pts.face_count() as f64 / sampled.max(1) as f64)
+    Ok((sum * count as f64 / sampled.max(1) as f64, count))
 }
 
 /// `split` (hybrid): build the vertex→face lists, face planes and border vertices.
@@ -563,7 +566,11 @@ fn prepare<'a, 'm>(
             border,
         }
     });
-    pts.area = area(pts)?;
+    let (area, faces) = area(pts)?;
+    pts.area = area;
+    if let Some(s) = pts.stream.as_mut() {
+        s.faces = faces;
+    }
     let locked = match &gather {
         Some(g) if opts.lock_border => g.border.clone(),
         _ => vec![false; pts.positions.len()],

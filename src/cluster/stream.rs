@@ -161,22 +161,6 @@ pub fn simplify_file_in_blocks(
     let mut raw = Positions::default();
     crate::io::ply::read_into(path, &mut raw)?;
     let vertices = raw.0.len();
-    let mut faces = 0usize;
-    let stream = FileFaces {
-        path: path.to_path_buf(),
-        block,
-        faces: 0,
-    };
-    // The count first: --ratio needs it, and the area's sampling scales by it.
-    stream.blocks(&mut |_, b| {
-        faces += b.len();
-        Ok(())
-    })?;
-    progress(0.1);
-    let target_faces = match target {
-        Target::Faces(n) => n,
-        Target::Ratio(r) => SimplifyOptions::with_ratio(faces, r)?.target_faces,
-    };
     let mut pts = {
         let m = Mesh {
             positions: raw.0,
@@ -184,8 +168,18 @@ pub fn simplify_file_in_blocks(
         };
         Points::of(&m, Vec::new().into())
     };
-    pts.stream = Some(FileFaces { faces, ..stream });
+    pts.stream = Some(FileFaces {
+        path: path.to_path_buf(),
+        block,
+        faces: 0,
+    });
+    // The area pass counts the faces too: --ratio needs the count.
     let work = prepare(&mut pts, opts, false)?;
+    let faces = work.pts.face_count();
+    let target_faces = match target {
+        Target::Faces(n) => n,
+        Target::Ratio(r) => SimplifyOptions::with_ratio(faces, r)?.target_faces,
+    };
     progress(0.2);
     let mut report = ClusterReport {
         method: Method::Cluster,

@@ -65,6 +65,23 @@ impl<R: BufRead> Body<R> {
         Ok(f(scratch))
     }
 
+    /// Skips up to `n` bytes (binary only) a buffer at a time, not a value at a time (a
+    /// streaming pass skips the vertices this way); returns how many there were.
+    fn skip(&mut self, n: u64) -> io::Result<u64> {
+        let mut left = n;
+        while left > 0 {
+            let buf = self.r.fill_buf()?;
+            if buf.is_empty() {
+                break;
+            }
+            let k = (buf.len() as u64).min(left) as usize;
+            self.r.consume(k);
+            self.pos += k as u64;
+            left -= k as u64;
+        }
+        Ok(n - left)
+    }
+
     /// Next whitespace-separated token (ascii only), reading further lines as needed.
     fn token(&mut self) -> Result<&str, Fail> {
         loop {
@@ -388,9 +405,12 @@ pub fn read_into(path: &Path, sink: &mut dyn Sink) -> Result<()> {
             // Unknown element (or a second vertex element, or one this pass skips): skip it
             // value by value.
             if let (true, Some(size)) = (binary, el.fixed_size()) {
-                for i in 0..el.count {
-                    body.bytes(size, &mut scratch, |_| ())
-                        .map_err(|f| fail(&body, f, &el.name, i))?;
+                let done = body
+                    .skip(el.count * size as u64)
+                    .map_err(|e| Error::io(path, e))?;
+                if done < el.count * size as u64 {
+                    let i = done / size as u64;
+                    return Err(fail(&body, Fail::Eof, &el.name, i));
                 }
                 continue;
             }
