@@ -27,16 +27,21 @@ pub(super) fn default_budget() -> u64 {
     proc_kib("/proc/meminfo", "MemTotal:").map_or(4 << 30, |b| b / 2)
 }
 
-/// Bytes per input face the whole-mesh `cluster` path holds at its peak: the mesh (12 B a face
-/// and 12 B a vertex, two faces a vertex) plus the clustering's 36 MiB peak on the 1M scan
-/// (`meshslim bench scan-1m.ply --backends cluster`, docs/PERFORMANCE.md), rounded up.
-const WHOLE_CLUSTER_BYTES_PER_FACE: u64 = 64;
+/// Bytes per input face the whole-mesh path holds at its peak: the mesh (12 B a face and 12 B a
+/// vertex, two faces a vertex) plus the method's peak heap on the 1M scan (`meshslim bench
+/// scan-1m.ply --backends cluster,hybrid`, docs/PERFORMANCE.md: 36 and 94 MiB), rounded up.
+fn whole_bytes_per_face(method: crate::Method) -> u64 {
+    match method {
+        crate::Method::Hybrid => 128,
+        _ => 64,
+    }
+}
 
-/// What `--method cluster` would hold reading `path` whole, from its header's counts; `None`
-/// for a file whose counts are not in a header (only PLY streams).
-pub(super) fn whole_mesh_estimate(path: &Path) -> Option<u64> {
+/// What `method` would hold reading `path` whole, from its header's counts; `None` for a file
+/// whose counts are not in a header (only PLY streams).
+pub(super) fn whole_mesh_estimate(path: &Path, method: crate::Method) -> Option<u64> {
     let (_, faces) = crate::io::ply::header_counts(path).ok()?;
-    Some(faces.saturating_mul(WHOLE_CLUSTER_BYTES_PER_FACE))
+    Some(faces.saturating_mul(whole_bytes_per_face(method)))
 }
 
 /// `4G`, `512M`, `100k` or plain bytes (binary units).

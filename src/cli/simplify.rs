@@ -41,6 +41,8 @@ Examples:
   meshslim simplify terrain.obj terrain-small.obj --ratio 0.05 --lock-border
   # simplify as far as an error of 0.1% of the bounding-box diagonal allows
   meshslim simplify scan.ply scan-err.ply --faces 0 --max-error 0.001
+  # a PLY larger than memory: vertex clustering with the faces streamed from the file
+  meshslim simplify huge.ply huge-1m.ply --faces 1000000 --method cluster --stream
   # machine-readable report
   meshslim simplify builtin:torus torus-half.glb --ratio 0.5 --json";
 
@@ -100,14 +102,15 @@ pub struct SimplifyArgs {
     #[arg(long, value_enum, default_value_t = MethodArg::Qem)]
     pub method: MethodArg,
 
-    /// Stream the input (a PLY file, --method cluster): hold its vertices and read its faces
-    /// again in blocks at each pass, so memory follows the vertices and the output, not the
-    /// faces. Chosen by itself when reading the file whole would take more than --memory.
-    /// Normals, colours and UVs are not carried when streaming
+    /// Stream the input (a PLY file, --method cluster or hybrid): hold its vertices and read
+    /// its faces again in blocks at each clustering pass, so memory follows the vertices and
+    /// the output, not the faces (hybrid's rounds then run on the clustered mesh). Chosen by
+    /// itself when reading the file whole would take more than --memory. Normals, colours and
+    /// UVs are not carried when streaming
     #[arg(long)]
     pub stream: bool,
 
-    /// What reading the input whole may take before --method cluster streams it instead, as
+    /// What reading the input whole may take before cluster or hybrid streams it instead, as
     /// 4G, 512M or bytes [default: half the machine's memory]
     #[arg(long, value_name = "SIZE", value_parser = super::memory::parse_size)]
     pub memory: Option<u64>,
@@ -238,12 +241,12 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
         }
         Input::File(path) if args.stream => Some((path.clone(), "--stream".to_string())),
         Input::File(path)
-            if method == crate::Method::Cluster
+            if matches!(method, crate::Method::Cluster | crate::Method::Hybrid)
                 && !args.lock_border
-                && args.backend.backend() != Backend::Gpu =>
+                && (method == crate::Method::Hybrid || args.backend.backend() != Backend::Gpu) =>
         {
             let budget = args.memory.unwrap_or_else(super::memory::default_budget);
-            super::memory::whole_mesh_estimate(path)
+            super::memory::whole_mesh_estimate(path, method)
                 .filter(|&need| need > budget)
                 .map(|need| {
                     let why = format!(

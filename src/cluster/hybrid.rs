@@ -5,8 +5,10 @@
 //! on the CPU on both backends: its split of cells by connectivity is a union-find, and it is a
 //! tenth of the hybrid's time (docs/PERFORMANCE.md, "Clustering").
 
+use super::grid::Grid;
 use super::{
-    Built, ClusterReport, Points, check_backend, cluster_to, max_error, output, prepare, tally,
+    Built, ClusterReport, Points, Work, check_backend, cluster_to, max_error, output, prepare,
+    tally,
 };
 use crate::error::Result;
 use crate::mesh::Mesh;
@@ -67,6 +69,57 @@ fn pinched_clusters(b: &Built) -> Vec<u32> {
     bad
 }
 
+/// The hybrid's clustering: to at least `intermediate` faces (the rounds then go to `target`),
+/// clusters that pinch a non-manifold edge taken apart until none is left.
+pub(super) fn cluster_repaired(
+    work: &mut Work,
+    intermediate: usize,
+    target: usize,
+    report: &mut ClusterReport,
+) -> Result<(Grid, Built)> {
+    let (grid, mut built, _) = cluster_to(work, intermediate, None, Some(target), report)?;
+    // Splitting cells by connectivity keeps separate sheets apart, but a sheet folded inside
+    // one cell can still pinch into a non-manifold edge: take the clusters on one apart (their
+    // members each their own cluster) and build again, until none is left.
+    for _ in 0..MAX_REPAIRS {
+        let bad = pinched_clusters(&built);
+        if bad.is_empty() {
+            break;
+        }
+        for (v, &k) in built.vertex_cluster.iter().enumerate() {
+            if bad.binary_search(&k).is_ok() {
+                work.locked[v] = true;
+            }
+        }
+        built = work.build(&grid)?;
+        report.builds += 1;
+        report.repaired_clusters += bad.len();
+    }
+    Ok((grid, built))
+}
+
+/// The rounds from `up` on `opts.backend` (cpu-parallel or gpu).
+pub(super) fn rounds(
+    up: &crate::parallel::Upload,
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport)> {
+    match opts.backend {
+        crate::options::Backend::Gpu => {
+            let (ctx, sim) = crate::gpu::shared()?;
+            crate::gpu::simplify_upload(ctx, sim, up, mesh, opts, progress)
+        }
+        _ => crate::cpu::simplify_upload(up, mesh, opts, progress),
+    }
+}
+
+/// The intermediate face count the hybrid clusters to for `target` of `input` faces.
+pub(super) fn intermediate(target: usize, input: usize) -> usize {
+    ((target as f64 * HYBRID_FACTOR + HYBRID_EXTRA).max(HYBRID_MIN_SHARE * input as f64)).round()
+        as usize
+}
+
 /// `--method hybrid`.
 pub fn simplify_hybrid(
     mesh: &Mesh,
@@ -79,9 +132,7 @@ pub fn simplify_hybrid(
         ..opts.clone()
     };
     let t = Instant::now();
-    let intermediate = ((opts.target_faces as f64 * HYBRID_FACTOR + HYBRID_EXTRA)
-        .max(HYBRID_MIN_SHARE * mesh.triangles.len() as f64))
-    .round() as usize;
+    let intermediate = intermediate(opts.target_faces, mesh.triangles.len());
     let mut report = ClusterReport {
         method: Method::Hybrid,
         ..Default::default()
@@ -93,30 +144,8 @@ pub fn simplify_hybrid(
     } else {
         let mut pts = Points::new(mesh);
         let mut work = prepare(&mut pts, opts, true)?;
-        let (grid, mut built, _) = cluster_to(
-            &work,
-            intermediate,
-            None,
-            Some(opts.target_faces),
-            &mut report,
-        )?;
-        // Splitting cells by connectivity keeps separate sheets apart, but a sheet folded
-        // inside one cell can still pinch into a non-manifold edge: take the clusters on one
-        // apart (their members each their own cluster) and build again, until none is left.
-        for _ in 0..MAX_REPAIRS {
-            let bad = pinched_clusters(&built);
-            if bad.is_empty() {
-                break;
-            }
-            for (v, &k) in built.vertex_cluster.iter().enumerate() {
-                if bad.binary_search(&k).is_ok() {
-                    work.locked[v] = true;
-                }
-            }
-            built = work.build(&grid)?;
-            report.builds += 1;
-            report.repaired_clusters += bad.len();
-        }
+        let (grid, built) =
+            cluster_repaired(&mut work, intermediate, opts.target_faces, &mut report)?;
         tally(&mut report, &built);
         report.cell_size = grid.h as f64;
         report.intermediate_faces = Some(built.faces.len());
@@ -129,13 +158,7 @@ pub fn simplify_hybrid(
     };
     report.seconds = t.elapsed().as_secs_f64();
     opts.cancel.check()?;
-    let (out, mut r) = match backend {
-        crate::options::Backend::Gpu => {
-            let (ctx, sim) = crate::gpu::shared()?;
-            crate::gpu::simplify_upload(ctx, sim, &up, mesh, opts, progress)?
-        }
-        _ => crate::cpu::simplify_upload(&up, mesh, opts, progress)?,
-    };
+    let (out, mut r) = rounds(&up, mesh, opts, progress)?;
     r.max_collapse_error = r.max_collapse_error.max(built_error);
     r.collapses = mesh.positions.len().saturating_sub(out.positions.len());
     r.clustering = Some(report);

@@ -133,6 +133,8 @@ struct Work<'a, 'm> {
     /// `hybrid`: the vertex→face lists, face planes and border vertices its gather and its
     /// connectivity split read; `cluster` scatters its quadrics without them.
     gather: Option<Gather>,
+    /// `hybrid`: cells split into their connected components.
+    split: bool,
     border_weight: f32,
     /// Per point: clustered with nobody (a locked border; a hybrid cluster that made a
     /// non-manifold edge, taken apart).
@@ -166,12 +168,22 @@ impl Work<'_, '_> {
         let (sorted, members) = stages::radix_sort(&keys);
         drop(keys);
         let cells: Cells = stages::cell_ranges(&sorted, members);
-        let (clusters, label) = match &self.gather {
-            Some(_) => {
-                let label = stages::cell_labels(&cells, &self.pts.faces, &self.pts.positions);
-                (Clusters::split(&cells, &label), Some(label))
-            }
-            None => (Clusters::whole_cells(&cells), None),
+        let (clusters, label) = if self.split {
+            let label = match &self.gather {
+                Some(_) => stages::cell_labels(&cells, &self.pts.faces, &self.pts.positions),
+                // Streamed: the union-find fed block by block.
+                None => {
+                    let mut u = stages::CellUnion::new(cells.vertex_cell.len());
+                    self.pts.blocks(&mut |_, faces| {
+                        u.join_faces(&cells, faces);
+                        Ok(())
+                    })?;
+                    u.labels(&cells, &self.pts.positions)
+                }
+            };
+            (Clusters::split(&cells, &label), Some(label))
+        } else {
+            (Clusters::whole_cells(&cells), None)
         };
         // Each cluster's box: its cell's, or its vertex for a singleton.
         let boxes: Vec<(V3, V3)> = (0..clusters.len())
@@ -224,7 +236,7 @@ impl Work<'_, '_> {
             })
             .collect();
         let faces = match marked {
-            Some(marked) => stages::dedupe_faces(marked, clusters.len(), false),
+            Some(marked) => stages::dedupe_faces(marked, clusters.len(), self.split),
             None => stages::cluster_faces(
                 &self.pts.faces,
                 &clusters.vertex_cluster,
@@ -556,7 +568,8 @@ fn prepare<'a, 'm>(
     opts: &SimplifyOptions,
     split: bool,
 ) -> Result<Work<'a, 'm>> {
-    let gather = (split || opts.lock_border).then(|| {
+    // Streamed faces have no vertex→face lists: a streamed hybrid scatters its quadrics.
+    let gather = (pts.stream.is_none() && (split || opts.lock_border)).then(|| {
         let csr = Csr::new(pts.positions.len(), &pts.faces);
         let planes = stages::face_planes(&pts.positions, &pts.faces);
         let border = border_vertices(&csr, &pts.faces);
@@ -578,6 +591,7 @@ fn prepare<'a, 'm>(
     Ok(Work {
         pts,
         gather: gather.filter(|_| split),
+        split,
         border_weight: opts.border_weight as f32,
         locked,
         gpu: None,

@@ -1,16 +1,16 @@
-//! Out-of-core `--method cluster` (Lindstrom, "Out-of-Core Simplification of Large Polygonal
+//! Out-of-core `--method cluster` and `hybrid` (Lindstrom, "Out-of-Core Simplification of Large Polygonal
 //! Models", SIGGRAPH 2000): the vertex positions are held, the faces are not. A first pass reads
 //! the vertices alone; every later pass (the area, the counting pass, each build of the size
 //! search) reads the faces again from the file in blocks of [`BLOCK`] triangles and consumes
 //! them as they pass: the cells' quadrics are summed block after block and only the faces that
-//! survive are kept. Memory depends on the vertices and the output, not on the faces.
+//! survive are kept. Memory depends on the vertices and the output, not on the faces. The
+//! hybrid splits cells by connectivity with a union-find fed block by block, scatters its
+//! quadrics (no vertex→face lists), then runs the rounds in memory on the clustered mesh.
 //!
 //! Not carried: normals, colours and UVs (they would be held per vertex); the output's vertices
 //! are the clusters' positions. Only PLY (ascii or binary) streams so far.
 
-use super::{
-    BAND, Built, ClusterReport, Points, StopReason, cluster_to, max_error, prepare, tally,
-};
+use super::{Built, ClusterReport, Points, StopReason, cluster_to, max_error, prepare, tally};
 use crate::error::{Error, Result};
 use crate::io::sink::{Sink, Vertex};
 use crate::mesh::Mesh;
@@ -114,7 +114,7 @@ pub enum Target {
     Ratio(f64),
 }
 
-/// `--method cluster --stream` on the PLY file at `path`: the input's counts come from the
+/// `--method cluster` or `hybrid` with `--stream` on the PLY file at `path`: the input's counts come from the
 /// file; `opts.target_faces` is replaced by `target`. Returns the simplified mesh (positions
 /// and faces) and the report; the input's face and vertex counts are the file's.
 pub fn simplify_file(
@@ -144,16 +144,20 @@ pub fn simplify_file_in_blocks(
             path.display()
         )));
     }
-    if opts.method != Method::Cluster {
-        return Err(Error::InvalidOption(format!(
-            "--stream runs --method cluster; --method {} holds the whole mesh",
-            opts.method.name()
-        )));
-    }
-    if opts.lock_border || opts.backend == Backend::Gpu {
+    let hybrid = match opts.method {
+        Method::Cluster => false,
+        Method::Hybrid => true,
+        m => {
+            return Err(Error::InvalidOption(format!(
+                "--stream runs --method cluster and hybrid; --method {} holds the whole mesh",
+                m.name()
+            )));
+        }
+    };
+    if opts.lock_border || (opts.backend == Backend::Gpu && !hybrid) {
         return Err(Error::InvalidOption(
-            "--stream runs on the CPU without --lock-border (finding the border needs every \
-             face at once)"
+            "--stream clusters on the CPU (hybrid's rounds may run on --backend gpu), without \
+             --lock-border (finding the border needs every face at once)"
                 .into(),
         ));
     }
@@ -174,7 +178,7 @@ pub fn simplify_file_in_blocks(
         faces: 0,
     });
     // The area pass counts the faces too: --ratio needs the count.
-    let work = prepare(&mut pts, opts, false)?;
+    let mut work = prepare(&mut pts, opts, hybrid)?;
     let faces = work.pts.face_count();
     let target_faces = match target {
         Target::Faces(n) => n,
@@ -182,46 +186,96 @@ pub fn simplify_file_in_blocks(
     };
     progress(0.2);
     let mut report = ClusterReport {
-        method: Method::Cluster,
+        method: opts.method,
         ..Default::default()
     };
-    let (grid, built, stop) = cluster_to(&work, target_faces, opts.max_error, None, &mut report)?;
+    let to = super::hybrid::intermediate(target_faces, faces);
+    if hybrid && to as f64 >= super::hybrid::HYBRID_SKIP * faces as f64 {
+        // Clustering would keep most faces, and the rounds then hold them anyway: read the
+        // mesh whole and run the hybrid as it is (its rounds start from the input).
+        drop(work);
+        drop(pts);
+        let mesh = crate::io::read(path)?;
+        let opts = SimplifyOptions {
+            target_faces,
+            ..opts.clone()
+        };
+        return super::hybrid::simplify_hybrid(&mesh, &opts, progress);
+    }
+    let (grid, built, stop) = if hybrid {
+        let (grid, built) =
+            super::hybrid::cluster_repaired(&mut work, to, target_faces, &mut report)?;
+        (grid, built, StopReason::TargetReached)
+    } else {
+        cluster_to(&work, target_faces, opts.max_error, None, &mut report)?
+    };
     opts.cancel.check()?;
-    progress(0.9);
     tally(&mut report, &built);
     report.cell_size = grid.h as f64;
-    let out = output(work.pts, &built);
+    let (clustered, quadrics) = output(work.pts, &built);
+    let built_error = max_error(&built);
+    let frame = (work.pts.center, work.pts.scale);
+    drop(work);
+    drop(pts);
     report.seconds = t.elapsed().as_secs_f64();
-    let report = SimplifyReport {
-        backend: Backend::CpuParallel,
-        auto: None,
-        input_faces: faces,
+    let input = Counts { faces, vertices };
+    if !hybrid {
+        progress(1.0);
+        let out = clustered;
+        let r = SimplifyReport {
+            backend: Backend::CpuParallel,
+            auto: None,
+            input_faces: faces,
+            target_faces,
+            output_faces: out.triangles.len(),
+            input_vertices: vertices,
+            output_vertices: out.positions.len(),
+            collapses: vertices.saturating_sub(out.positions.len()),
+            max_collapse_error: built_error,
+            stop_reason: stop,
+            dropped_degenerate_faces: 0,
+            pinned_vertices: 0,
+            rounds: None,
+            blocked: None,
+            clustering: Some(report),
+        };
+        return Ok((out, r));
+    }
+    // The hybrid's rounds, in memory on the clustered mesh, from the clusters' quadrics.
+    progress(0.5);
+    report.intermediate_faces = Some(clustered.triangles.len());
+    let up = crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics);
+    let opts = &SimplifyOptions {
         target_faces,
-        output_faces: out.triangles.len(),
-        input_vertices: vertices,
-        output_vertices: out.positions.len(),
-        collapses: vertices.saturating_sub(out.positions.len()),
-        max_collapse_error: max_error(&built),
-        stop_reason: stop,
-        dropped_degenerate_faces: 0,
-        pinned_vertices: 0,
-        rounds: None,
-        blocked: None,
-        clustering: Some(report),
+        backend: if opts.backend == Backend::Gpu {
+            Backend::Gpu
+        } else {
+            Backend::CpuParallel
+        },
+        ..opts.clone()
     };
-    debug_assert!(
-        stop != StopReason::TargetReached
-            || (out.triangles.len() as f64 - target_faces as f64).abs()
-                <= BAND * target_faces as f64 + 1.0
-    );
-    Ok((out, report))
+    let (out, mut r) =
+        super::hybrid::rounds(&up, &clustered, opts, &mut |f| progress(0.5 + 0.5 * f))?;
+    r.max_collapse_error = r.max_collapse_error.max(built_error);
+    r.input_faces = input.faces;
+    r.input_vertices = input.vertices;
+    r.collapses = input.vertices.saturating_sub(out.positions.len());
+    r.clustering = Some(report);
+    Ok((out, r))
+}
+
+/// The input file's counts.
+struct Counts {
+    faces: usize,
+    vertices: usize,
 }
 
 /// The clusters the kept faces use, numbered in order of first use (as the in-memory output),
-/// at their placed positions.
-fn output(pts: &Points, b: &Built) -> Mesh {
+/// at their placed positions, and their quadrics.
+fn output(pts: &Points, b: &Built) -> (Mesh, Vec<crate::gpu::types::Quadric>) {
     let mut id = vec![u32::MAX; b.clusters];
     let mut positions = Vec::new();
+    let mut quadrics = Vec::new();
     let mut triangles = Vec::with_capacity(b.faces.len());
     for (_, t) in &b.faces {
         triangles.push(t.map(|k| {
@@ -229,13 +283,15 @@ fn output(pts: &Points, b: &Built) -> Mesh {
                 id[k as usize] = positions.len() as u32;
                 let p = b.placed[k as usize].pos.map(|x| x as f64);
                 positions.push(denormalize(p, pts.center, pts.scale));
+                quadrics.push(b.placed[k as usize].quadric);
             }
             id[k as usize]
         }));
     }
-    Mesh {
+    let mesh = Mesh {
         positions,
         triangles,
         ..Mesh::default()
-    }
+    };
+    (mesh, quadrics)
 }
