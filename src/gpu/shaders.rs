@@ -136,9 +136,11 @@ pub const SEAMS: &str = include_str!("../../shaders/seams.wgsl");
 /// The clustering stages' structs and constants, for the stages that bind `ClusterParams` or
 /// `RadixParams`.
 pub const CLUSTER: &str = include_str!("../../shaders/cluster.wgsl");
+/// A cluster's gather and placement, for the stages that bind `cluster_placed`.
+pub const PLACE: &str = include_str!("../../shaders/place.wgsl");
 
-/// The full source of a stage: the common definitions, the mesh and seam accessors when the
-/// stage binds the buffers they read, then the stage.
+/// The full source of a stage: the common definitions, the clustering, mesh, seam and
+/// placement helpers when the stage binds the buffers they read, then the stage.
 pub fn source(stage_source: &str) -> String {
     let binds = |var: &str| {
         ["read", "read_write"]
@@ -154,6 +156,9 @@ pub fn source(stage_source: &str) -> String {
         if binds("face_extra") {
             src = format!("{src}\n{SEAMS}");
         }
+    }
+    if binds("cluster_placed") {
+        src = format!("{src}\n{PLACE}");
     }
     format!("{src}\n{stage_source}")
 }
@@ -276,7 +281,7 @@ mod tests {
             let name = entry.file_name().into_string().unwrap();
             let stem = name.trim_end_matches(".wgsl");
             assert!(
-                ["common", "mesh", "seams", "cluster"].contains(&stem)
+                ["common", "mesh", "seams", "cluster", "place"].contains(&stem)
                     || stage_source(stem).is_some(),
                 "shaders/{name} is not listed in SOURCES"
             );
