@@ -5,6 +5,8 @@
 const SINGLETON: u32 = 0x80000000u;
 // Keys one radix workgroup takes: 256 threads × 4 contiguous keys.
 const SORT_BLOCK: u32 = 1024u;
+// A floating cell's vertex not yet claimed by a centre (fc_centre).
+const UNCLAIMED: u32 = 0xffffffffu;
 
 const PLACE_SINGLE: u32 = 0u;
 const PLACE_SOLVE: u32 = 1u;

@@ -9,6 +9,9 @@
 //! simplifier's do). `qem` keeps seams.
 
 pub mod floating;
+// `floating-cell` on the gpu backend: its stages' twins and its build on `gpu::GpuClusterMesh`.
+pub mod floating_gpu;
+pub mod floating_twins;
 // `cluster` on the gpu backend: the build's stage descriptions, their CPU twins (the GPU's
 // gather order; the CPU driver scatters its quadrics instead) and the GPU driver.
 pub mod gpu;

@@ -117,6 +117,21 @@ pub const SOURCES: &[(&str, &str)] = &[
         "cluster_faces_compact",
         include_str!("../../shaders/cluster_faces_compact.wgsl"),
     ),
+    // The floating cells' build (also described in src/cluster/gpu_schedule.rs).
+    ("fc_grades", include_str!("../../shaders/fc_grades.wgsl")),
+    ("fc_ranks", include_str!("../../shaders/fc_ranks.wgsl")),
+    ("fc_keys", include_str!("../../shaders/fc_keys.wgsl")),
+    ("fc_init", include_str!("../../shaders/fc_init.wgsl")),
+    ("fc_decide", include_str!("../../shaders/fc_decide.wgsl")),
+    ("fc_claim", include_str!("../../shaders/fc_claim.wgsl")),
+    (
+        "fc_cluster_keys",
+        include_str!("../../shaders/fc_cluster_keys.wgsl"),
+    ),
+    (
+        "fc_quadrics",
+        include_str!("../../shaders/fc_quadrics.wgsl"),
+    ),
 ];
 
 /// The source of `shaders/<stem>.wgsl`.
@@ -136,11 +151,15 @@ pub const SEAMS: &str = include_str!("../../shaders/seams.wgsl");
 /// The clustering stages' structs and constants, for the stages that bind `ClusterParams` or
 /// `RadixParams`.
 pub const CLUSTER: &str = include_str!("../../shaders/cluster.wgsl");
+/// The floating cells' uniform and helpers, for the stages that bind `FloatParams`.
+pub const FLOATING: &str = include_str!("../../shaders/floating.wgsl");
+/// The floating cells' hash-grid search, for those of them that also bind `cell_key`.
+pub const FLOATING_CELLS: &str = include_str!("../../shaders/floating_cells.wgsl");
 /// A cluster's gather and placement, for the stages that bind `cluster_placed`.
 pub const PLACE: &str = include_str!("../../shaders/place.wgsl");
 
-/// The full source of a stage: the common definitions, the clustering, mesh, seam and
-/// placement helpers when the stage binds the buffers they read, then the stage.
+/// The full source of a stage: the common definitions, the clustering, floating-cell, mesh,
+/// seam and placement helpers when the stage binds the buffers they read, then the stage.
 pub fn source(stage_source: &str) -> String {
     let binds = |var: &str| {
         ["read", "read_write"]
@@ -150,6 +169,12 @@ pub fn source(stage_source: &str) -> String {
     let mut src = COMMON.to_string();
     if stage_source.contains(": ClusterParams;") || stage_source.contains(": RadixParams;") {
         src = format!("{src}\n{CLUSTER}");
+    }
+    if stage_source.contains(": FloatParams;") {
+        src = format!("{src}\n{FLOATING}");
+        if binds("cell_key") {
+            src = format!("{src}\n{FLOATING_CELLS}");
+        }
     }
     if binds("indices") && binds("vertex_faces") {
         src = format!("{src}\n{MESH}");
@@ -281,7 +306,16 @@ mod tests {
             let name = entry.file_name().into_string().unwrap();
             let stem = name.trim_end_matches(".wgsl");
             assert!(
-                ["common", "mesh", "seams", "cluster", "place"].contains(&stem)
+                [
+                    "common",
+                    "mesh",
+                    "seams",
+                    "cluster",
+                    "floating",
+                    "floating_cells",
+                    "place"
+                ]
+                .contains(&stem)
                     || stage_source(stem).is_some(),
                 "shaders/{name} is not listed in SOURCES"
             );
@@ -374,6 +408,13 @@ mod tests {
         assert_eq!(size("ClusterParams"), size_of::<ClusterParams>());
         assert_eq!(size("RadixParams"), size_of::<RadixParams>());
         assert_eq!(size("ClusterPlaced"), size_of::<ClusterPlaced>());
+        let module = parse("fc_quadrics", stage_source("fc_quadrics").unwrap());
+        let (_, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some("FloatParams"))
+            .expect("no struct FloatParams in floating.wgsl");
+        assert_eq!(ty.inner.size(module.to_ctx()) as usize, size_of::<FloatParams>());
     }
 
     /// The constants of shaders/cluster.wgsl against their Rust twins.
@@ -396,6 +437,7 @@ mod tests {
         };
         let pairs = [
             ("SINGLETON", crate::cluster::grid::SINGLETON),
+            ("UNCLAIMED", crate::cluster::floating::UNCLAIMED),
             ("SORT_BLOCK", SORT_BLOCK),
             ("PLACE_SINGLE", place::SINGLE),
             ("PLACE_SOLVE", place::SOLVE),
