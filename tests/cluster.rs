@@ -186,9 +186,10 @@ fn max_error_bounds_the_cell() {
     }
 }
 
+/// `hybrid` runs on the CPU only (`cluster` and `floating-cell` also on the GPU).
 #[test]
 fn clustering_on_the_gpu_backend_is_refused_with_a_clear_message() {
-    let mut o = opts(100, Method::FloatingCell);
+    let mut o = opts(100, Method::Hybrid);
     o.backend = Backend::Gpu;
     match simplify(&icosphere(3), &o) {
         Err(Error::InvalidOption(msg)) => assert!(msg.contains("cpu-parallel"), "{msg}"),

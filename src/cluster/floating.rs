@@ -15,10 +15,10 @@ use super::{
     tally,
 };
 use crate::cpu::common::{V3, dot, length, sub, tie_rank, xyz};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::mesh::morton::morton3;
-use crate::options::{Method, SimplifyOptions, SimplifyReport};
+use crate::options::{Backend, Method, SimplifyOptions, SimplifyReport};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -276,9 +276,24 @@ pub fn clusters_of(centre: &[u32]) -> (Vec<u32>, usize) {
     (centre.iter().map(|&c| id[c as usize]).collect(), n as usize)
 }
 
-/// One floating-cell clustering at radius `r`, and the rounds its centres took.
-fn build_floating(work: &Work, ranks: &[u64], r: f32) -> (Built, usize) {
+/// One floating-cell clustering at radius `r`, and the rounds its centres took: on the device
+/// when the work has one (the same stages, `floating_gpu.rs`), else here.
+fn build_floating(work: &Work, ranks: &[u64], r: f32) -> Result<(Built, usize)> {
     let pts = work.pts;
+    if let Some(g) = &work.gpu {
+        let (b, rounds) = g
+            .lock()
+            .map_err(|_| Error::Internal("the GPU clustering lock is poisoned".into()))?
+            .build_floating(pts.lo, pts.hi, r)?;
+        let built = Built {
+            placed: b.placed,
+            faces: b.faces,
+            vertex_cluster: b.vertex_cluster,
+            clusters: b.clusters,
+            cells: b.cells,
+        };
+        return Ok((built, rounds));
+    }
     let (centre, rounds) = claim(&pts.positions, ranks, &work.locked, pts.lo, pts.hi, r);
     let (vertex_cluster, n) = clusters_of(&centre);
     let centres: Vec<u32> = (0..centre.len() as u32)
@@ -317,7 +332,7 @@ fn build_floating(work: &Work, ranks: &[u64], r: f32) -> (Built, usize) {
         clusters: n,
         cells: n,
     };
-    (built, rounds)
+    Ok((built, rounds))
 }
 
 /// `--method floating-cell`.
@@ -329,8 +344,19 @@ pub fn simplify_floating(
     let backend = check_backend(opts)?;
     let t = Instant::now();
     let mut pts = Points::new(mesh);
-    let work = prepare(&mut pts, opts, false);
-    let ranks = {
+    let mut work = prepare(&mut pts, opts, false);
+    // On the GPU the mesh and its buffers stay on the device between the search's builds, and
+    // the ranks are made there on the first.
+    let ranks = if backend == Backend::Gpu {
+        let g = super::gpu::GpuClusterMesh::new(
+            super::gpu::shared()?,
+            &work.pts.positions,
+            &work.pts.faces,
+            &work.locked,
+        )?;
+        work.gpu = Some(std::sync::Mutex::new(g));
+        Vec::new()
+    } else {
         let csr = Csr::new(work.pts.positions.len(), &work.pts.faces);
         ranks(&grades(&work.pts.positions, &work.pts.faces, &csr))
     };
@@ -349,7 +375,7 @@ pub fn simplify_floating(
         .map(|e| e / ((1.0 + 3f64.sqrt()) * (1.0 + 0.5 * JITTER as f64)));
     let mut rounds = 0;
     let (r, built, stop) = land(target, None, first, None, cap, &mut report, &mut |r| {
-        let (b, n) = build_floating(&work, &ranks, r as f32);
+        let (b, n) = build_floating(&work, &ranks, r as f32)?;
         rounds = n;
         Ok((r as f32 as f64, b))
     })?;

@@ -531,15 +531,18 @@ fn border_vertices(csr: &Csr, faces: &[[u32; 3]]) -> Vec<bool> {
         .collect()
 }
 
-/// The backend a clustering method runs on: `cluster` on the GPU when asked (`auto` takes the
-/// CPU: on lavapipe a build is 4-12x slower, docs/PERFORMANCE.md), the others on the CPU.
+/// The backend a clustering method runs on: `cluster` and `floating-cell` on the GPU when asked
+/// (`auto` takes the CPU: on lavapipe a build is 4-12x slower, docs/PERFORMANCE.md), `hybrid`
+/// on the CPU.
 fn check_backend(opts: &SimplifyOptions) -> Result<Backend> {
     match opts.backend {
         Backend::Cpu | Backend::CpuParallel | Backend::Auto => Ok(Backend::CpuParallel),
-        Backend::Gpu if opts.method == Method::Cluster => Ok(Backend::Gpu),
+        Backend::Gpu if matches!(opts.method, Method::Cluster | Method::FloatingCell) => {
+            Ok(Backend::Gpu)
+        }
         Backend::Gpu => Err(Error::InvalidOption(format!(
             "--method {} runs on the CPU only so far (backend cpu-parallel); the gpu backend \
-             runs --method qem and cluster",
+             runs --method qem, cluster and floating-cell",
             opts.method.name()
         ))),
     }
