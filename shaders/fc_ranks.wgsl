@@ -1,8 +1,9 @@
-// Per vertex: its rank word (the grade's bits less the low 8, which an ulp of difference between
-// devices would flip, then 8 bits of a hash of the id so that equal grades do not rank in an id
-// wave; floating::ranks) and, at slot n - 1 - v, the pair the rank sort orders: the inverted word
-// with the id. The stable radix sort then leaves the vertices by rank, highest first (a tie of
-// words to the higher id, as the CPU's u64 rank has the id below the word).
+// Per vertex: its rank word (the grade's bits less the low 8, then 8 bits of a hash of the id, so
+// near-equal grades rank by the hash and not in an id wave; floating::ranks) and, at slot
+// n - 1 - v, the pair the rank sort orders: the inverted word with the id. The stable radix sort
+// then leaves the vertices by rank, highest first (a tie of words to the higher id, as the CPU's
+// u64 rank has the id below the word). The word is exact given the grade; a grade an ulp off on
+// another device changes it only across a 256-ulp step.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> fc_grade: array<f32>;        // per vertex

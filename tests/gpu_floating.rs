@@ -71,7 +71,9 @@ fn locked_of(n: usize, lock: bool) -> Vec<bool> {
 }
 
 fn rd<T: bytemuck::Pod>(g: &GpuClusterMesh, b: CBuf, n: usize) -> Vec<T> {
-    let bytes = g.read_buffer(b, (n * std::mem::size_of::<T>()) as u64).unwrap();
+    let bytes = g
+        .read_buffer(b, (n * std::mem::size_of::<T>()) as u64)
+        .unwrap();
     bytemuck::pod_collect_to_vec(&bytes)
 }
 
@@ -133,9 +135,21 @@ fn cells_on_both(gpu: &mut GpuClusterMesh, label: &str, sorted: &(Vec<u32>, Vec<
     gpu.run_part(Part::Cells).unwrap();
     let c = twins::cells(&gpu.cluster_params(), &sorted.0, &sorted.1);
     let n = c.cell_key.len();
-    assert_eq!(rd::<u32>(gpu, CBuf::CellHead, nv + 1), c.cell_head, "{label}");
-    assert_eq!(rd::<u32>(gpu, CBuf::CellStart, n + 1), c.cell_start, "{label}");
-    assert_eq!(rd::<u32>(gpu, CBuf::VertexCell, nv), c.vertex_cell, "{label}");
+    assert_eq!(
+        rd::<u32>(gpu, CBuf::CellHead, nv + 1),
+        c.cell_head,
+        "{label}"
+    );
+    assert_eq!(
+        rd::<u32>(gpu, CBuf::CellStart, n + 1),
+        c.cell_start,
+        "{label}"
+    );
+    assert_eq!(
+        rd::<u32>(gpu, CBuf::VertexCell, nv),
+        c.vertex_cell,
+        "{label}"
+    );
     assert_eq!(rd::<u32>(gpu, CBuf::CellKey, n), c.cell_key, "{label}");
     n
 }
@@ -179,16 +193,32 @@ fn each_floating_stage_matches_its_cpu_twin() {
         let (mut ranks, mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv], vec![0u32; nv]);
         ft::fc_ranks(&params, &grades, &mut ranks, &mut keys, &mut vals);
         assert_eq!(rd::<u32>(&gpu, CBuf::FcRank, nv), ranks, "{name}: fc_rank");
-        assert_eq!(rd::<u32>(&gpu, CBuf::SortKeys, nv), keys, "{name}: rank keys");
-        assert_eq!(rd::<u32>(&gpu, CBuf::SortVals, nv), vals, "{name}: rank values");
+        assert_eq!(
+            rd::<u32>(&gpu, CBuf::SortKeys, nv),
+            keys,
+            "{name}: rank keys"
+        );
+        assert_eq!(
+            rd::<u32>(&gpu, CBuf::SortVals, nv),
+            vals,
+            "{name}: rank values"
+        );
         let (_, order) = sort_on_both(&mut gpu, name, ft::RANK_PASSES, nv);
         gpu.run_fc_part(FcPart::Order).unwrap();
-        assert_eq!(rd::<u32>(&gpu, CBuf::FcOrder, nv), order, "{name}: fc_order");
+        assert_eq!(
+            rd::<u32>(&gpu, CBuf::FcOrder, nv),
+            order,
+            "{name}: fc_order"
+        );
         // The order is by rank, highest first, as the CPU's u64 ranks order.
         let full: Vec<u64> = (0..nv)
             .map(|v| floating::rank(grades[v], v as u32))
             .collect();
-        assert!(order.windows(2).all(|w| full[w[0] as usize] > full[w[1] as usize]));
+        assert!(
+            order
+                .windows(2)
+                .all(|w| full[w[0] as usize] > full[w[1] as usize])
+        );
 
         for &r in &radii {
             let label = format!("{name} at r = {r}");
@@ -197,12 +227,28 @@ fn each_floating_stage_matches_its_cpu_twin() {
             gpu.run_fc_part(FcPart::Keys).unwrap();
             let (mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv]);
             ft::fc_keys(&c, &pos, &order, &mut keys, &mut vals);
-            assert_eq!(rd::<u32>(&gpu, CBuf::SortKeys, nv), keys, "{label}: fc_keys");
-            assert_eq!(rd::<u32>(&gpu, CBuf::SortVals, nv), vals, "{label}: fc_keys");
+            assert_eq!(
+                rd::<u32>(&gpu, CBuf::SortKeys, nv),
+                keys,
+                "{label}: fc_keys"
+            );
+            assert_eq!(
+                rd::<u32>(&gpu, CBuf::SortVals, nv),
+                vals,
+                "{label}: fc_keys"
+            );
             let (mut centre, mut head) = (vec![0u32; nv], vec![0u32; nv + 1]);
             ft::fc_init(&c, &locked_u32, &mut centre, &mut head);
-            assert_eq!(rd::<u32>(&gpu, CBuf::FcCentre, nv), centre, "{label}: fc_init");
-            assert_eq!(rd::<u32>(&gpu, CBuf::FcHead, nv), head[..nv], "{label}: fc_init");
+            assert_eq!(
+                rd::<u32>(&gpu, CBuf::FcCentre, nv),
+                centre,
+                "{label}: fc_init"
+            );
+            assert_eq!(
+                rd::<u32>(&gpu, CBuf::FcHead, nv),
+                head[..nv],
+                "{label}: fc_init"
+            );
             let passes = gpu.hash_passes();
             let sorted = sort_on_both(&mut gpu, &label, passes, nv);
             let cells = cells_on_both(&mut gpu, &label, &sorted);
@@ -238,7 +284,10 @@ fn each_floating_stage_matches_its_cpu_twin() {
                     );
                     let what = format!("{label}: round {rounds}");
                     let live_gpu: Vec<u32> = rd(&gpu, CBuf::FcLive, ROUND_SLOTS);
-                    assert_eq!(live_gpu[slot as usize], live[slot as usize], "{what}: fc_live");
+                    assert_eq!(
+                        live_gpu[slot as usize], live[slot as usize],
+                        "{what}: fc_live"
+                    );
                     assert_eq!(rd::<u32>(&gpu, CBuf::FcDecided, nv), decided, "{what}");
                     let mut after = centre.clone();
                     ft::fc_claim(
@@ -253,7 +302,11 @@ fn each_floating_stage_matches_its_cpu_twin() {
                         &mut after,
                         &mut head,
                     );
-                    assert_eq!(rd::<u32>(&gpu, CBuf::FcCentre, nv), after, "{what}: centres");
+                    assert_eq!(
+                        rd::<u32>(&gpu, CBuf::FcCentre, nv),
+                        after,
+                        "{what}: centres"
+                    );
                     assert_eq!(rd::<u32>(&gpu, CBuf::FcHead, nv), head[..nv], "{what}");
                     if live[slot as usize] == 0 {
                         break 'rounds;
@@ -263,7 +316,10 @@ fn each_floating_stage_matches_its_cpu_twin() {
                 }
             }
             let centre: Vec<u32> = rd(&gpu, CBuf::FcCentre, nv);
-            assert!(!centre.contains(&UNCLAIMED), "{label}: every vertex claimed");
+            assert!(
+                !centre.contains(&UNCLAIMED),
+                "{label}: every vertex claimed"
+            );
 
             // Centres numbered, vertices keyed by cluster.
             let mut head: Vec<u32> = rd(&gpu, CBuf::FcHead, nv + 1);
@@ -315,7 +371,10 @@ fn each_floating_stage_matches_its_cpu_twin() {
             let f = twins::faces(&c, indices, &vertex_cluster);
             let kept = f.face_origin.len();
             assert!(kept > 0, "{label}: some faces survive");
-            assert_eq!(rd::<u32>(&gpu, CBuf::ClusterFaces, 3 * kept), f.cluster_faces);
+            assert_eq!(
+                rd::<u32>(&gpu, CBuf::ClusterFaces, 3 * kept),
+                f.cluster_faces
+            );
             assert_eq!(rd::<u32>(&gpu, CBuf::FaceOrigin, kept), f.face_origin);
             eprintln!("{label}: {rounds} rounds, {clusters} clusters, {kept} faces");
         }
@@ -354,9 +413,24 @@ fn the_floating_twins_are_the_cpu_driver() {
     }
 }
 
-/// The whole GPU build against the twins' chain: the same ranks (measured: every grade on
-/// lavapipe is the CPU's bit for bit on these meshes), so the same rounds, clusters and faces;
-/// vertices within rounding. Twice the same bits.
+/// The ranks the device makes for `pos`, against the CPU's: how many differ. The grades take a
+/// square root and divisions, which Vulkan does not round correctly everywhere (nor forbid fused
+/// multiply-adds): on lavapipe every grade of these meshes is the CPU's bit for bit, so none;
+/// elsewhere a grade an ulp off can cross a 256-ulp rank step.
+fn ranks_differing(gpu: &mut GpuClusterMesh, pos: &[[f32; 4]], faces: &[[u32; 3]]) -> usize {
+    gpu.run_fc_part(FcPart::Ranks).unwrap();
+    let csr = stages::Csr::new(pos.len(), faces);
+    let cpu = floating::ranks(&floating::grades(pos, faces, &csr));
+    let got: Vec<u32> = rd(gpu, CBuf::FcRank, pos.len());
+    got.iter()
+        .zip(&cpu)
+        .filter(|(g, c)| **g != (**c >> 32) as u32)
+        .count()
+}
+
+/// The whole GPU build against the twins' chain: with the same ranks (lavapipe), the same
+/// rounds, clusters and faces, vertices within rounding; on a device whose ranks differ, faces
+/// within 5% of the twins'. Twice the same bits either way.
 #[test]
 fn the_gpu_floating_build_equals_the_twins_chain() {
     let Some(ctx) = gpu_context() else { return };
@@ -365,6 +439,7 @@ fn the_gpu_floating_build_equals_the_twins_chain() {
         let (pos, lo, hi) = points(&m);
         let locked = locked_of(pos.len(), lock);
         let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
+        let differ = ranks_differing(&mut gpu, &pos, &m.triangles);
         for r in radii {
             let label = format!("{name} at r = {r}");
             let (g, rounds) = gpu.build_floating(lo, hi, r).unwrap();
@@ -378,8 +453,17 @@ fn the_gpu_floating_build_equals_the_twins_chain() {
                 "{label}: the same vertices twice, bit for bit"
             );
             let twin = ft::run(&pos, &m.triangles, &locked, lo, hi, r);
-            assert_eq!(rounds, twin.rounds.len(), "{label}: rounds");
             let t = twin.result();
+            if differ > 0 {
+                eprintln!("{label}: {differ} ranks differ from the CPU's on this device");
+                let (a, b) = (g.faces.len() as f64, t.faces.len() as f64);
+                assert!(
+                    (a - b).abs() <= 0.05 * b,
+                    "{label}: {a} faces, the twins {b}"
+                );
+                continue;
+            }
+            assert_eq!(rounds, twin.rounds.len(), "{label}: rounds");
             assert_eq!(g.vertex_cluster, t.vertex_cluster, "{label}: clusters");
             assert_eq!(g.faces, t.faces, "{label}: faces");
             assert_eq!(g.placed.len(), t.placed.len(), "{label}");
@@ -395,8 +479,9 @@ fn the_gpu_floating_build_equals_the_twins_chain() {
     }
 }
 
-/// `meshslim simplify --method floating-cell --backend gpu` against `cpu-parallel`: the same
-/// ranks and so the same search, radius, rounds, clusters and faces. Vertices: the CPU driver
+/// `meshslim simplify --method floating-cell --backend gpu` against `cpu-parallel`: with the same
+/// ranks (lavapipe) the same search, radius, rounds, clusters and faces; on a device whose ranks
+/// differ, both in the ±5% band or equally far from it. Vertices: the CPU driver
 /// scatters its quadrics in face order, the GPU gathers them cluster by cluster, the same sums
 /// to rounding; on a curved surface that leaves them within 5% of the radius (measured: 1e-6 r
 /// on the sphere, 1.5e-5 r on the torus), but on a flat patch every candidate costs zero and
@@ -404,9 +489,8 @@ fn the_gpu_floating_build_equals_the_twins_chain() {
 /// (measured: 0.85 r).
 #[test]
 fn simplify_floating_on_the_gpu_writes_the_cpu_parallel_faces() {
-    if gpu_context().is_none() {
-        return;
-    }
+    let Some(ctx) = gpu_context() else { return };
+    let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
     let mut sphere = meshslim::mesh::icosphere(5);
     meshslim::mesh::add_noise(&mut sphere, 0.01, 5);
     let meshes = [
@@ -415,6 +499,10 @@ fn simplify_floating_on_the_gpu_writes_the_cpu_parallel_faces() {
         ("torus", meshslim::mesh::torus(1.0, 0.3, 64, 32), 0.05),
     ];
     for (name, m, within) in meshes {
+        let (pos, _, _) = points(&m);
+        let locked = vec![false; pos.len()];
+        let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
+        let differ = ranks_differing(&mut gpu, &pos, &m.triangles);
         for target in [m.triangles.len() / 10, m.triangles.len() / 50] {
             let run = |backend| {
                 let mut o = meshslim::SimplifyOptions::with_faces(target);
@@ -426,6 +514,11 @@ fn simplify_floating_on_the_gpu_writes_the_cpu_parallel_faces() {
             let (gpu, rg) = run(meshslim::Backend::Gpu);
             assert_eq!(rg.backend, meshslim::Backend::Gpu);
             let label = format!("{name} to {target}");
+            if differ > 0 {
+                eprintln!("{label}: {differ} ranks differ from the CPU's on this device");
+                assert_eq!(rg.stop_reason, rc.stop_reason, "{label}");
+                continue;
+            }
             let (cc, cg) = (rc.clustering.unwrap(), rg.clustering.unwrap());
             assert_eq!(cg.cell_size, cc.cell_size, "{label}: radius");
             assert_eq!(cg.centre_rounds, cc.centre_rounds, "{label}: rounds");
@@ -442,10 +535,18 @@ fn simplify_floating_on_the_gpu_writes_the_cpu_parallel_faces() {
                 .positions
                 .iter()
                 .zip(&gpu.positions)
-                .map(|(a, b)| (0..3).map(|i| (a[i] - b[i]) as f64).map(|x| x * x).sum::<f64>())
+                .map(|(a, b)| {
+                    (0..3)
+                        .map(|i| (a[i] - b[i]) as f64)
+                        .map(|x| x * x)
+                        .sum::<f64>()
+                })
                 .fold(0f64, f64::max)
                 .sqrt();
-            eprintln!("{label}: same faces; vertices at most {:.2e} r apart", worst / r);
+            eprintln!(
+                "{label}: same faces; vertices at most {:.2e} r apart",
+                worst / r
+            );
             for (a, b) in cpu.positions.iter().zip(&gpu.positions) {
                 let d = (0..3)
                     .map(|i| (a[i] - b[i]) as f64)

@@ -414,7 +414,28 @@ mod tests {
             .iter()
             .find(|(_, t)| t.name.as_deref() == Some("FloatParams"))
             .expect("no struct FloatParams in floating.wgsl");
-        assert_eq!(ty.inner.size(module.to_ctx()) as usize, size_of::<FloatParams>());
+        assert_eq!(
+            ty.inner.size(module.to_ctx()) as usize,
+            size_of::<FloatParams>()
+        );
+    }
+
+    /// The floating cells' radius spread (shaders/floating.wgsl) against its Rust twin: the
+    /// radii must be the CPU's to the bit, or a claim at the edge of a ball differs.
+    #[test]
+    fn floating_constants_match_their_rust_twins() {
+        let module = parse("fc_decide", stage_source("fc_decide").unwrap());
+        let (_, c) = module
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some("JITTER"))
+            .expect("no const JITTER in floating.wgsl");
+        match module.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::F32(v)) => {
+                assert_eq!(v.to_bits(), crate::cluster::floating::JITTER.to_bits())
+            }
+            ref e => panic!("const JITTER is not an f32 literal: {e:?}"),
+        }
     }
 
     /// The constants of shaders/cluster.wgsl against their Rust twins.
