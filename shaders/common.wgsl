@@ -121,6 +121,12 @@ fn tie_rank(e: u32) -> u32 {
     return x ^ (x >> 16u);
 }
 
+// a·b in cpu::common::dot's order (x, then y, then z): WGSL's dot leaves the order to the driver,
+// and the floating cells compare these sums against radii where an ulp decides.
+fn dot3(a: vec3<f32>, b: vec3<f32>) -> f32 {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
 fn quadric_from_plane(n: vec3<f32>, d: f32, w: f32) -> Quadric {
     return Quadric(
         vec4<f32>(w * n.x * n.x, w * n.x * n.y, w * n.x * n.z, w * n.y * n.y),

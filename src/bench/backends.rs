@@ -77,6 +77,17 @@ pub static BACKENDS: &[BenchBackend] = &[
         band: crate::cluster::BAND,
     },
     BenchBackend {
+        name: "floating-cell-gpu",
+        about: "meshslim's floating-cell vertex clustering as WGSL compute passes (wgpu)",
+        simplify: |m, faces| {
+            let mut o = with_method(faces, crate::Method::FloatingCell);
+            o.backend = crate::Backend::Gpu;
+            Ok(crate::simplify(m, &o)?.0)
+        },
+        device: gpu_name,
+        band: crate::cluster::BAND,
+    },
+    BenchBackend {
         name: "hybrid",
         about: "meshslim's clustering to 2x the target + 20k faces, then the rounds (cpu-parallel)",
         simplify: |m, faces| Ok(crate::simplify(m, &with_method(faces, crate::Method::Hybrid))?.0),

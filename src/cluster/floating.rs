@@ -6,7 +6,8 @@
 //! binary search). Two centres of one round are then more than twice the radius apart, so
 //! their claims never meet, and the rounds pick the centres the sequential greedy picks
 //! (tests/cluster.rs checks it). Each centre's radius is the nominal one spread by ±10%
-//! ([`radius`]); "within twice the radius" is then within the sum of the two radii.
+//! ([`radius`]); "within twice the radius" is then within the sum of the two radii. On the gpu
+//! backend the same rounds run as WGSL stages (`floating_gpu.rs`, twins in `floating_twins.rs`).
 
 use super::grid::Grid;
 use super::stages::{self, Csr, Placed};
@@ -15,66 +16,86 @@ use super::{
     tally,
 };
 use crate::cpu::common::{V3, dot, length, sub, tie_rank, xyz};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::mesh::morton::morton3;
-use crate::options::{Method, SimplifyOptions, SimplifyReport};
+use crate::options::{Backend, Method, SimplifyOptions, SimplifyReport};
 use rayon::prelude::*;
 use std::time::Instant;
 
-/// Low & Tan's grade: `cos(θ/2)` for the widest angle θ between two edges at the vertex (a
-/// flat or straight-through vertex has θ near 180° and grades near 0, a tip or a crease
-/// corner grades high), times the longest edge there (a vertex among large faces stands for
-/// more surface). Gathered over the vertex's faces.
+/// Low & Tan's grade of every vertex ([`grade`]).
 pub fn grades(positions: &[[f32; 4]], faces: &[[u32; 3]], csr: &Csr) -> Vec<f32> {
     (0..positions.len() as u32)
         .into_par_iter()
         .with_min_len(1024)
         .map_init(Vec::new, |dirs: &mut Vec<V3>, v| {
-            let pv = xyz(positions[v as usize]);
-            dirs.clear();
-            let mut longest = 0.0f32;
-            for &f in csr.faces_of(v) {
-                for u in faces[f as usize] {
-                    if u == v {
-                        continue;
-                    }
-                    let e = sub(xyz(positions[u as usize]), pv);
-                    let l = length(e);
-                    if l > 0.0 {
-                        longest = longest.max(l);
-                        dirs.push([e[0] / l, e[1] / l, e[2] / l]);
-                    }
-                }
-            }
-            // The widest angle has the least cosine.
-            let mut least = 1.0f32;
-            for i in 0..dirs.len() {
-                for j in i + 1..dirs.len() {
-                    least = least.min(dot(dirs[i], dirs[j]));
-                }
-            }
-            // cos(θ/2) = sqrt((1 + cos θ) / 2).
-            ((1.0 + least.clamp(-1.0, 1.0)) * 0.5).sqrt() * longest
+            grade(positions, faces, csr.faces_of(v), v, dirs)
         })
         .collect()
 }
 
-/// Each vertex's rank, all distinct: the grade's top bits (a non-negative f32 orders as its
-/// bits), then a hash of the id to break ties among equal grades without a monotone id wave
-/// (as the rounds' `tie_rank`), then the id.
+/// Low & Tan's grade of `v`, whose faces are `list`: `cos(θ/2)` for the widest angle θ between
+/// two edges at the vertex (a flat or straight-through vertex has θ near 180° and grades near
+/// 0, a tip or a crease corner grades high), times the longest edge there (a vertex among large
+/// faces stands for more surface). `dirs` is scratch. The twin of shaders/fc_grades.wgsl, which
+/// recomputes each direction per pair instead of keeping the list (the same values; min and
+/// max do not depend on the order).
+pub fn grade(
+    positions: &[[f32; 4]],
+    faces: &[[u32; 3]],
+    list: &[u32],
+    v: u32,
+    dirs: &mut Vec<V3>,
+) -> f32 {
+    let pv = xyz(positions[v as usize]);
+    dirs.clear();
+    let mut longest = 0.0f32;
+    for &f in list {
+        for u in faces[f as usize] {
+            if u == v {
+                continue;
+            }
+            let e = sub(xyz(positions[u as usize]), pv);
+            let l = length(e);
+            if l > 0.0 {
+                longest = longest.max(l);
+                dirs.push([e[0] / l, e[1] / l, e[2] / l]);
+            }
+        }
+    }
+    // The widest angle has the least cosine.
+    let mut least = 1.0f32;
+    for i in 0..dirs.len() {
+        for j in i + 1..dirs.len() {
+            least = least.min(dot(dirs[i], dirs[j]));
+        }
+    }
+    // cos(θ/2) = sqrt((1 + cos θ) / 2).
+    ((1.0 + least.clamp(-1.0, 1.0)) * 0.5).sqrt() * longest
+}
+
+/// Each vertex's rank ([`rank`]).
 pub fn ranks(grades: &[f32]) -> Vec<u64> {
     grades
         .par_iter()
         .enumerate()
-        .map(|(v, g)| {
-            let g = g.max(0.0).to_bits() >> 8;
-            ((g as u64) << 40) | ((tie_rank(v as u32) as u64 & 0xff) << 32) | v as u64
-        })
+        .map(|(v, &g)| rank(g, v as u32))
         .collect()
 }
 
-const UNCLAIMED: u32 = u32::MAX;
+/// The rank of vertex `v` of grade `g`, all distinct: the grade's top bits (a non-negative f32
+/// orders as its bits), then a hash of the id to break ties among equal grades without a
+/// monotone id wave (as the rounds' `tie_rank`), then the id. The GPU keeps the top word
+/// (`fc_rank`) and compares the id beside it.
+#[inline]
+pub fn rank(g: f32, v: u32) -> u64 {
+    let g = g.max(0.0).to_bits() >> 8;
+    ((g as u64) << 40) | ((tie_rank(v) as u64 & 0xff) << 32) | v as u64
+}
+
+/// A vertex no centre has claimed yet (`fc_centre`). Keep in sync with `UNCLAIMED` in
+/// shaders/cluster.wgsl.
+pub const UNCLAIMED: u32 = u32::MAX;
 
 /// Centres' radii spread over ±[`JITTER`]/2 about the nominal radius, by a hash of the centre:
 /// with one radius for all, a regular mesh's count jumps as the radius crosses a spacing of
@@ -87,6 +108,33 @@ pub const JITTER: f32 = 0.2;
 pub fn radius(r: f32, v: u32) -> f32 {
     let u = tie_rank(v ^ 0x9e37_79b9) as f32 / u32::MAX as f32;
     r * (1.0 + JITTER * (u - 0.5))
+}
+
+/// The hash grid of the rounds at nominal radius `r`: cells twice the largest radius wide, so
+/// two vertices within the sum of their radii lie in neighbouring cells.
+pub fn hash_grid(lo: V3, hi: V3, r: f32) -> Grid {
+    let r_max = r * (1.0 + 0.5 * JITTER);
+    Grid::new(lo, hi, 2.0 * r_max)
+}
+
+/// The cells around `p`'s (3×3×3) present in `keys` (sorted, each once), as ranges of members
+/// (`start[i]..start[i + 1]` for cell `i`), nearest first, and how many there are.
+pub fn cells_around(grid: &Grid, keys: &[u32], start: &[u32], p: V3) -> ([(u32, u32); 27], usize) {
+    let c = grid.coords(p);
+    let mut out = [(0u32, 0u32); 27];
+    let mut k = 0;
+    for d in AROUND {
+        let q = [0, 1, 2].map(|i| c[i] as i32 + d[i]);
+        if (0..3).any(|i| q[i] < 0 || q[i] >= grid.dims[i] as i32) {
+            continue;
+        }
+        let key = morton3(q[0] as u32, q[1] as u32, q[2] as u32);
+        if let Ok(i) = keys.binary_search(&key) {
+            out[k] = (start[i], start[i + 1]);
+            k += 1;
+        }
+    }
+    (out, k)
 }
 
 /// The 3×3×3 cells around a cell, nearest first: the vertex's own cell most often holds a
@@ -122,8 +170,7 @@ pub fn claim(
 ) -> (Vec<u32>, usize) {
     let n = positions.len();
     // Two centres are independent beyond the sum of their radii, at most twice the largest.
-    let r_max = r * (1.0 + 0.5 * JITTER);
-    let grid = Grid::new(lo, hi, 2.0 * r_max);
+    let grid = hash_grid(lo, hi, r);
     let keys = stages::cell_keys(&grid, positions, &vec![false; n]);
     let (sorted, members) = stages::radix_sort(&keys);
     let mut cells = stages::cell_ranges(&sorted, members);
@@ -138,23 +185,7 @@ pub fn claim(
         .collect();
     let mut live: Vec<u32> = (0..n as u32).filter(|&v| !locked[v as usize]).collect();
     // The cells around `p` (3×3×3), as ranges of `cells.members`.
-    let around = |start: &[u32], p: V3| {
-        let c = grid.coords(p);
-        let mut out = [(0u32, 0u32); 27];
-        let mut k = 0;
-        for d in AROUND {
-            let q = [0, 1, 2].map(|i| c[i] as i32 + d[i]);
-            if (0..3).any(|i| q[i] < 0 || q[i] >= grid.dims[i] as i32) {
-                continue;
-            }
-            let key = morton3(q[0] as u32, q[1] as u32, q[2] as u32);
-            if let Ok(i) = cells.key.binary_search(&key) {
-                out[k] = (start[i], start[i + 1]);
-                k += 1;
-            }
-        }
-        (out, k)
-    };
+    let around = |start: &[u32], p: V3| cells_around(&grid, &cells.key, start, p);
     let mut rounds = 0;
     while !live.is_empty() {
         rounds += 1;
@@ -246,9 +277,24 @@ pub fn clusters_of(centre: &[u32]) -> (Vec<u32>, usize) {
     (centre.iter().map(|&c| id[c as usize]).collect(), n as usize)
 }
 
-/// One floating-cell clustering at radius `r`, and the rounds its centres took.
-fn build_floating(work: &Work, ranks: &[u64], r: f32) -> (Built, usize) {
+/// One floating-cell clustering at radius `r`, and the rounds its centres took: on the device
+/// when the work has one (the same stages, `floating_gpu.rs`), else here.
+fn build_floating(work: &Work, ranks: &[u64], r: f32) -> Result<(Built, usize)> {
     let pts = work.pts;
+    if let Some(g) = &work.gpu {
+        let (b, rounds) = g
+            .lock()
+            .map_err(|_| Error::Internal("the GPU clustering lock is poisoned".into()))?
+            .build_floating(pts.lo, pts.hi, r)?;
+        let built = Built {
+            placed: b.placed,
+            faces: b.faces,
+            vertex_cluster: b.vertex_cluster,
+            clusters: b.clusters,
+            cells: b.cells,
+        };
+        return Ok((built, rounds));
+    }
     let (centre, rounds) = claim(&pts.positions, ranks, &work.locked, pts.lo, pts.hi, r);
     let (vertex_cluster, n) = clusters_of(&centre);
     let centres: Vec<u32> = (0..centre.len() as u32)
@@ -287,7 +333,7 @@ fn build_floating(work: &Work, ranks: &[u64], r: f32) -> (Built, usize) {
         clusters: n,
         cells: n,
     };
-    (built, rounds)
+    Ok((built, rounds))
 }
 
 /// `--method floating-cell`.
@@ -299,8 +345,19 @@ pub fn simplify_floating(
     let backend = check_backend(opts)?;
     let t = Instant::now();
     let mut pts = Points::new(mesh);
-    let work = prepare(&mut pts, opts, false)?;
-    let ranks = {
+    let mut work = prepare(&mut pts, opts, false)?;
+    // On the GPU the mesh and its buffers stay on the device between the search's builds, and
+    // the ranks are made there on the first.
+    let ranks = if backend == Backend::Gpu {
+        let g = super::gpu::GpuClusterMesh::new(
+            super::gpu::shared()?,
+            &work.pts.positions,
+            &work.pts.faces,
+            &work.locked,
+        )?;
+        work.gpu = Some(std::sync::Mutex::new(g));
+        Vec::new()
+    } else {
         let csr = Csr::new(work.pts.positions.len(), &work.pts.faces);
         ranks(&grades(&work.pts.positions, &work.pts.faces, &csr))
     };
@@ -319,7 +376,7 @@ pub fn simplify_floating(
         .map(|e| e / ((1.0 + 3f64.sqrt()) * (1.0 + 0.5 * JITTER as f64)));
     let mut rounds = 0;
     let (r, built, stop) = land(target, None, first, None, cap, &mut report, &mut |r| {
-        let (b, n) = build_floating(&work, &ranks, r as f32);
+        let (b, n) = build_floating(&work, &ranks, r as f32)?;
         rounds = n;
         Ok((r as f32 as f64, b))
     })?;

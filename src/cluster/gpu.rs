@@ -28,8 +28,8 @@ const MAX_PASSES: usize = 4;
 
 /// The clustering stages' pipelines, made once per device.
 pub struct GpuClusterer {
-    device: wgpu::Device,
-    queue: wgpu::Queue,
+    pub(super) device: wgpu::Device,
+    pub(super) queue: wgpu::Queue,
     pipelines: HashMap<&'static str, wgpu::ComputePipeline>,
     max_workgroups: u32,
     /// Seconds spent compiling the shaders.
@@ -37,7 +37,7 @@ pub struct GpuClusterer {
 }
 
 /// Waits for an error scope and turns what it caught into an error.
-fn check(scope: wgpu::ErrorScopeGuard, doing: &str) -> Result<()> {
+pub(super) fn check(scope: wgpu::ErrorScopeGuard, doing: &str) -> Result<()> {
     match pollster::block_on(scope.pop()) {
         Some(e) => Err(Error::Gpu(format!("{doing}: {e}"))),
         None => Ok(()),
@@ -140,11 +140,11 @@ pub enum Part {
 /// The mesh on the GPU with its vertex→face lists and face planes, and every working buffer of
 /// a build.
 pub struct GpuClusterMesh<'a> {
-    sim: &'a GpuClusterer,
-    nv: usize,
+    pub(super) sim: &'a GpuClusterer,
+    pub(super) nv: usize,
     nf: usize,
     any_locked: bool,
-    cluster: ClusterParams,
+    pub(super) cluster: ClusterParams,
     /// The half holding the sort's current keys and values.
     cur: usize,
     /// The radix pass a [`CBuf::Radix`] binding takes.
@@ -152,7 +152,16 @@ pub struct GpuClusterMesh<'a> {
     halves: [[wgpu::Buffer; 2]; 2],
     radix: Vec<wgpu::Buffer>,
     scans: [wgpu::Buffer; 3],
-    bufs: HashMap<CBuf, wgpu::Buffer>,
+    /// The build's buffers; the floating cells' are added on their first build
+    /// (`floating_gpu.rs`).
+    pub(super) bufs: HashMap<CBuf, wgpu::Buffer>,
+    /// The floating cells' uniforms, one per round slot ([`CBuf::Floating`]), empty until their
+    /// first build.
+    pub(super) floats: Vec<wgpu::Buffer>,
+    /// The round slot a [`CBuf::Floating`] binding takes.
+    pub(super) slot: usize,
+    /// Whether the floating cells' rank order has been sorted (once per mesh).
+    pub(super) ranked: bool,
     /// The last build's cells and kept faces, and its grid.
     built: Option<(u32, u32)>,
     grid: Option<Grid>,
@@ -281,6 +290,9 @@ impl<'a> GpuClusterMesh<'a> {
             bufs,
             built: None,
             grid: None,
+            floats: Vec::new(),
+            slot: 0,
+            ranked: false,
             setup_seconds: 0.0,
         };
         let mut enc = dev.create_command_encoder(&Default::default());
@@ -301,13 +313,18 @@ impl<'a> GpuClusterMesh<'a> {
             .write_buffer(c, 0, bytemuck::bytes_of(&self.cluster));
     }
 
+    /// The uniform of the current grid (the twins take it).
+    pub fn cluster_params(&self) -> ClusterParams {
+        self.cluster
+    }
+
     /// Radix passes the current grid's keys need.
     pub fn passes(&self) -> u32 {
         twins::radix_passes(&self.cluster, self.any_locked)
     }
 
     /// Records `part` into `enc`.
-    fn record_part(&mut self, enc: &mut wgpu::CommandEncoder, part: Part) {
+    pub(super) fn record_part(&mut self, enc: &mut wgpu::CommandEncoder, part: Part) {
         match part {
             Part::Keys => self.record(enc, sched::KEYS),
             Part::SortPass(p) => {
@@ -348,7 +365,7 @@ impl<'a> GpuClusterMesh<'a> {
         check(scope, "running clustering steps")
     }
 
-    fn wait(&self) -> Result<()> {
+    pub(super) fn wait(&self) -> Result<()> {
         self.sim
             .device
             .poll(wgpu::PollType::wait_indefinitely())
@@ -377,13 +394,23 @@ impl<'a> GpuClusterMesh<'a> {
             self.record_part(&mut enc, part);
         }
         self.sim.queue.submit([enc.finish()]);
+        let b = self.read_build()?;
+        self.grid = Some(*grid);
+        check(scope, "clustering on the GPU")?;
+        Ok(b)
+    }
+
+    /// The result of the build just submitted: the counts, then the clusters, the faces and
+    /// each vertex's cluster.
+    pub(super) fn read_build(&mut self) -> Result<ClusterBuild> {
         let (nv, nf) = (self.nv as u64, self.nf as u64);
         let counts = self.read_many(&[(CBuf::CellHead, 4 * nv, 4), (CBuf::FaceKeep, 4 * nf, 4)])?;
         let cells = u32::from_le_bytes(counts[0][..4].try_into().unwrap_or_default()) as u64;
         let kept = u32::from_le_bytes(counts[1][..4].try_into().unwrap_or_default()) as u64;
         assert!(cells <= nv && kept <= nf, "counts within their buffers");
+        // The grid is the uniform build's to set (a floating build has none).
         self.built = Some((cells as u32, kept as u32));
-        self.grid = Some(*grid);
+        self.grid = None;
         let data = self.read_many(&[
             (CBuf::ClusterPlaced, 0, 32 * cells),
             (CBuf::ClusterQuadric, 0, 48 * cells),
@@ -391,7 +418,6 @@ impl<'a> GpuClusterMesh<'a> {
             (CBuf::FaceOrigin, 0, 4 * kept),
             (CBuf::VertexCell, 0, 4 * nv),
         ])?;
-        check(scope, "clustering on the GPU")?;
         let pod = |i: usize| -> &[u8] { &data[i] };
         Ok(ClusterBuild::from_buffers(
             &bytemuck::pod_collect_to_vec::<u8, ClusterPlaced>(pod(0)),
@@ -451,6 +477,7 @@ impl<'a> GpuClusterMesh<'a> {
             CBuf::SortKeysOut => &self.halves[1 - self.cur][0],
             CBuf::SortValsOut => &self.halves[1 - self.cur][1],
             CBuf::Radix => &self.radix[self.pass],
+            CBuf::Floating => &self.floats[self.slot],
             CBuf::ScanCount => match scan.map(|s| s.0) {
                 Some(CCount::Faces) => &self.scans[1],
                 Some(CCount::Digits) => &self.scans[2],
@@ -464,10 +491,14 @@ impl<'a> GpuClusterMesh<'a> {
         }
     }
 
-    fn record(&mut self, enc: &mut wgpu::CommandEncoder, steps: &[CStep]) {
+    pub(super) fn record(&mut self, enc: &mut wgpu::CommandEncoder, steps: &[CStep]) {
         for step in steps {
             match *step {
                 CStep::Clear(buf) => enc.clear_buffer(self.buffer(buf, None), 0, None),
+                CStep::CopyBuffer(from, to) => {
+                    let (from, to) = (self.buffer(from, None), self.buffer(to, None));
+                    enc.copy_buffer_to_buffer(from, 0, to, 0, from.size().min(to.size()));
+                }
                 CStep::Run(stage) => self.dispatch(enc, stage, None),
                 CStep::PrefixSum { count, data } => {
                     for stage in [
@@ -545,7 +576,7 @@ impl<'a> GpuClusterMesh<'a> {
     }
 
     /// `(buffer, byte offset, bytes)` ranges read back through one staging buffer, one wait.
-    fn read_many(&self, ranges: &[(CBuf, u64, u64)]) -> Result<Vec<Vec<u8>>> {
+    pub(super) fn read_many(&self, ranges: &[(CBuf, u64, u64)]) -> Result<Vec<Vec<u8>>> {
         let dev = &self.sim.device;
         let total: u64 = ranges.iter().map(|r| r.2.next_multiple_of(4)).sum();
         let staging = dev.create_buffer(&wgpu::BufferDescriptor {

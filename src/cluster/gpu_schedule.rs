@@ -5,6 +5,11 @@
 //! named after them, and a test checks every description against its WGSL through naga. The
 //! rounds' `Buf` has no room for the sort's halves and the clusters' buffers, hence this
 //! schedule of its own, with the prefix sum and adjacency stages described again on its buffers.
+//!
+//! The floating cells (`fc_*`, Low & Tan 1997) reuse the build's parts: the radix sort orders
+//! the vertices by rank once per mesh, then per build into the cells of a hash grid (by cell,
+//! then rank) and, after the rounds, by cluster; the cells part finds the ranges each time, and
+//! the faces part is the uniform grid's.
 
 use crate::parallel::schedule::Access;
 
@@ -51,6 +56,18 @@ pub enum CBuf {
     FaceOrigin,
     /// The clusters' vertices as a renderer's vertex buffer ([`crate::gpu::GpuMesh`]).
     MeshPositions,
+    /// [`crate::gpu::types::FloatParams`] (uniform, one buffer per round slot).
+    Floating,
+    FcGrade,
+    FcRank,
+    /// The vertices by rank, highest first: the sorted values of the rank sort, kept.
+    FcOrder,
+    FcCentre,
+    FcDecided,
+    /// 1 per centre, then scanned: the centres' numbers.
+    FcHead,
+    /// Per round slot of a batch: the unclaimed vertices at the round's start.
+    FcLive,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -161,6 +178,37 @@ pub const CLUSTER_FACES_COMPACT: CStage = stage!(cluster_faces_compact in "clust
 pub const CLUSTER_MESH: CStage = stage!(cluster_mesh in "cluster_mesh" over Each(Vertices);
     cluster: Uniform Cluster, cell_head: Read CellHead, cluster_placed: Read ClusterPlaced,
     mesh_positions: ReadWrite MeshPositions);
+pub const FC_GRADES: CStage = stage!(fc_grades in "fc_grades" over Each(Vertices);
+    params: Uniform Params, positions: Read Positions, indices: Read Indices,
+    offsets: Read Offsets, vertex_faces: Read VertexFaces, fc_grade: ReadWrite FcGrade);
+pub const FC_RANKS: CStage = stage!(fc_ranks in "fc_ranks" over Each(Vertices);
+    params: Uniform Params, fc_grade: Read FcGrade, fc_rank: ReadWrite FcRank,
+    sort_keys: ReadWrite SortKeys, sort_vals: ReadWrite SortVals);
+pub const FC_KEYS: CStage = stage!(fc_keys in "fc_keys" over Each(Vertices);
+    cluster: Uniform Cluster, positions: Read Positions, fc_order: Read FcOrder,
+    sort_keys: ReadWrite SortKeys, sort_vals: ReadWrite SortVals);
+pub const FC_INIT: CStage = stage!(fc_init in "fc_init" over Each(Vertices);
+    cluster: Uniform Cluster, locked: Read Locked, fc_centre: ReadWrite FcCentre,
+    fc_head: ReadWrite FcHead);
+pub const FC_DECIDE: CStage = stage!(fc_decide in "fc_decide" over Each(Vertices);
+    cluster: Uniform Cluster, floating: Uniform Floating, positions: Read Positions,
+    fc_rank: Read FcRank, sort_vals: Read SortVals, cell_head: Read CellHead,
+    cell_start: Read CellStart, cell_key: Read CellKey, fc_centre: Read FcCentre,
+    fc_decided: ReadWrite FcDecided, fc_live: ReadWrite FcLive);
+pub const FC_CLAIM: CStage = stage!(fc_claim in "fc_claim" over Each(Vertices);
+    cluster: Uniform Cluster, floating: Uniform Floating, positions: Read Positions,
+    sort_vals: Read SortVals, cell_head: Read CellHead, cell_start: Read CellStart,
+    cell_key: Read CellKey, fc_decided: Read FcDecided, fc_centre: ReadWrite FcCentre,
+    fc_head: ReadWrite FcHead);
+pub const FC_CLUSTER_KEYS: CStage = stage!(fc_cluster_keys in "fc_cluster_keys" over Each(Vertices);
+    cluster: Uniform Cluster, fc_centre: Read FcCentre, fc_head: Read FcHead,
+    sort_keys: ReadWrite SortKeys, sort_vals: ReadWrite SortVals);
+pub const FC_QUADRICS: CStage = stage!(fc_quadrics in "fc_quadrics" over Each(Vertices);
+    cluster: Uniform Cluster, floating: Uniform Floating, positions: Read Positions,
+    indices: Read Indices, offsets: Read Offsets, vertex_faces: Read VertexFaces,
+    face_normals: Read FaceNormals, locked: Read Locked, fc_centre: Read FcCentre,
+    sort_vals: Read SortVals, cell_head: Read CellHead, cell_start: Read CellStart,
+    cluster_placed: ReadWrite ClusterPlaced, cluster_quadric: ReadWrite ClusterQuadric);
 
 /// Every stage, each once: the runner makes one pipeline per entry.
 pub const STAGES: &[&CStage] = &[
@@ -182,6 +230,14 @@ pub const STAGES: &[&CStage] = &[
     &CLUSTER_FACES_DEDUPE,
     &CLUSTER_FACES_COMPACT,
     &CLUSTER_MESH,
+    &FC_GRADES,
+    &FC_RANKS,
+    &FC_KEYS,
+    &FC_INIT,
+    &FC_DECIDE,
+    &FC_CLAIM,
+    &FC_CLUSTER_KEYS,
+    &FC_QUADRICS,
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -193,9 +249,11 @@ pub enum CStep {
         count: CCount,
         data: CBuf,
     },
+    /// The whole of one buffer into another of the same size.
+    CopyBuffer(CBuf, CBuf),
 }
 
-use CStep::{Clear, PrefixSum, Run};
+use CStep::{Clear, CopyBuffer, PrefixSum, Run};
 
 /// Once per mesh (the grid does not change them): the vertex→face lists and face planes.
 pub const MESH: &[CStep] = &[
@@ -252,12 +310,52 @@ pub const FACES: &[CStep] = &[
 /// After a build, for a renderer: the clusters' vertices beside the compacted faces.
 pub const DRAWABLE: &[CStep] = &[Run(&CLUSTER_MESH)];
 
+/// Floating cells, once per mesh: each vertex's grade and rank, and the rank sort's keys; then
+/// four [`SORT_PASS`]es (32-bit keys) and [`FLOATING_ORDER`].
+pub const FLOATING_RANKS: &[CStep] = &[Run(&FC_GRADES), Run(&FC_RANKS)];
+/// The vertices by rank, kept from the rank sort (the halves are the builds' again after it).
+pub const FLOATING_ORDER: &[CStep] = &[CopyBuffer(CBuf::SortVals, CBuf::FcOrder)];
+/// Per build: the hash grid's keys in rank order and every vertex unclaimed (a locked one its
+/// own centre); then the [`SORT_PASS`]es and [`CELLS`].
+pub const FLOATING_KEYS: &[CStep] = &[Run(&FC_KEYS), Run(&FC_INIT)];
+/// The start of a batch of rounds: the slots' counters cleared.
+pub const FLOATING_BATCH: &[CStep] = &[Clear(CBuf::FcLive)];
+/// One round: the new centres, then their claims.
+pub const FLOATING_ROUND: &[CStep] = &[Run(&FC_DECIDE), Run(&FC_CLAIM)];
+/// After the rounds: centres numbered in vertex order, every vertex keyed by its cluster; then
+/// the [`SORT_PASS`]es, [`CELLS`] (a cell per cluster, its members in vertex order),
+/// [`FLOATING_QUADRICS`] and [`FACES`].
+pub const FLOATING_CLUSTERS: &[CStep] = &[
+    PrefixSum {
+        count: Vertices,
+        data: CBuf::FcHead,
+    },
+    Run(&FC_CLUSTER_KEYS),
+];
+/// One vertex per floating cell.
+pub const FLOATING_QUADRICS: &[CStep] = &[Run(&FC_QUADRICS)];
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::parallel::schedule::check::{in_house_order, snake_case};
 
-    const PARTS: &[&[CStep]] = &[MESH, KEYS, SORT_PASS, CELLS, QUADRICS, FACES, DRAWABLE];
+    const PARTS: &[&[CStep]] = &[
+        MESH,
+        KEYS,
+        SORT_PASS,
+        CELLS,
+        QUADRICS,
+        FACES,
+        DRAWABLE,
+        FLOATING_RANKS,
+        FLOATING_ORDER,
+        FLOATING_KEYS,
+        FLOATING_BATCH,
+        FLOATING_ROUND,
+        FLOATING_CLUSTERS,
+        FLOATING_QUADRICS,
+    ];
 
     /// Every stage's described bindings against its shader as naga reads it (names, order,
     /// access), in the house order: uniforms, then read-only, then read_write.
@@ -323,7 +421,7 @@ mod tests {
                 steps.iter().any(|step| match step {
                     Run(t) => t.entry == s.entry,
                     PrefixSum { .. } => s.shader == "prefix_sum",
-                    Clear(_) => false,
+                    Clear(_) | CopyBuffer(..) => false,
                 })
             });
             assert!(runs, "{} never runs", s.entry);

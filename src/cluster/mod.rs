@@ -9,6 +9,9 @@
 //! simplifier's do). `qem` keeps seams.
 
 pub mod floating;
+// `floating-cell` on the gpu backend: its stages' twins and its build on `gpu::GpuClusterMesh`.
+pub mod floating_gpu;
+pub mod floating_twins;
 // `cluster` on the gpu backend: the build's stage descriptions, their CPU twins (the GPU's
 // gather order; the CPU driver scatters its quadrics instead) and the GPU driver.
 pub mod gpu;
@@ -618,19 +621,14 @@ fn border_vertices(csr: &Csr, faces: &[[u32; 3]]) -> Vec<bool> {
         .collect()
 }
 
-/// The backend a clustering method runs on: `cluster` and `hybrid` on the GPU when asked
-/// (`auto` takes the CPU: on lavapipe a build is 7-12x slower, docs/PERFORMANCE.md), the others
-/// on the CPU.
+/// The backend a clustering method runs on: the GPU when asked (`auto` takes the CPU: on
+/// lavapipe a build is several times slower, docs/PERFORMANCE.md), else the CPU's cores.
+/// `hybrid`'s clustering runs on the CPU either way; its rounds follow the backend.
 fn check_backend(opts: &SimplifyOptions) -> Result<Backend> {
-    match opts.backend {
-        Backend::Cpu | Backend::CpuParallel | Backend::Auto => Ok(Backend::CpuParallel),
-        Backend::Gpu if matches!(opts.method, Method::Cluster | Method::Hybrid) => Ok(Backend::Gpu),
-        Backend::Gpu => Err(Error::InvalidOption(format!(
-            "--method {} runs on the CPU only so far (backend cpu-parallel); the gpu backend \
-             runs --method qem, cluster and hybrid",
-            opts.method.name()
-        ))),
-    }
+    Ok(match opts.backend {
+        Backend::Gpu => Backend::Gpu,
+        Backend::Cpu | Backend::CpuParallel | Backend::Auto => Backend::CpuParallel,
+    })
 }
 
 /// `--method cluster`.

@@ -191,18 +191,23 @@ pub fn cluster_quadrics(
         };
         let centre = [0, 1, 2].map(|i| 0.5 * (lo[i] + hi[i]));
         let p = stages::cluster_quadric(&surface, members, centre, lo, hi);
-        cluster_placed[k] = ClusterPlaced {
-            pos: [p.pos[0], p.pos[1], p.pos[2], 0.0],
-            attr: p.attr,
-            how: match p.how {
-                Placement::Single => place::SINGLE,
-                Placement::Solve => place::SOLVE,
-                Placement::Member => place::MEMBER,
-                Placement::Centroid => place::CENTROID,
-            },
-            _pad: [0; 2],
-        };
+        cluster_placed[k] = placed_of(&p);
         cluster_quadric[k] = p.quadric;
+    }
+}
+
+/// A cluster's vertex as the GPU writes it (its quadric goes to a buffer beside).
+pub fn placed_of(p: &Placed) -> ClusterPlaced {
+    ClusterPlaced {
+        pos: [p.pos[0], p.pos[1], p.pos[2], 0.0],
+        attr: p.attr,
+        how: match p.how {
+            Placement::Single => place::SINGLE,
+            Placement::Solve => place::SOLVE,
+            Placement::Member => place::MEMBER,
+            Placement::Centroid => place::CENTROID,
+        },
+        _pad: [0; 2],
     }
 }
 
@@ -387,6 +392,121 @@ pub struct CpuBuild {
     pub face_origin: Vec<u32>,
 }
 
+/// The radix passes of a sort of `(keys, vals)`: after each, the scanned digit counts and the
+/// keys and values it wrote.
+pub fn sort(keys: &[u32], vals: &[u32], passes: u32) -> Vec<(Vec<u32>, Vec<u32>, Vec<u32>)> {
+    let n = keys.len();
+    let (mut keys, mut vals) = (keys.to_vec(), vals.to_vec());
+    let mut sums = Vec::new();
+    let mut out = Vec::new();
+    for pass in 0..passes {
+        let r = radix_params(n, pass);
+        let mut counts = vec![0u32; 256 * r.blocks as usize + 1];
+        radix_count(&r, &keys, &mut counts);
+        prefix_sum(256 * r.blocks, &mut counts, &mut sums);
+        let (mut k2, mut v2) = (vec![0u32; n], vec![0u32; n]);
+        radix_scatter(&r, &keys, &vals, &counts, &mut k2, &mut v2);
+        (keys, vals) = (k2, v2);
+        out.push((counts, keys.clone(), vals.clone()));
+    }
+    out
+}
+
+/// `cell_heads`, its prefix sum and `cell_ranges` over sorted keys.
+pub struct CellsOut {
+    /// Scanned: the cell count at `[n]`.
+    pub cell_head: Vec<u32>,
+    pub cell_start: Vec<u32>,
+    pub vertex_cell: Vec<u32>,
+    pub cell_key: Vec<u32>,
+}
+
+pub fn cells(c: &ClusterParams, keys: &[u32], vals: &[u32]) -> CellsOut {
+    let nv = c.vertex_count as usize;
+    let mut cell_head = vec![0u32; nv + 1];
+    cell_heads(c, keys, &mut cell_head);
+    let cells = prefix_sum(nv as u32, &mut cell_head, &mut Vec::new()) as usize;
+    let mut out = CellsOut {
+        cell_head,
+        cell_start: vec![0u32; cells + 1],
+        vertex_cell: vec![0u32; nv],
+        cell_key: vec![0u32; cells],
+    };
+    cell_ranges(
+        c,
+        &out.cell_head,
+        keys,
+        vals,
+        &mut out.cell_start,
+        &mut out.vertex_cell,
+        &mut out.cell_key,
+    );
+    out
+}
+
+/// The faces part (`cluster_faces_mark`, a scan, `_fill`, `_dedupe`, a scan, `_compact`) over
+/// each vertex's cluster.
+#[derive(Default)]
+pub struct FacesOut {
+    pub face_key: Vec<u32>,
+    /// After the dedupe, before its scan.
+    pub face_keep: Vec<u32>,
+    pub bucket_offsets: Vec<u32>,
+    /// After the dedupe.
+    pub bucket_faces: Vec<u32>,
+    pub cluster_faces: Vec<u32>,
+    pub face_origin: Vec<u32>,
+}
+
+pub fn faces(c: &ClusterParams, indices: &[u32], vertex_cell: &[u32]) -> FacesOut {
+    let (nv, nf) = (c.vertex_count as usize, c.face_count as usize);
+    let mut sums = Vec::new();
+    let mut b = FacesOut {
+        face_key: vec![0u32; 3 * nf],
+        face_keep: vec![0u32; nf + 1],
+        bucket_offsets: vec![0u32; nv + 1],
+        ..Default::default()
+    };
+    cluster_faces_mark(
+        c,
+        indices,
+        vertex_cell,
+        &mut b.face_key,
+        &mut b.face_keep,
+        &mut b.bucket_offsets,
+    );
+    let kept = prefix_sum(nv as u32, &mut b.bucket_offsets, &mut sums) as usize;
+    b.bucket_faces = vec![0u32; kept];
+    let mut cursor = vec![0u32; nv];
+    cluster_faces_fill(
+        c,
+        &b.face_key,
+        &b.face_keep,
+        &b.bucket_offsets,
+        &mut cursor,
+        &mut b.bucket_faces,
+    );
+    cluster_faces_dedupe(
+        c,
+        &b.face_key,
+        &b.bucket_offsets,
+        &mut b.bucket_faces,
+        &mut b.face_keep,
+    );
+    let mut scanned = b.face_keep.clone();
+    let out = prefix_sum(nf as u32, &mut scanned, &mut sums) as usize;
+    b.cluster_faces = vec![0u32; 3 * out];
+    b.face_origin = vec![0u32; out];
+    cluster_faces_compact(
+        c,
+        &b.face_key,
+        &scanned,
+        &mut b.cluster_faces,
+        &mut b.face_origin,
+    );
+    b
+}
+
 /// The whole build through the twins, stage by stage.
 pub fn run(positions: &[[f32; 4]], faces: &[[u32; 3]], locked: &[bool], grid: &Grid) -> CpuBuild {
     let (nv, nf) = (positions.len(), faces.len());
@@ -402,34 +522,20 @@ pub fn run(positions: &[[f32; 4]], faces: &[[u32; 3]], locked: &[bool], grid: &G
     let (mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv]);
     cell_keys(&c, positions, &locked, &mut keys, &mut vals);
     b.keys = (keys.clone(), vals.clone());
-    let mut sums = Vec::new();
-    for pass in 0..radix_passes(&c, locked.contains(&1)) {
-        let r = radix_params(nv, pass);
-        let mut counts = vec![0u32; 256 * r.blocks as usize + 1];
-        radix_count(&r, &keys, &mut counts);
-        prefix_sum(256 * r.blocks, &mut counts, &mut sums);
-        let (mut k2, mut v2) = (vec![0u32; nv], vec![0u32; nv]);
-        radix_scatter(&r, &keys, &vals, &counts, &mut k2, &mut v2);
-        (keys, vals) = (k2, v2);
-        b.passes.push((counts, keys.clone(), vals.clone()));
+    b.passes = sort(&keys, &vals, radix_passes(&c, locked.contains(&1)));
+    if let Some((_, k, v)) = b.passes.last() {
+        (keys, vals) = (k.clone(), v.clone());
     }
-    b.cell_head = vec![0u32; nv + 1];
-    cell_heads(&c, &keys, &mut b.cell_head);
-    let cells = prefix_sum(nv as u32, &mut b.cell_head, &mut sums) as usize;
-    b.cell_start = vec![0u32; cells + 1];
-    b.vertex_cell = vec![0u32; nv];
-    b.cell_key = vec![0u32; cells];
-    cell_ranges(
-        &c,
-        &b.cell_head,
-        &keys,
-        &vals,
-        &mut b.cell_start,
-        &mut b.vertex_cell,
-        &mut b.cell_key,
+    let cells = self::cells(&c, &keys, &vals);
+    (b.cell_head, b.cell_start, b.vertex_cell, b.cell_key) = (
+        cells.cell_head,
+        cells.cell_start,
+        cells.vertex_cell,
+        cells.cell_key,
     );
-    b.cluster_placed = vec![ClusterPlaced::default(); cells];
-    b.cluster_quadric = vec![Quadric::default(); cells];
+    let n = b.cell_key.len();
+    b.cluster_placed = vec![ClusterPlaced::default(); n];
+    b.cluster_quadric = vec![Quadric::default(); n];
     cluster_quadrics(
         &c,
         positions,
@@ -444,46 +550,10 @@ pub fn run(positions: &[[f32; 4]], faces: &[[u32; 3]], locked: &[bool], grid: &G
         &mut b.cluster_placed,
         &mut b.cluster_quadric,
     );
-    b.face_key = vec![0u32; 3 * nf];
-    b.face_keep = vec![0u32; nf + 1];
-    b.bucket_offsets = vec![0u32; nv + 1];
-    cluster_faces_mark(
-        &c,
-        indices,
-        &b.vertex_cell,
-        &mut b.face_key,
-        &mut b.face_keep,
-        &mut b.bucket_offsets,
-    );
-    let kept = prefix_sum(nv as u32, &mut b.bucket_offsets, &mut sums) as usize;
-    b.bucket_faces = vec![0u32; kept];
-    let mut cursor = vec![0u32; nv];
-    cluster_faces_fill(
-        &c,
-        &b.face_key,
-        &b.face_keep,
-        &b.bucket_offsets,
-        &mut cursor,
-        &mut b.bucket_faces,
-    );
-    cluster_faces_dedupe(
-        &c,
-        &b.face_key,
-        &b.bucket_offsets,
-        &mut b.bucket_faces,
-        &mut b.face_keep,
-    );
-    let mut scanned = b.face_keep.clone();
-    let out = prefix_sum(nf as u32, &mut scanned, &mut sums) as usize;
-    b.cluster_faces = vec![0u32; 3 * out];
-    b.face_origin = vec![0u32; out];
-    cluster_faces_compact(
-        &c,
-        &b.face_key,
-        &scanned,
-        &mut b.cluster_faces,
-        &mut b.face_origin,
-    );
+    let f = self::faces(&c, indices, &b.vertex_cell);
+    (b.face_key, b.face_keep, b.bucket_offsets, b.bucket_faces) =
+        (f.face_key, f.face_keep, f.bucket_offsets, f.bucket_faces);
+    (b.cluster_faces, b.face_origin) = (f.cluster_faces, f.face_origin);
     (b.offsets, b.vertex_faces) = (csr.offsets, csr.vertex_faces);
     b
 }

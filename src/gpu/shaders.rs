@@ -121,6 +121,21 @@ pub const SOURCES: &[(&str, &str)] = &[
         "cluster_mesh",
         include_str!("../../shaders/cluster_mesh.wgsl"),
     ),
+    // The floating cells' build (also described in src/cluster/gpu_schedule.rs).
+    ("fc_grades", include_str!("../../shaders/fc_grades.wgsl")),
+    ("fc_ranks", include_str!("../../shaders/fc_ranks.wgsl")),
+    ("fc_keys", include_str!("../../shaders/fc_keys.wgsl")),
+    ("fc_init", include_str!("../../shaders/fc_init.wgsl")),
+    ("fc_decide", include_str!("../../shaders/fc_decide.wgsl")),
+    ("fc_claim", include_str!("../../shaders/fc_claim.wgsl")),
+    (
+        "fc_cluster_keys",
+        include_str!("../../shaders/fc_cluster_keys.wgsl"),
+    ),
+    (
+        "fc_quadrics",
+        include_str!("../../shaders/fc_quadrics.wgsl"),
+    ),
 ];
 
 /// The source of `shaders/<stem>.wgsl`.
@@ -140,9 +155,15 @@ pub const SEAMS: &str = include_str!("../../shaders/seams.wgsl");
 /// The clustering stages' structs and constants, for the stages that bind `ClusterParams` or
 /// `RadixParams`.
 pub const CLUSTER: &str = include_str!("../../shaders/cluster.wgsl");
+/// The floating cells' uniform and helpers, for the stages that bind `FloatParams`.
+pub const FLOATING: &str = include_str!("../../shaders/floating.wgsl");
+/// The floating cells' hash-grid search, for those of them that also bind `cell_key`.
+pub const FLOATING_CELLS: &str = include_str!("../../shaders/floating_cells.wgsl");
+/// A cluster's gather and placement, for the stages that bind `cluster_placed`.
+pub const PLACE: &str = include_str!("../../shaders/place.wgsl");
 
-/// The full source of a stage: the common definitions, the mesh and seam accessors when the
-/// stage binds the buffers they read, then the stage.
+/// The full source of a stage: the common definitions, the clustering, floating-cell, mesh,
+/// seam and placement helpers when the stage binds the buffers they read, then the stage.
 pub fn source(stage_source: &str) -> String {
     let binds = |var: &str| {
         ["read", "read_write"]
@@ -153,11 +174,21 @@ pub fn source(stage_source: &str) -> String {
     if stage_source.contains(": ClusterParams;") || stage_source.contains(": RadixParams;") {
         src = format!("{src}\n{CLUSTER}");
     }
+    if stage_source.contains(": FloatParams;") {
+        src = format!("{src}\n{FLOATING}");
+        if binds("cell_key") {
+            src = format!("{src}\n{FLOATING_CELLS}");
+        }
+    }
     if binds("indices") && binds("vertex_faces") {
         src = format!("{src}\n{MESH}");
         if binds("face_extra") {
             src = format!("{src}\n{SEAMS}");
         }
+    }
+    // The placement, for the stages that place clusters (not those that only read them).
+    if stage_source.contains("var<storage, read_write> cluster_placed:") {
+        src = format!("{src}\n{PLACE}");
     }
     format!("{src}\n{stage_source}")
 }
@@ -280,7 +311,16 @@ mod tests {
             let name = entry.file_name().into_string().unwrap();
             let stem = name.trim_end_matches(".wgsl");
             assert!(
-                ["common", "mesh", "seams", "cluster"].contains(&stem)
+                [
+                    "common",
+                    "mesh",
+                    "seams",
+                    "cluster",
+                    "floating",
+                    "floating_cells",
+                    "place"
+                ]
+                .contains(&stem)
                     || stage_source(stem).is_some(),
                 "shaders/{name} is not listed in SOURCES"
             );
@@ -373,6 +413,34 @@ mod tests {
         assert_eq!(size("ClusterParams"), size_of::<ClusterParams>());
         assert_eq!(size("RadixParams"), size_of::<RadixParams>());
         assert_eq!(size("ClusterPlaced"), size_of::<ClusterPlaced>());
+        let module = parse("fc_quadrics", stage_source("fc_quadrics").unwrap());
+        let (_, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some("FloatParams"))
+            .expect("no struct FloatParams in floating.wgsl");
+        assert_eq!(
+            ty.inner.size(module.to_ctx()) as usize,
+            size_of::<FloatParams>()
+        );
+    }
+
+    /// The floating cells' radius spread (shaders/floating.wgsl) against its Rust twin: the
+    /// radii must be the CPU's to the bit, or a claim at the edge of a ball differs.
+    #[test]
+    fn floating_constants_match_their_rust_twins() {
+        let module = parse("fc_decide", stage_source("fc_decide").unwrap());
+        let (_, c) = module
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some("JITTER"))
+            .expect("no const JITTER in floating.wgsl");
+        match module.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::F32(v)) => {
+                assert_eq!(v.to_bits(), crate::cluster::floating::JITTER.to_bits())
+            }
+            ref e => panic!("const JITTER is not an f32 literal: {e:?}"),
+        }
     }
 
     /// The constants of shaders/cluster.wgsl against their Rust twins.
@@ -395,6 +463,7 @@ mod tests {
         };
         let pairs = [
             ("SINGLETON", crate::cluster::grid::SINGLETON),
+            ("UNCLAIMED", crate::cluster::floating::UNCLAIMED),
             ("SORT_BLOCK", SORT_BLOCK),
             ("PLACE_SINGLE", place::SINGLE),
             ("PLACE_SOLVE", place::SOLVE),

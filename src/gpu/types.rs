@@ -247,3 +247,15 @@ pub struct ClusterPlaced {
     pub how: u32,
     pub _pad: [u32; 2],
 }
+
+/// The floating cells' constants, a uniform (one buffer per round slot, so a batch of rounds is
+/// recorded in one command buffer). Keep in sync with `FloatParams` in shaders/floating.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct FloatParams {
+    /// The nominal radius; each centre's is spread about it (`cluster::floating::radius`).
+    pub r: f32,
+    /// The counter of unclaimed vertices `fc_decide` adds to: the round's place in its batch.
+    pub slot: u32,
+    pub _pad: [u32; 2],
+}

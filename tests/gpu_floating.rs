@@ -1,0 +1,559 @@
+//! `--method floating-cell` on the gpu backend (lavapipe in CI): every floating stage's buffers
+//! against its CPU twin (src/cluster/floating_twins.rs) fed the GPU's own inputs, so integers
+//! must match exactly stage by stage and floats within 1e-4; the whole GPU build against the
+//! twins' chain; and `simplify` on the GPU against cpu-parallel. With CI=true a missing adapter
+//! fails.
+
+mod common;
+
+use common::gpu_context;
+use meshslim::Mesh;
+use meshslim::cluster::floating::{self, UNCLAIMED};
+use meshslim::cluster::floating_gpu::FcPart;
+use meshslim::cluster::floating_twins::{self as ft, ROUND_SLOTS};
+use meshslim::cluster::gpu::{GpuClusterMesh, GpuClusterer, Part};
+use meshslim::cluster::gpu_schedule::CBuf;
+use meshslim::cluster::{stages, twins};
+use meshslim::gpu::types::{ClusterPlaced, Params, Quadric};
+use meshslim::mesh::prepare::{frame_of, normalize};
+
+/// Within `tol` of the larger magnitude, or of `scale` when both are smaller.
+fn close(a: f32, b: f32, tol: f32, scale: f32) -> bool {
+    (a - b).abs() <= tol * a.abs().max(b.abs()).max(scale).max(1e-30)
+}
+
+/// The mesh's positions in the unit-diagonal frame, as the clustering driver makes them, and
+/// their box.
+fn points(m: &Mesh) -> (Vec<[f32; 4]>, [f32; 3], [f32; 3]) {
+    let (center, scale) = frame_of(m);
+    let pos: Vec<[f32; 4]> = m
+        .positions
+        .iter()
+        .map(|&p| {
+            let q = normalize(p, center, scale);
+            [q[0] as f32, q[1] as f32, q[2] as f32, 1.0]
+        })
+        .collect();
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for p in &pos {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    (pos, lo, hi)
+}
+
+/// Meshes, each with the nominal radii (unit-diagonal frame) to build at and whether to lock
+/// every 7th vertex (centres of themselves from the start).
+fn cases() -> Vec<(&'static str, Mesh, Vec<f32>, bool)> {
+    let mut torus = meshslim::mesh::torus(1.0, 0.3, 96, 48);
+    meshslim::mesh::add_noise(&mut torus, 0.002, 7);
+    let mut sphere = meshslim::mesh::icosphere(5);
+    meshslim::mesh::add_noise(&mut sphere, 0.005, 3);
+    vec![
+        ("noisy_icosphere", sphere, vec![0.01, 0.04], false),
+        ("noisy_torus", torus, vec![0.02], false),
+        ("grid", meshslim::mesh::grid(60), vec![0.015, 0.05], false),
+        ("cube", meshslim::mesh::cube(20), vec![0.03], false),
+        (
+            "icosphere_locked",
+            meshslim::mesh::icosphere(4),
+            vec![0.03],
+            true,
+        ),
+    ]
+}
+
+fn locked_of(n: usize, lock: bool) -> Vec<bool> {
+    (0..n).map(|v| lock && v % 7 == 0).collect()
+}
+
+fn rd<T: bytemuck::Pod>(g: &GpuClusterMesh, b: CBuf, n: usize) -> Vec<T> {
+    let bytes = g
+        .read_buffer(b, (n * std::mem::size_of::<T>()) as u64)
+        .unwrap();
+    bytemuck::pod_collect_to_vec(&bytes)
+}
+
+fn check_placed(
+    label: &str,
+    g: &[ClusterPlaced],
+    c: &[ClusterPlaced],
+    gq: &[Quadric],
+    cq: &[Quadric],
+) {
+    assert_eq!(g.len(), c.len(), "{label}: clusters");
+    for k in 0..g.len() {
+        let (a, b) = (g[k], c[k]);
+        assert!(
+            (0..3).all(|i| close(a.pos[i], b.pos[i], 1e-4, 1e-3)),
+            "{label}: cluster {k} at {:?} on the GPU, {:?} on the CPU",
+            a.pos,
+            b.pos
+        );
+        assert_eq!(
+            (a.attr, a.how),
+            (b.attr, b.how),
+            "{label}: cluster {k}'s placement"
+        );
+        let scale = cq[k].q.iter().flatten().fold(0f32, |m, x| m.max(x.abs()));
+        let flat = |q: &Quadric| q.q.iter().flatten().copied().collect::<Vec<f32>>();
+        let (fa, fb) = (flat(&gq[k]), flat(&cq[k]));
+        assert!(
+            fa.iter().zip(&fb).all(|(&x, &y)| close(x, y, 1e-4, scale)),
+            "{label}: cluster {k}'s quadric {fa:?} on the GPU, {fb:?} on the CPU"
+        );
+    }
+}
+
+/// Runs the sort passes `0..passes` on the GPU and checks the result against the twins' sort of
+/// the keys and values it started from; returns the sorted keys and values.
+fn sort_on_both(
+    gpu: &mut GpuClusterMesh,
+    label: &str,
+    passes: u32,
+    nv: usize,
+) -> (Vec<u32>, Vec<u32>) {
+    let keys: Vec<u32> = rd(gpu, CBuf::SortKeys, nv);
+    let vals: Vec<u32> = rd(gpu, CBuf::SortVals, nv);
+    for p in 0..passes {
+        gpu.run_part(Part::SortPass(p)).unwrap();
+    }
+    let (gk, gv): (Vec<u32>, Vec<u32>) = (rd(gpu, CBuf::SortKeys, nv), rd(gpu, CBuf::SortVals, nv));
+    let want = twins::sort(&keys, &vals, passes)
+        .pop()
+        .map_or((keys, vals), |p| (p.1, p.2));
+    assert_eq!((&gk, &gv), (&want.0, &want.1), "{label}: the sort");
+    (gk, gv)
+}
+
+/// The cells part on the GPU against `twins::cells` of the same sorted keys.
+fn cells_on_both(gpu: &mut GpuClusterMesh, label: &str, sorted: &(Vec<u32>, Vec<u32>)) -> usize {
+    let nv = sorted.0.len();
+    gpu.run_part(Part::Cells).unwrap();
+    let c = twins::cells(&gpu.cluster_params(), &sorted.0, &sorted.1);
+    let n = c.cell_key.len();
+    assert_eq!(
+        rd::<u32>(gpu, CBuf::CellHead, nv + 1),
+        c.cell_head,
+        "{label}"
+    );
+    assert_eq!(
+        rd::<u32>(gpu, CBuf::CellStart, n + 1),
+        c.cell_start,
+        "{label}"
+    );
+    assert_eq!(
+        rd::<u32>(gpu, CBuf::VertexCell, nv),
+        c.vertex_cell,
+        "{label}"
+    );
+    assert_eq!(rd::<u32>(gpu, CBuf::CellKey, n), c.cell_key, "{label}");
+    n
+}
+
+#[test]
+fn each_floating_stage_matches_its_cpu_twin() {
+    let Some(ctx) = gpu_context() else { return };
+    let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
+    for (name, m, radii, lock) in cases() {
+        let (pos, lo, hi) = points(&m);
+        let locked = locked_of(pos.len(), lock);
+        let locked_u32: Vec<u32> = locked.iter().map(|&l| l as u32).collect();
+        let (nv, nf) = (pos.len(), m.triangles.len());
+        let indices: &[u32] = bytemuck::cast_slice(&m.triangles);
+        let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
+        let offsets: Vec<u32> = rd(&gpu, CBuf::Offsets, nv + 1);
+        let vertex_faces: Vec<u32> = rd(&gpu, CBuf::VertexFaces, 3 * nf);
+        let normals: Vec<[f32; 4]> = rd(&gpu, CBuf::FaceNormals, nf);
+        let params = Params {
+            vertex_count: nv as u32,
+            face_count: nf as u32,
+            ..Default::default()
+        };
+
+        // fc_grades: floats, within 1e-4 of the longest edge there.
+        gpu.run_fc_part(FcPart::Ranks).unwrap();
+        let grades: Vec<f32> = rd(&gpu, CBuf::FcGrade, nv);
+        let mut want = vec![0f32; nv];
+        ft::fc_grades(&params, &pos, indices, &offsets, &vertex_faces, &mut want);
+        let exact = grades.iter().zip(&want).filter(|(a, b)| a == b).count();
+        eprintln!("{name}: {exact} of {nv} grades bit for bit");
+        for v in 0..nv {
+            assert!(
+                close(grades[v], want[v], 1e-4, 1e-6),
+                "{name}: grade of {v}: {} on the GPU, {} on the CPU",
+                grades[v],
+                want[v]
+            );
+        }
+        // fc_ranks fed the GPU's grades: exact.
+        let (mut ranks, mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv], vec![0u32; nv]);
+        ft::fc_ranks(&params, &grades, &mut ranks, &mut keys, &mut vals);
+        assert_eq!(rd::<u32>(&gpu, CBuf::FcRank, nv), ranks, "{name}: fc_rank");
+        assert_eq!(
+            rd::<u32>(&gpu, CBuf::SortKeys, nv),
+            keys,
+            "{name}: rank keys"
+        );
+        assert_eq!(
+            rd::<u32>(&gpu, CBuf::SortVals, nv),
+            vals,
+            "{name}: rank values"
+        );
+        let (_, order) = sort_on_both(&mut gpu, name, ft::RANK_PASSES, nv);
+        gpu.run_fc_part(FcPart::Order).unwrap();
+        assert_eq!(
+            rd::<u32>(&gpu, CBuf::FcOrder, nv),
+            order,
+            "{name}: fc_order"
+        );
+        // The order is by rank, highest first, as the CPU's u64 ranks order.
+        let full: Vec<u64> = (0..nv)
+            .map(|v| floating::rank(grades[v], v as u32))
+            .collect();
+        assert!(
+            order
+                .windows(2)
+                .all(|w| full[w[0] as usize] > full[w[1] as usize])
+        );
+
+        for &r in &radii {
+            let label = format!("{name} at r = {r}");
+            gpu.set_radius(lo, hi, r).unwrap();
+            let c = gpu.cluster_params();
+            gpu.run_fc_part(FcPart::Keys).unwrap();
+            let (mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv]);
+            ft::fc_keys(&c, &pos, &order, &mut keys, &mut vals);
+            assert_eq!(
+                rd::<u32>(&gpu, CBuf::SortKeys, nv),
+                keys,
+                "{label}: fc_keys"
+            );
+            assert_eq!(
+                rd::<u32>(&gpu, CBuf::SortVals, nv),
+                vals,
+                "{label}: fc_keys"
+            );
+            let (mut centre, mut head) = (vec![0u32; nv], vec![0u32; nv + 1]);
+            ft::fc_init(&c, &locked_u32, &mut centre, &mut head);
+            assert_eq!(
+                rd::<u32>(&gpu, CBuf::FcCentre, nv),
+                centre,
+                "{label}: fc_init"
+            );
+            assert_eq!(
+                rd::<u32>(&gpu, CBuf::FcHead, nv),
+                head[..nv],
+                "{label}: fc_init"
+            );
+            let passes = gpu.hash_passes();
+            let sorted = sort_on_both(&mut gpu, &label, passes, nv);
+            let cells = cells_on_both(&mut gpu, &label, &sorted);
+            let cell_head: Vec<u32> = rd(&gpu, CBuf::CellHead, nv + 1);
+            let cell_start: Vec<u32> = rd(&gpu, CBuf::CellStart, cells + 1);
+            let cell_key: Vec<u32> = rd(&gpu, CBuf::CellKey, cells);
+
+            // The rounds, each stage from the GPU's buffers before it.
+            let mut rounds = 0;
+            'rounds: loop {
+                for slot in 0..ROUND_SLOTS as u32 {
+                    if slot == 0 {
+                        gpu.run_fc_part(FcPart::Batch).unwrap();
+                    }
+                    let f = ft::float_params(r, slot);
+                    let centre: Vec<u32> = rd(&gpu, CBuf::FcCentre, nv);
+                    let mut decided: Vec<u32> = rd(&gpu, CBuf::FcDecided, nv);
+                    let mut head: Vec<u32> = rd(&gpu, CBuf::FcHead, nv + 1);
+                    gpu.run_fc_part(FcPart::Round(slot)).unwrap();
+                    let mut live = vec![0u32; ROUND_SLOTS];
+                    ft::fc_decide(
+                        &c,
+                        &f,
+                        &pos,
+                        &ranks,
+                        &sorted.1,
+                        &cell_head,
+                        &cell_start,
+                        &cell_key,
+                        &centre,
+                        &mut decided,
+                        &mut live,
+                    );
+                    let what = format!("{label}: round {rounds}");
+                    let live_gpu: Vec<u32> = rd(&gpu, CBuf::FcLive, ROUND_SLOTS);
+                    assert_eq!(
+                        live_gpu[slot as usize], live[slot as usize],
+                        "{what}: fc_live"
+                    );
+                    assert_eq!(rd::<u32>(&gpu, CBuf::FcDecided, nv), decided, "{what}");
+                    let mut after = centre.clone();
+                    ft::fc_claim(
+                        &c,
+                        &f,
+                        &pos,
+                        &sorted.1,
+                        &cell_head,
+                        &cell_start,
+                        &cell_key,
+                        &decided,
+                        &mut after,
+                        &mut head,
+                    );
+                    assert_eq!(
+                        rd::<u32>(&gpu, CBuf::FcCentre, nv),
+                        after,
+                        "{what}: centres"
+                    );
+                    assert_eq!(rd::<u32>(&gpu, CBuf::FcHead, nv), head[..nv], "{what}");
+                    if live[slot as usize] == 0 {
+                        break 'rounds;
+                    }
+                    rounds += 1;
+                    assert!(rounds <= nv, "{label}: rounds do not end");
+                }
+            }
+            let centre: Vec<u32> = rd(&gpu, CBuf::FcCentre, nv);
+            assert!(
+                !centre.contains(&UNCLAIMED),
+                "{label}: every vertex claimed"
+            );
+
+            // Centres numbered, vertices keyed by cluster.
+            let mut head: Vec<u32> = rd(&gpu, CBuf::FcHead, nv + 1);
+            gpu.run_fc_part(FcPart::Clusters).unwrap();
+            meshslim::cpu::prefix_sum::prefix_sum(nv as u32, &mut head, &mut Vec::new());
+            assert_eq!(rd::<u32>(&gpu, CBuf::FcHead, nv + 1), head, "{label}: head");
+            let (mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv]);
+            ft::fc_cluster_keys(&c, &centre, &head, &mut keys, &mut vals);
+            assert_eq!(rd::<u32>(&gpu, CBuf::SortKeys, nv), keys, "{label}");
+            assert_eq!(rd::<u32>(&gpu, CBuf::SortVals, nv), vals, "{label}");
+            let by_cluster = sort_on_both(&mut gpu, &label, ft::cluster_passes(nv), nv);
+            let clusters = cells_on_both(&mut gpu, &label, &by_cluster);
+            assert_eq!(clusters as u32, head[nv], "{label}: a cluster per centre");
+            let vertex_cluster: Vec<u32> = rd(&gpu, CBuf::VertexCell, nv);
+            assert_eq!(
+                floating::clusters_of(&centre),
+                (vertex_cluster.clone(), clusters),
+                "{label}: the driver's clusters_of"
+            );
+
+            gpu.run_fc_part(FcPart::Quadrics).unwrap();
+            let mut placed = vec![ClusterPlaced::default(); clusters];
+            let mut quadric = vec![Quadric::default(); clusters];
+            ft::fc_quadrics(
+                &c,
+                &ft::float_params(r, 0),
+                &pos,
+                indices,
+                &offsets,
+                &vertex_faces,
+                &normals,
+                &locked_u32,
+                &centre,
+                &by_cluster.1,
+                &rd::<u32>(&gpu, CBuf::CellHead, nv + 1),
+                &rd::<u32>(&gpu, CBuf::CellStart, clusters + 1),
+                &mut placed,
+                &mut quadric,
+            );
+            check_placed(
+                &label,
+                &rd(&gpu, CBuf::ClusterPlaced, clusters),
+                &placed,
+                &rd(&gpu, CBuf::ClusterQuadric, clusters),
+                &quadric,
+            );
+
+            gpu.run_part(Part::Faces).unwrap();
+            let f = twins::faces(&c, indices, &vertex_cluster);
+            let kept = f.face_origin.len();
+            assert!(kept > 0, "{label}: some faces survive");
+            assert_eq!(
+                rd::<u32>(&gpu, CBuf::ClusterFaces, 3 * kept),
+                f.cluster_faces
+            );
+            assert_eq!(rd::<u32>(&gpu, CBuf::FaceOrigin, kept), f.face_origin);
+            eprintln!("{label}: {rounds} rounds, {clusters} clusters, {kept} faces");
+        }
+    }
+}
+
+/// The twins' chain is the CPU driver's: the same grades and ranks, the same centres in the same
+/// number of rounds as `floating::claim`, the same clusters.
+#[test]
+fn the_floating_twins_are_the_cpu_driver() {
+    for (name, m, radii, lock) in cases() {
+        let (pos, lo, hi) = points(&m);
+        let locked = locked_of(pos.len(), lock);
+        let csr = stages::Csr::new(pos.len(), &m.triangles);
+        let ranks = floating::ranks(&floating::grades(&pos, &m.triangles, &csr));
+        for r in radii {
+            let twin = ft::run(&pos, &m.triangles, &locked, lo, hi, r);
+            assert_eq!(
+                twin.ranks,
+                ranks.iter().map(|&x| (x >> 32) as u32).collect::<Vec<_>>(),
+                "{name}: ranks"
+            );
+            let (centre, rounds) = floating::claim(&pos, &ranks, &locked, lo, hi, r);
+            assert_eq!(twin.centre(), centre, "{name} at r = {r}: centres");
+            assert_eq!(twin.rounds.len(), rounds, "{name} at r = {r}: rounds");
+            let (vertex_cluster, n) = floating::clusters_of(&centre);
+            let result = twin.result();
+            assert_eq!(result.vertex_cluster, vertex_cluster, "{name} at r = {r}");
+            assert_eq!(result.clusters, n, "{name} at r = {r}");
+            assert_eq!(
+                result.faces,
+                stages::cluster_faces(&m.triangles, &vertex_cluster, n, false),
+                "{name} at r = {r}: faces"
+            );
+        }
+    }
+}
+
+/// The ranks the device makes for `pos`, against the CPU's: how many differ. The grades take a
+/// square root and divisions, which Vulkan does not round correctly everywhere (nor forbid fused
+/// multiply-adds): on lavapipe every grade of these meshes is the CPU's bit for bit, so none;
+/// elsewhere a grade an ulp off can cross a 256-ulp rank step.
+fn ranks_differing(gpu: &mut GpuClusterMesh, pos: &[[f32; 4]], faces: &[[u32; 3]]) -> usize {
+    gpu.run_fc_part(FcPart::Ranks).unwrap();
+    let csr = stages::Csr::new(pos.len(), faces);
+    let cpu = floating::ranks(&floating::grades(pos, faces, &csr));
+    let got: Vec<u32> = rd(gpu, CBuf::FcRank, pos.len());
+    got.iter()
+        .zip(&cpu)
+        .filter(|(g, c)| **g != (**c >> 32) as u32)
+        .count()
+}
+
+/// The whole GPU build against the twins' chain: with the same ranks (lavapipe), the same
+/// rounds, clusters and faces, vertices within rounding; on a device whose ranks differ, faces
+/// within 5% of the twins'. Twice the same bits either way.
+#[test]
+fn the_gpu_floating_build_equals_the_twins_chain() {
+    let Some(ctx) = gpu_context() else { return };
+    let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
+    for (name, m, radii, lock) in cases() {
+        let (pos, lo, hi) = points(&m);
+        let locked = locked_of(pos.len(), lock);
+        let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
+        let differ = ranks_differing(&mut gpu, &pos, &m.triangles);
+        for r in radii {
+            let label = format!("{name} at r = {r}");
+            let (g, rounds) = gpu.build_floating(lo, hi, r).unwrap();
+            let (again, _) = gpu.build_floating(lo, hi, r).unwrap();
+            assert_eq!(g.faces, again.faces, "{label}: the same faces twice");
+            assert!(
+                g.placed
+                    .iter()
+                    .zip(&again.placed)
+                    .all(|(a, b)| a.pos == b.pos && a.quadric == b.quadric),
+                "{label}: the same vertices twice, bit for bit"
+            );
+            let twin = ft::run(&pos, &m.triangles, &locked, lo, hi, r);
+            let t = twin.result();
+            if differ > 0 {
+                eprintln!("{label}: {differ} ranks differ from the CPU's on this device");
+                let (a, b) = (g.faces.len() as f64, t.faces.len() as f64);
+                assert!(
+                    (a - b).abs() <= 0.05 * b,
+                    "{label}: {a} faces, the twins {b}"
+                );
+                continue;
+            }
+            assert_eq!(rounds, twin.rounds.len(), "{label}: rounds");
+            assert_eq!(g.vertex_cluster, t.vertex_cluster, "{label}: clusters");
+            assert_eq!(g.faces, t.faces, "{label}: faces");
+            assert_eq!(g.placed.len(), t.placed.len(), "{label}");
+            for (k, (a, b)) in g.placed.iter().zip(&t.placed).enumerate() {
+                assert!(
+                    (0..3).all(|i| close(a.pos[i], b.pos[i], 1e-4, 1e-3)),
+                    "{label}: cluster {k} at {:?} on the GPU, {:?} on the CPU",
+                    a.pos,
+                    b.pos
+                );
+            }
+        }
+    }
+}
+
+/// `meshslim simplify --method floating-cell --backend gpu` against `cpu-parallel`: with the same
+/// ranks (lavapipe) the same search, radius, rounds, clusters and faces; on a device whose ranks
+/// differ, both in the ±5% band or equally far from it. Vertices: the CPU driver
+/// scatters its quadrics in face order, the GPU gathers them cluster by cluster, the same sums
+/// to rounding; on a curved surface that leaves them within 5% of the radius (measured: 1e-6 r
+/// on the sphere, 1.5e-5 r on the torus), but on a flat patch every candidate costs zero and
+/// rounding picks among them, so on the cube only the box is shared: within its diagonal, 2√3 r
+/// (measured: 0.85 r).
+#[test]
+fn simplify_floating_on_the_gpu_writes_the_cpu_parallel_faces() {
+    let Some(ctx) = gpu_context() else { return };
+    let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
+    let mut sphere = meshslim::mesh::icosphere(5);
+    meshslim::mesh::add_noise(&mut sphere, 0.01, 5);
+    let meshes = [
+        ("noisy_icosphere", sphere, 0.05),
+        ("cube", meshslim::mesh::cube(20), 2.0 * 3f64.sqrt()),
+        ("torus", meshslim::mesh::torus(1.0, 0.3, 64, 32), 0.05),
+    ];
+    for (name, m, within) in meshes {
+        let (pos, _, _) = points(&m);
+        let locked = vec![false; pos.len()];
+        let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
+        let differ = ranks_differing(&mut gpu, &pos, &m.triangles);
+        for target in [m.triangles.len() / 10, m.triangles.len() / 50] {
+            let run = |backend| {
+                let mut o = meshslim::SimplifyOptions::with_faces(target);
+                o.method = meshslim::Method::FloatingCell;
+                o.backend = backend;
+                meshslim::simplify(&m, &o).unwrap()
+            };
+            let (cpu, rc) = run(meshslim::Backend::CpuParallel);
+            let (gpu, rg) = run(meshslim::Backend::Gpu);
+            assert_eq!(rg.backend, meshslim::Backend::Gpu);
+            let label = format!("{name} to {target}");
+            if differ > 0 {
+                eprintln!("{label}: {differ} ranks differ from the CPU's on this device");
+                assert_eq!(rg.stop_reason, rc.stop_reason, "{label}");
+                continue;
+            }
+            let (cc, cg) = (rc.clustering.unwrap(), rg.clustering.unwrap());
+            assert_eq!(cg.cell_size, cc.cell_size, "{label}: radius");
+            assert_eq!(cg.centre_rounds, cc.centre_rounds, "{label}: rounds");
+            assert_eq!(cg.clusters, cc.clusters, "{label}: clusters");
+            assert_eq!(cpu.triangles, gpu.triangles, "{label}");
+            let b = m.bounds().unwrap();
+            let diagonal = (0..3)
+                .map(|i| (b.max[i] - b.min[i]) as f64)
+                .map(|x| x * x)
+                .sum::<f64>()
+                .sqrt();
+            let r = cc.cell_size * diagonal; // the radius in the mesh's units
+            let worst = cpu
+                .positions
+                .iter()
+                .zip(&gpu.positions)
+                .map(|(a, b)| {
+                    (0..3)
+                        .map(|i| (a[i] - b[i]) as f64)
+                        .map(|x| x * x)
+                        .sum::<f64>()
+                })
+                .fold(0f64, f64::max)
+                .sqrt();
+            eprintln!(
+                "{label}: same faces; vertices at most {:.2e} r apart",
+                worst / r
+            );
+            for (a, b) in cpu.positions.iter().zip(&gpu.positions) {
+                let d = (0..3)
+                    .map(|i| (a[i] - b[i]) as f64)
+                    .map(|x| x * x)
+                    .sum::<f64>();
+                assert!(d.sqrt() <= within * r, "{label}: {a:?} against {b:?}");
+            }
+        }
+    }
+}
