@@ -15,6 +15,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let m = meshslim::mesh::subdivide_midpoint(&m);
     meshslim::io::write(std::path::Path::new(&path), &m)?;
-    println!("{name} subdivided again: {} faces -> {path}", m.triangles.len());
+    println!(
+        "{name} subdivided again: {} faces -> {path}",
+        m.triangles.len()
+    );
     Ok(())
 }

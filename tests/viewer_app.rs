@@ -343,8 +343,8 @@ fn a_dropped_file_opens_and_the_result_saves_and_screenshots() {
     assert!(drawn as f64 / (img.width() * img.height()) as f64 > 0.05);
 }
 
-/// `--method cluster` on the gpu backend runs on the window's device and the window draws the
-/// buffers the build wrote (sized for every input vertex, not a fresh upload of the result),
+/// `--method cluster` and `floating-cell` on the gpu backend run on the window's device and the
+/// window draws the buffers the build wrote (sized for every input vertex, not a fresh upload of the result),
 /// with the kept faces' count in the draw arguments; a method the device does not run moves
 /// the backend to cpu-parallel.
 #[test]
@@ -358,55 +358,60 @@ fn clustering_on_the_window_device_is_drawn_from_its_buffers() {
     let mut h = harness(model);
     assert!(h.state().has_gpu_backend(), "{}", h.state().status);
     h.state_mut().backend = Backend::Gpu;
-    h.state_mut().set_method(meshslim::Method::FloatingCell);
+    h.state_mut().set_method(meshslim::Method::Hybrid);
     assert_eq!(h.state().backend, Backend::CpuParallel);
-    h.state_mut().backend = Backend::Gpu;
-    h.state_mut().set_method(meshslim::Method::Cluster);
-    assert_eq!(h.state().backend, Backend::Gpu);
-    h.state_mut().set_target_faces(2000);
-    h.step();
-    h.get_by_label("Simplify").click();
-    h.step();
-    finish_job(&mut h);
-    let s = h
-        .state()
-        .simplified
-        .as_ref()
-        .unwrap_or_else(|| panic!("{}", h.state().status));
-    assert_eq!(s.report.backend, Backend::Gpu);
-    let faces = s.report.output_faces;
-    assert!((1900..=2100).contains(&faces), "{faces}");
-    assert!(s.scene.gpu.positions.size() >= input_vertices as u64 * 16);
-    let args = read_buffer(h.state(), &s.scene.gpu.draw_args, 20);
-    assert_eq!(
-        u32::from_le_bytes(args[0..4].try_into().unwrap()) as usize,
-        3 * faces
-    );
-    // The drawn faces are the output's, up to the numbering of their vertices: the same
-    // positions corner by corner.
-    let idx: Vec<u32> = bytemuck::pod_collect_to_vec(&read_buffer(
-        h.state(),
-        &s.scene.gpu.indices,
-        12 * faces as u64,
-    ));
-    let clusters = idx.iter().max().map_or(0, |&m| m as u64 + 1);
-    let pos: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&read_buffer(
-        h.state(),
-        &s.scene.gpu.positions,
-        16 * clusters,
-    ));
-    let g = &s.scene.gpu;
-    for (c, &v) in s.mesh.triangles.iter().flatten().enumerate() {
-        let p = pos[idx[c] as usize];
-        let world = [0, 1, 2].map(|i| p[i] as f64 / g.scale + g.center[i]);
-        let out = s.mesh.positions[v as usize];
-        for i in 0..3 {
-            assert!(
-                (world[i] - out[i] as f64).abs() < 1e-4,
-                "corner {c}: drawn {world:?}, written {out:?}"
-            );
+    for method in [meshslim::Method::Cluster, meshslim::Method::FloatingCell] {
+        h.state_mut().backend = Backend::Gpu;
+        h.state_mut().set_method(method);
+        assert_eq!(h.state().backend, Backend::Gpu);
+        h.state_mut().set_target_faces(2000);
+        h.step();
+        h.get_by_label("Simplify").click();
+        h.step();
+        finish_job(&mut h);
+        let s = h
+            .state()
+            .simplified
+            .as_ref()
+            .unwrap_or_else(|| panic!("{}", h.state().status));
+        assert_eq!(s.report.backend, Backend::Gpu);
+        let faces = s.report.output_faces;
+        assert!((1900..=2100).contains(&faces), "{faces}");
+        assert!(s.scene.gpu.positions.size() >= input_vertices as u64 * 16);
+        let args = read_buffer(h.state(), &s.scene.gpu.draw_args, 20);
+        assert_eq!(
+            u32::from_le_bytes(args[0..4].try_into().unwrap()) as usize,
+            3 * faces
+        );
+        // The drawn faces are the output's, up to the numbering of their vertices: the same
+        // positions corner by corner.
+        let idx: Vec<u32> = bytemuck::pod_collect_to_vec(&read_buffer(
+            h.state(),
+            &s.scene.gpu.indices,
+            12 * faces as u64,
+        ));
+        let clusters = idx.iter().max().map_or(0, |&m| m as u64 + 1);
+        let pos: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&read_buffer(
+            h.state(),
+            &s.scene.gpu.positions,
+            16 * clusters,
+        ));
+        let g = &s.scene.gpu;
+        for (c, &v) in s.mesh.triangles.iter().flatten().enumerate() {
+            let p = pos[idx[c] as usize];
+            let world = [0, 1, 2].map(|i| p[i] as f64 / g.scale + g.center[i]);
+            let out = s.mesh.positions[v as usize];
+            for i in 0..3 {
+                assert!(
+                    (world[i] - out[i] as f64).abs() < 1e-4,
+                    "corner {c}: drawn {world:?}, written {out:?}"
+                );
+            }
         }
+        let after = h.render().expect("render");
+        assert!(
+            drawn_share(&after) > 0.05,
+            "{method:?}: the result is drawn"
+        );
     }
-    let after = h.render().expect("render");
-    assert!(drawn_share(&after) > 0.05, "the result is drawn");
 }

@@ -342,15 +342,31 @@ pub fn simplify_floating(
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
+    let on = match check_backend(opts)? {
+        Backend::Gpu => Some(super::gpu::shared()?),
+        _ => None,
+    };
+    let (out, report, _) = floating_on(on, mesh, opts, progress)?;
+    Ok((out, report))
+}
+
+/// `--method floating-cell`, on `on`'s device when given (its result then also left there,
+/// [`super::Drawn`]), else on the CPU's cores.
+pub(super) fn floating_on(
+    on: Option<&super::gpu::GpuClusterer>,
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport, Option<super::Drawn>)> {
     let backend = check_backend(opts)?;
     let t = Instant::now();
     let mut pts = Points::new(mesh);
     let mut work = prepare(&mut pts, opts, false)?;
     // On the GPU the mesh and its buffers stay on the device between the search's builds, and
     // the ranks are made there on the first.
-    let ranks = if backend == Backend::Gpu {
+    let ranks = if let Some(sim) = on {
         let g = super::gpu::GpuClusterMesh::new(
-            super::gpu::shared()?,
+            sim,
             &work.pts.positions,
             &work.pts.faces,
             &work.locked,
@@ -375,9 +391,11 @@ pub fn simplify_floating(
         .max_error
         .map(|e| e / ((1.0 + 3f64.sqrt()) * (1.0 + 0.5 * JITTER as f64)));
     let mut rounds = 0;
+    let mut last = None;
     let (r, built, stop) = land(target, None, first, None, cap, &mut report, &mut |r| {
         let (b, n) = build_floating(&work, &ranks, r as f32)?;
         rounds = n;
+        last = Some(r as f32);
         Ok((r as f32 as f64, b))
     })?;
     opts.cancel.check()?;
@@ -386,8 +404,24 @@ pub fn simplify_floating(
     report.split_clusters = 0;
     report.cell_size = r;
     report.centre_rounds = Some(rounds);
+    // The search may have kept an earlier build than the device's last: build it again
+    // before drawing from the device's buffers.
+    let drawn = if work.gpu.is_some() {
+        if last != Some(r as f32) {
+            build_floating(&work, &ranks, r as f32)?;
+        }
+        let g = work.gpu.take().map(|g| g.into_inner());
+        let Some(Ok(mut g)) = g else {
+            return Err(crate::error::Error::Internal(
+                "the GPU clustering lock is poisoned".into(),
+            ));
+        };
+        Some(super::Drawn::of(&mut g, &built, work.pts)?)
+    } else {
+        None
+    };
     let (out, _) = output(mesh, work.pts, &built);
     report.seconds = t.elapsed().as_secs_f64();
     let report = clustered_report(mesh, opts, backend, &out, &built, stop, report);
-    Ok((out, report))
+    Ok((out, report, drawn))
 }

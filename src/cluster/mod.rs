@@ -645,9 +645,9 @@ pub fn simplify_cluster(
     Ok((out, report))
 }
 
-/// `--method cluster` on `clusterer`'s device, its result also left there as a mesh a renderer
-/// draws (the viewer's: its own device, its own pipelines).
-pub fn simplify_cluster_drawn(
+/// `--method cluster` or `floating-cell` on `clusterer`'s device, its result also left there as
+/// a mesh a renderer draws (the viewer's: its own device, its own pipelines).
+pub fn simplify_drawn(
     clusterer: &gpu::GpuClusterer,
     mesh: &Mesh,
     opts: &SimplifyOptions,
@@ -657,7 +657,16 @@ pub fn simplify_cluster_drawn(
         backend: Backend::Gpu,
         ..opts.clone()
     };
-    let (out, report, drawn) = cluster_on(Some(clusterer), mesh, opts, progress)?;
+    let (out, report, drawn) = match opts.method {
+        Method::Cluster => cluster_on(Some(clusterer), mesh, opts, progress)?,
+        Method::FloatingCell => floating::floating_on(Some(clusterer), mesh, opts, progress)?,
+        m => {
+            return Err(Error::InvalidOption(format!(
+                "--method {} leaves no mesh on the device (cluster and floating-cell do)",
+                m.name()
+            )));
+        }
+    };
     let drawn = drawn.ok_or_else(|| Error::Internal("a GPU clustering left no mesh".into()))?;
     Ok((out, report, drawn))
 }
@@ -670,6 +679,21 @@ pub struct Drawn {
     /// Per cluster, in the unit-diagonal frame (w = 1).
     pub positions: Vec<[f32; 4]>,
     pub indices: Vec<u32>,
+}
+
+impl Drawn {
+    /// The last build on `g` (the one `built` read back) as drawn.
+    fn of(g: &mut gpu::GpuClusterMesh, built: &Built, pts: &Points) -> Result<Drawn> {
+        Ok(Drawn {
+            gpu: g.drawable(pts.center, pts.scale)?,
+            positions: built
+                .placed
+                .iter()
+                .map(|p| [p.pos[0], p.pos[1], p.pos[2], 1.0])
+                .collect(),
+            indices: built.faces.iter().flat_map(|(_, t)| *t).collect(),
+        })
+    }
 }
 
 fn cluster_on(
@@ -707,15 +731,7 @@ fn cluster_on(
             if g.last_grid() != Some(grid) {
                 g.build(&grid)?;
             }
-            Some(Drawn {
-                gpu: g.drawable(work.pts.center, work.pts.scale)?,
-                positions: built
-                    .placed
-                    .iter()
-                    .map(|p| [p.pos[0], p.pos[1], p.pos[2], 1.0])
-                    .collect(),
-                indices: built.faces.iter().flat_map(|(_, t)| *t).collect(),
-            })
+            Some(Drawn::of(&mut g, &built, work.pts)?)
         }
         None => None,
     };

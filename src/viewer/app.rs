@@ -313,11 +313,11 @@ impl ViewerApp {
     }
 
     /// The gpu backend runs `method` on the window's device and leaves its result there: the
-    /// rounds (`qem`) and `cluster`; the others run on the CPU's cores.
+    /// rounds (`qem`), `cluster` and `floating-cell`; `hybrid` runs on the CPU's cores here.
     pub(super) fn gpu_draws(&self, method: crate::Method) -> bool {
         match method {
             crate::Method::Qem => self.gpu.sim.is_some(),
-            crate::Method::Cluster => self.gpu.clusterer.is_some(),
+            crate::Method::Cluster | crate::Method::FloatingCell => self.gpu.clusterer.is_some(),
             _ => false,
         }
     }

@@ -38,9 +38,9 @@ pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> 
     screenshot_with(model, ratio, crate::Method::Qem, style, size)
 }
 
-/// As [`screenshot`], simplified by `method`: `qem` and `cluster` on the GPU, drawn from the
-/// buffers they wrote; `floating-cell` and `hybrid` on the CPU's cores, their result uploaded
-/// and drawn by the same renderer.
+/// As [`screenshot`], simplified by `method`: `qem`, `cluster` and `floating-cell` on the GPU,
+/// drawn from the buffers they wrote; `hybrid` on the CPU's cores, its result uploaded and
+/// drawn by the same renderer.
 pub fn screenshot_with(
     model: &Model,
     ratio: f64,
@@ -62,7 +62,7 @@ pub fn screenshot_with(
     let (scene, faces) = if ratio < 1.0 {
         let mut opts = SimplifyOptions::with_ratio(model.up.face_count(), ratio)?;
         opts.method = method;
-        opts.backend = if matches!(method, crate::Method::Qem | crate::Method::Cluster) {
+        opts.backend = if method != crate::Method::Hybrid {
             Backend::Gpu
         } else {
             Backend::CpuParallel

@@ -146,7 +146,7 @@ impl ViewerApp {
                 ui.selectable_value(&mut self.method, m, m.name())
                     .on_hover_text(about);
             }
-            // floating-cell and hybrid run on the CPU's cores here.
+            // hybrid runs on the CPU's cores here.
             if !self.gpu_draws(self.method) && self.backend == Backend::Gpu {
                 self.backend = Backend::CpuParallel;
             }

@@ -352,12 +352,17 @@ pub fn simplify(
             let gpu = rounds.into_mesh(up)?;
             (gpu, d.positions, indices, mesh, report, uvs)
         }
-        Backend::Gpu if opts.method == crate::Method::Cluster => {
+        Backend::Gpu
+            if matches!(
+                opts.method,
+                crate::Method::Cluster | crate::Method::FloatingCell
+            ) =>
+        {
             let c = on
                 .cluster
                 .ok_or_else(|| Error::Gpu("GPU clustering is not available".into()))?;
             let (mesh, report, drawn) =
-                crate::cluster::simplify_cluster_drawn(c, &model.mesh, opts, progress)?;
+                crate::cluster::simplify_drawn(c, &model.mesh, opts, progress)?;
             // The output's corners are the drawn faces' corners, in the same order.
             let uvs = mesh.uvs_from(UvOrigin::BottomLeft).map(|uv| {
                 mesh.triangles
