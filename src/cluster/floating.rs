@@ -406,19 +406,17 @@ pub(super) fn floating_on(
     report.centre_rounds = Some(rounds);
     // The search may have kept an earlier build than the device's last: build it again
     // before drawing from the device's buffers.
-    let drawn = if work.gpu.is_some() {
-        if last != Some(r as f32) {
-            build_floating(&work, &ranks, r as f32)?;
+    if work.gpu.is_some() && last != Some(r as f32) {
+        build_floating(&work, &ranks, r as f32)?;
+    }
+    let drawn = match work.gpu.take() {
+        Some(g) => {
+            let mut g = g.into_inner().map_err(|_| {
+                crate::error::Error::Internal("the GPU clustering lock is poisoned".into())
+            })?;
+            Some(super::Drawn::of(&mut g, &built, work.pts)?)
         }
-        let g = work.gpu.take().map(|g| g.into_inner());
-        let Some(Ok(mut g)) = g else {
-            return Err(crate::error::Error::Internal(
-                "the GPU clustering lock is poisoned".into(),
-            ));
-        };
-        Some(super::Drawn::of(&mut g, &built, work.pts)?)
-    } else {
-        None
+        None => None,
     };
     let (out, _) = output(mesh, work.pts, &built);
     report.seconds = t.elapsed().as_secs_f64();
