@@ -119,6 +119,29 @@ fn streamed_hybrid_is_the_whole_mesh_hybrid() {
     assert!(eb <= 1.05 * ea, "streamed {eb} against whole {ea}");
 }
 
+/// An OBJ streams by its positions: the faces and the clustering of the whole-mesh path (the
+/// file has no attributes, so no seam vertices either way).
+#[test]
+fn an_obj_streams_like_a_ply() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = noisy_torus();
+    let path = dir.path().join("torus.obj");
+    meshslim::io::write(&path, &m).unwrap();
+    let whole = meshslim::io::read(&path).unwrap();
+    let (a, _) = simplify(&whole, &opts(2000)).unwrap();
+    let (b, rb) =
+        simplify_file_in_blocks(&path, Target::Faces(2000), &opts(0), 1000, &mut |_| {}).unwrap();
+    assert_eq!(rb.input_faces, whole.triangles.len());
+    assert_eq!(a.triangles, b.triangles);
+    // An error in the file names its line, as the whole-mesh reader's does.
+    let bad = dir.path().join("bad.obj");
+    std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n").unwrap();
+    let e = simplify_file_in_blocks(&bad, Target::Faces(1), &opts(0), 10, &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bad.obj") && e.contains("line 4"), "{e}");
+}
+
 #[test]
 fn a_ratio_is_taken_of_the_files_faces() {
     let dir = tempfile::tempdir().unwrap();
@@ -143,9 +166,9 @@ fn what_streaming_cannot_do_is_refused_with_a_reason() {
     let dir = tempfile::tempdir().unwrap();
     let m = noisy_torus();
     let ply = dir.path().join("torus.ply");
-    let obj = dir.path().join("torus.obj");
+    let stl = dir.path().join("torus.stl");
     write(&m, &ply, false);
-    meshslim::io::write(&obj, &m).unwrap();
+    meshslim::io::write(&stl, &m).unwrap();
     let run = |path: &Path, o: SimplifyOptions| {
         simplify_file_in_blocks(path, Target::Faces(500), &o, 1000, &mut |_| {})
     };
@@ -153,7 +176,7 @@ fn what_streaming_cannot_do_is_refused_with_a_reason() {
         Err(Error::InvalidOption(msg)) => assert!(msg.contains(needle), "{msg}"),
         other => panic!("expected a refusal naming {needle:?}, got {other:?}"),
     };
-    expect(run(&obj, opts(0)), "PLY");
+    expect(run(&stl, opts(0)), "PLY (ascii or binary) and OBJ");
     let mut qem = opts(0);
     qem.method = Method::Qem;
     expect(run(&ply, qem), "--method cluster");

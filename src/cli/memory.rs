@@ -37,10 +37,19 @@ fn whole_bytes_per_face(method: crate::Method) -> u64 {
     }
 }
 
-/// What `method` would hold reading `path` whole, from its header's counts; `None` for a file
-/// whose counts are not in a header (only PLY streams).
+/// Bytes of an OBJ file per triangle, about: a `v` line of ~30 characters per two faces and
+/// an `f` line of ~25 per face. An OBJ has no header with its counts; this errs high on files
+/// with `vt`/`vn` lines (more bytes per face), so they stream later rather than sooner.
+const OBJ_BYTES_PER_FACE: u64 = 40;
+
+/// What `method` would hold reading `path` whole: from a PLY header's face count, an OBJ's
+/// size; `None` for the formats that do not stream.
 pub(super) fn whole_mesh_estimate(path: &Path, method: crate::Method) -> Option<u64> {
-    let (_, faces) = crate::io::ply::header_counts(path).ok()?;
+    let faces = match crate::io::Format::from_path(path).ok()? {
+        crate::io::Format::Ply => crate::io::ply::header_counts(path).ok()?.1,
+        crate::io::Format::Obj => std::fs::metadata(path).ok()?.len() / OBJ_BYTES_PER_FACE,
+        _ => return None,
+    };
     Some(faces.saturating_mul(whole_bytes_per_face(method)))
 }
 

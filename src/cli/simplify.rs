@@ -102,7 +102,7 @@ pub struct SimplifyArgs {
     #[arg(long, value_enum, default_value_t = MethodArg::Qem)]
     pub method: MethodArg,
 
-    /// Stream the input (a PLY file, --method cluster or hybrid): hold its vertices and read
+    /// Stream the input (a PLY or OBJ file, --method cluster or hybrid): hold its vertices and read
     /// its faces again in blocks at each clustering pass, so memory follows the vertices and
     /// the output, not the faces (hybrid's rounds then run on the clustered mesh). Chosen by
     /// itself when reading the file whole would take more than --memory. Normals, colours and

@@ -8,7 +8,8 @@
 //! quadrics (no vertex→face lists), then runs the rounds in memory on the clustered mesh.
 //!
 //! Not carried: normals, colours and UVs (they would be held per vertex); the output's vertices
-//! are the clusters' positions. Only PLY (ascii or binary) streams so far.
+//! are the clusters' positions. PLY (ascii or binary) and OBJ stream; an OBJ's faces refer to
+//! its positions alone (no seam vertices: nothing is carried that would need them).
 
 use super::{Built, ClusterReport, Points, StopReason, cluster_to, max_error, prepare, tally};
 use crate::error::{Error, Result};
@@ -81,12 +82,20 @@ impl FileFaces {
             f,
             failed: None,
         };
-        crate::io::ply::read_into(&self.path, &mut b)?;
+        read_into(&self.path, &mut b)?;
         b.flush();
         match b.failed {
             Some(e) => Err(e),
             None => Ok(()),
         }
+    }
+}
+
+/// A streaming read of a PLY or an OBJ (by positions alone, `obj::read_into`).
+fn read_into(path: &Path, sink: &mut dyn Sink) -> Result<()> {
+    match crate::io::Format::from_path(path)? {
+        crate::io::Format::Obj => crate::io::obj::read_into(path, sink),
+        _ => crate::io::ply::read_into(path, sink),
     }
 }
 
@@ -137,10 +146,11 @@ pub fn simplify_file_in_blocks(
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
     assert!(block > 0, "a block holds at least one triangle");
-    if crate::io::Format::from_path(path)? != crate::io::Format::Ply {
+    let format = crate::io::Format::from_path(path)?;
+    if !matches!(format, crate::io::Format::Ply | crate::io::Format::Obj) {
         return Err(Error::InvalidOption(format!(
-            "--stream reads PLY files (ascii or binary); {} is not one: convert it, or drop \
-             --stream to read it whole",
+            "--stream reads PLY (ascii or binary) and OBJ files; {} is neither: convert it, \
+             or drop --stream to read it whole",
             path.display()
         )));
     }
@@ -163,7 +173,7 @@ pub fn simplify_file_in_blocks(
     }
     let t = Instant::now();
     let mut raw = Positions::default();
-    crate::io::ply::read_into(path, &mut raw)?;
+    read_into(path, &mut raw)?;
     let vertices = raw.0.len();
     let mut pts = {
         let m = Mesh {

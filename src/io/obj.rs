@@ -69,6 +69,167 @@ pub fn read(path: &Path) -> Result<Mesh> {
     read_from(BufReader::with_capacity(1 << 16, file), path)
 }
 
+/// A line's keyword and the rest of it.
+fn keyword(line: &str) -> (&str, &str) {
+    match line.find(|c: char| c.is_ascii_whitespace()) {
+        Some(i) => (&line[..i], line[i..].trim()),
+        None => (line, ""),
+    }
+}
+
+/// The numbers after a keyword, each finite.
+fn floats(rest: &str, what: &str, err: &dyn Fn(String) -> Error) -> Result<Vec<f32>> {
+    rest.split_ascii_whitespace()
+        .map(|t| {
+            let x: f32 = t
+                .parse()
+                .map_err(|_| err(format!("{what}: {t:?} is not a number")))?;
+            if x.is_finite() {
+                Ok(x)
+            } else {
+                Err(err(format!("{what} has a non-finite value {t}")))
+            }
+        })
+        .collect()
+}
+
+/// A `v` line's position (divided by `w`) and its numbers; `before` positions came earlier.
+fn vertex(
+    rest: &str,
+    before: usize,
+    err: &dyn Fn(String) -> Error,
+) -> Result<([f32; 3], Vec<f32>)> {
+    let what = format!("vertex {}", before + 1);
+    let f = floats(rest, &what, err)?;
+    let p = match f.len() {
+        3 | 6 => [f[0], f[1], f[2]],
+        4 if f[3] != 0.0 => [f[0] / f[3], f[1] / f[3], f[2] / f[3]],
+        4 => return Err(err(format!("{what} has w = 0"))),
+        n => {
+            return Err(err(format!(
+                "{what}: expected 3, 4 or 6 numbers, found {n}"
+            )));
+        }
+    };
+    if !p.iter().all(|c| c.is_finite()) {
+        return Err(err(format!("{what} has a non-finite coordinate {p:?}")));
+    }
+    Ok((p, f))
+}
+
+/// A face corner `v`, `v/vt`, `v//vn` or `v/vt/vn` as zero-based (position, texture, normal)
+/// indices ([`NONE`] where absent), checked against the `counts` defined so far.
+fn corner(c: &str, counts: [usize; 3], err: &dyn Fn(String) -> Error) -> Result<[u32; 3]> {
+    let mut parts = c.split('/');
+    let mut idx = [NONE; 3];
+    let names = ["vertex", "texture coordinate", "normal"];
+    for k in 0..3 {
+        let Some(s) = parts.next() else { break };
+        if s.is_empty() {
+            if k == 0 {
+                return Err(err(format!("face corner {c:?} has no vertex index")));
+            }
+            continue;
+        }
+        let i: i64 = s
+            .parse()
+            .map_err(|_| err(format!("face corner {c:?}: {s:?} is not an index")))?;
+        let n = counts[k] as i64;
+        let abs = if i > 0 {
+            i - 1
+        } else if i < 0 {
+            n + i
+        } else {
+            return Err(err(format!(
+                "face corner {c:?}: OBJ indices start at 1, not 0"
+            )));
+        };
+        if abs < 0 || abs >= n {
+            return Err(err(format!(
+                "face corner {c:?}: {} index {i} is out of range (only {n} defined before this line)",
+                names[k]
+            )));
+        }
+        idx[k] = abs as u32;
+    }
+    if parts.next().is_some() {
+        return Err(err(format!(
+            "face corner {c:?} has more than three indices"
+        )));
+    }
+    Ok(idx)
+}
+
+/// A polygon's fan of triangles, each handed to `push`; fewer than three corners is an error.
+fn fan(poly: &[u32], err: &dyn Fn(String) -> Error, mut push: impl FnMut([u32; 3])) -> Result<()> {
+    if poly.len() < 3 {
+        return Err(err(format!(
+            "face with {} corners; a face needs at least 3",
+            poly.len()
+        )));
+    }
+    for j in 1..poly.len() - 1 {
+        push([poly[0], poly[j], poly[j + 1]]);
+    }
+    Ok(())
+}
+
+/// Reads `path` into `sink` by positions alone, as the out-of-core clustering streams it: vertex
+/// `i` is the `i`-th `v` line, faces refer to positions (the `vt`/`vn` of a corner are checked,
+/// not kept, so there are no seam vertices), polygons fan-triangulated. Groups, materials and
+/// every other statement are skipped. Errors as [`read`]'s, with the line.
+pub fn read_into(path: &Path, sink: &mut dyn crate::io::sink::Sink) -> Result<()> {
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut r = BufReader::with_capacity(1 << 16, file);
+    let (wants_v, wants_f) = (sink.wants_vertices(), sink.wants_faces());
+    if wants_v {
+        sink.begin_vertices(0, Default::default());
+    }
+    let mut counts = [0usize; 3];
+    let mut poly: Vec<u32> = Vec::new();
+    let mut buf = Vec::new();
+    let mut line_no = 0u64;
+    loop {
+        buf.clear();
+        if r.read_until(b'\n', &mut buf)
+            .map_err(|e| Error::io(path, e))?
+            == 0
+        {
+            return Ok(());
+        }
+        line_no += 1;
+        let err = |m: String| Error::parse(path, Location::Line(line_no), m);
+        let text = String::from_utf8_lossy(&buf);
+        let line = text.trim();
+        let (kw, rest) = keyword(line);
+        match kw {
+            "v" => {
+                if wants_v {
+                    let (p, _) = vertex(rest, counts[0], &err)?;
+                    sink.vertex(&crate::io::sink::Vertex {
+                        position: p,
+                        ..Default::default()
+                    });
+                }
+                if counts[0] >= SEAM as usize - 1 {
+                    return Err(err("too many vertices for 32-bit indices".into()));
+                }
+                counts[0] += 1;
+            }
+            "vt" => counts[1] += 1,
+            "vn" => counts[2] += 1,
+            "f" | "fo" if wants_f => {
+                poly.clear();
+                for c in rest.split_ascii_whitespace() {
+                    poly.push(corner(c, counts, &err)?[0]);
+                }
+                fan(&poly, &err, |t| sink.triangle(t))?;
+            }
+            _ => {}
+        }
+    }
+}
+
 fn read_from(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
     let mut positions: Vec<[f32; 3]> = Vec::new();
     let mut colors: Vec<[f32; 4]> = Vec::new();
@@ -109,41 +270,11 @@ fn read_from(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
         let err = |m: String| Error::parse(path, at, m);
         let text = String::from_utf8_lossy(&buf);
         let line = text.trim();
-        let (kw, rest) = match line.find(|c: char| c.is_ascii_whitespace()) {
-            Some(i) => (&line[..i], line[i..].trim()),
-            None => (line, ""),
-        };
-        let floats = |rest: &str, what: &str| -> Result<Vec<f32>> {
-            rest.split_ascii_whitespace()
-                .map(|t| {
-                    let x: f32 = t
-                        .parse()
-                        .map_err(|_| err(format!("{what}: {t:?} is not a number")))?;
-                    if x.is_finite() {
-                        Ok(x)
-                    } else {
-                        Err(err(format!("{what} has a non-finite value {t}")))
-                    }
-                })
-                .collect()
-        };
+        let (kw, rest) = keyword(line);
+        let floats = |rest: &str, what: &str| floats(rest, what, &err);
         match kw {
             "v" => {
-                let what = format!("vertex {}", positions.len() + 1);
-                let f = floats(rest, &what)?;
-                let p = match f.len() {
-                    3 | 6 => [f[0], f[1], f[2]],
-                    4 if f[3] != 0.0 => [f[0] / f[3], f[1] / f[3], f[2] / f[3]],
-                    4 => return Err(err(format!("{what} has w = 0"))),
-                    n => {
-                        return Err(err(format!(
-                            "{what}: expected 3, 4 or 6 numbers, found {n}"
-                        )));
-                    }
-                };
-                if !p.iter().all(|c| c.is_finite()) {
-                    return Err(err(format!("{what} has a non-finite coordinate {p:?}")));
-                }
+                let (p, f) = vertex(rest, positions.len(), &err)?;
                 if f.len() == 6 {
                     if !any_color {
                         any_color = true;
@@ -183,44 +314,8 @@ fn read_from(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
             "f" | "fo" => {
                 poly.clear();
                 for c in rest.split_ascii_whitespace() {
-                    let mut parts = c.split('/');
-                    let mut idx = [NONE; 3];
                     let counts = [positions.len(), texcoords.len(), normals.len()];
-                    let names = ["vertex", "texture coordinate", "normal"];
-                    for k in 0..3 {
-                        let Some(s) = parts.next() else { break };
-                        if s.is_empty() {
-                            if k == 0 {
-                                return Err(err(format!("face corner {c:?} has no vertex index")));
-                            }
-                            continue;
-                        }
-                        let i: i64 = s.parse().map_err(|_| {
-                            err(format!("face corner {c:?}: {s:?} is not an index"))
-                        })?;
-                        let n = counts[k] as i64;
-                        let abs = if i > 0 {
-                            i - 1
-                        } else if i < 0 {
-                            n + i
-                        } else {
-                            return Err(err(format!(
-                                "face corner {c:?}: OBJ indices start at 1, not 0"
-                            )));
-                        };
-                        if abs < 0 || abs >= n {
-                            return Err(err(format!(
-                                "face corner {c:?}: {} index {i} is out of range (only {n} defined before this line)",
-                                names[k]
-                            )));
-                        }
-                        idx[k] = abs as u32;
-                    }
-                    if parts.next().is_some() {
-                        return Err(err(format!(
-                            "face corner {c:?} has more than three indices"
-                        )));
-                    }
+                    let idx = corner(c, counts, &err)?;
                     any_vt_corner |= idx[1] != NONE;
                     any_vn_corner |= idx[2] != NONE;
                     let pos = idx[0] as usize;
@@ -244,17 +339,11 @@ fn read_from(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
                     };
                     poly.push(v);
                 }
-                if poly.len() < 3 {
-                    return Err(err(format!(
-                        "face with {} corners; a face needs at least 3",
-                        poly.len()
-                    )));
-                }
-                for j in 1..poly.len() - 1 {
-                    triangles.push([poly[0], poly[j], poly[j + 1]]);
+                fan(&poly, &err, |t| {
+                    triangles.push(t);
                     face_groups.push(cur_group);
                     face_materials.push(cur_mat);
-                }
+                })?;
             }
             "o" | "g" => {
                 groups.used = true;
