@@ -11,7 +11,6 @@
 use meshslim::cluster::gpu::{GpuClusterMesh, Part, shared};
 use meshslim::cluster::gpu_schedule as sched;
 use meshslim::cluster::grid::Grid;
-use meshslim::mesh::prepare::{frame_of, normalize};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -19,23 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = args.next().ok_or("usage: cluster_gpu_stages MESH [CELL]")?;
     let h: f32 = args.next().map_or(Ok(4.9e-3), |s| s.parse())?;
     let m = meshslim::io::read(std::path::Path::new(&path))?;
-    let (center, scale) = frame_of(&m);
-    let pos: Vec<[f32; 4]> = m
-        .positions
-        .iter()
-        .map(|&p| {
-            let q = normalize(p, center, scale);
-            [q[0] as f32, q[1] as f32, q[2] as f32, 1.0]
-        })
-        .collect();
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for p in &pos {
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i]);
-            hi[i] = hi[i].max(p[i]);
-        }
-    }
+    let (pos, lo, hi) = meshslim::cluster::unit_frame_points(&m);
     let grid = Grid::new(lo, hi, h);
     let sim = shared()?;
     let locked = vec![false; pos.len()];

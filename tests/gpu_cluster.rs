@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::gpu_context;
+use common::{close, gpu_context, pod};
 use meshslim::Mesh;
 use meshslim::cluster::gpu::{GpuClusterMesh, GpuClusterer, Part};
 use meshslim::cluster::gpu_schedule::CBuf;
@@ -13,40 +13,6 @@ use meshslim::cluster::stages::{self, Placement};
 use meshslim::cluster::twins;
 use meshslim::cpu::common::quadric_eval;
 use meshslim::gpu::types::{ClusterPlaced, Quadric, SORT_BLOCK};
-use meshslim::mesh::prepare::{frame_of, normalize};
-
-fn pod<T: bytemuck::Pod>(bytes: Vec<u8>) -> Vec<T> {
-    bytemuck::pod_collect_to_vec(&bytes)
-}
-
-/// Within `tol` of the larger magnitude, or of `scale` when both are smaller (a sum's entry that
-/// cancels to near zero is as exact as the sum's largest term allows).
-fn close(a: f32, b: f32, tol: f32, scale: f32) -> bool {
-    (a - b).abs() <= tol * a.abs().max(b.abs()).max(scale).max(1e-30)
-}
-
-/// The mesh's positions in the unit-diagonal frame, as the clustering driver makes them, and
-/// their box.
-fn points(m: &Mesh) -> (Vec<[f32; 4]>, [f32; 3], [f32; 3]) {
-    let (center, scale) = frame_of(m);
-    let pos: Vec<[f32; 4]> = m
-        .positions
-        .iter()
-        .map(|&p| {
-            let q = normalize(p, center, scale);
-            [q[0] as f32, q[1] as f32, q[2] as f32, 1.0]
-        })
-        .collect();
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for p in &pos {
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i]);
-            hi[i] = hi[i].max(p[i]);
-        }
-    }
-    (pos, lo, hi)
-}
 
 /// Meshes, each with the cell sizes to cluster it at and whether to lock some vertices (every
 /// 7th: singleton keys, the fourth radix pass).
@@ -114,7 +80,7 @@ fn each_cluster_stage_matches_its_cpu_twin() {
     let Some(ctx) = gpu_context() else { return };
     let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
     for (name, m, sizes, lock) in cases() {
-        let (pos, lo, hi) = points(&m);
+        let (pos, lo, hi) = meshslim::cluster::unit_frame_points(&m);
         let locked = locked_of(pos.len(), lock);
         let (nv, nf) = (pos.len(), m.triangles.len());
         let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
@@ -329,7 +295,7 @@ fn the_gpu_build_equals_the_cpu_build() {
     let Some(ctx) = gpu_context() else { return };
     let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
     for (name, m, sizes, lock) in cases() {
-        let (pos, lo, hi) = points(&m);
+        let (pos, lo, hi) = meshslim::cluster::unit_frame_points(&m);
         let locked = locked_of(pos.len(), lock);
         let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
         for h in sizes {

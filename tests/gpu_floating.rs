@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::gpu_context;
+use common::{close, gpu_context};
 use meshslim::Mesh;
 use meshslim::cluster::floating::{self, UNCLAIMED};
 use meshslim::cluster::floating_gpu::FcPart;
@@ -15,35 +15,6 @@ use meshslim::cluster::gpu::{GpuClusterMesh, GpuClusterer, Part};
 use meshslim::cluster::gpu_schedule::CBuf;
 use meshslim::cluster::{stages, twins};
 use meshslim::gpu::types::{ClusterPlaced, Params, Quadric};
-use meshslim::mesh::prepare::{frame_of, normalize};
-
-/// Within `tol` of the larger magnitude, or of `scale` when both are smaller.
-fn close(a: f32, b: f32, tol: f32, scale: f32) -> bool {
-    (a - b).abs() <= tol * a.abs().max(b.abs()).max(scale).max(1e-30)
-}
-
-/// The mesh's positions in the unit-diagonal frame, as the clustering driver makes them, and
-/// their box.
-fn points(m: &Mesh) -> (Vec<[f32; 4]>, [f32; 3], [f32; 3]) {
-    let (center, scale) = frame_of(m);
-    let pos: Vec<[f32; 4]> = m
-        .positions
-        .iter()
-        .map(|&p| {
-            let q = normalize(p, center, scale);
-            [q[0] as f32, q[1] as f32, q[2] as f32, 1.0]
-        })
-        .collect();
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for p in &pos {
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i]);
-            hi[i] = hi[i].max(p[i]);
-        }
-    }
-    (pos, lo, hi)
-}
 
 /// Meshes, each with the nominal radii (unit-diagonal frame) to build at and whether to lock
 /// every 7th vertex (centres of themselves from the start).
@@ -159,7 +130,7 @@ fn each_floating_stage_matches_its_cpu_twin() {
     let Some(ctx) = gpu_context() else { return };
     let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
     for (name, m, radii, lock) in cases() {
-        let (pos, lo, hi) = points(&m);
+        let (pos, lo, hi) = meshslim::cluster::unit_frame_points(&m);
         let locked = locked_of(pos.len(), lock);
         let locked_u32: Vec<u32> = locked.iter().map(|&l| l as u32).collect();
         let (nv, nf) = (pos.len(), m.triangles.len());
@@ -386,7 +357,7 @@ fn each_floating_stage_matches_its_cpu_twin() {
 #[test]
 fn the_floating_twins_are_the_cpu_driver() {
     for (name, m, radii, lock) in cases() {
-        let (pos, lo, hi) = points(&m);
+        let (pos, lo, hi) = meshslim::cluster::unit_frame_points(&m);
         let locked = locked_of(pos.len(), lock);
         let csr = stages::Csr::new(pos.len(), &m.triangles);
         let ranks = floating::ranks(&floating::grades(&pos, &m.triangles, &csr));
@@ -436,7 +407,7 @@ fn the_gpu_floating_build_equals_the_twins_chain() {
     let Some(ctx) = gpu_context() else { return };
     let sim = GpuClusterer::new(&ctx.device, &ctx.queue).unwrap();
     for (name, m, radii, lock) in cases() {
-        let (pos, lo, hi) = points(&m);
+        let (pos, lo, hi) = meshslim::cluster::unit_frame_points(&m);
         let locked = locked_of(pos.len(), lock);
         let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
         let differ = ranks_differing(&mut gpu, &pos, &m.triangles);
@@ -499,7 +470,7 @@ fn simplify_floating_on_the_gpu_writes_the_cpu_parallel_faces() {
         ("torus", meshslim::mesh::torus(1.0, 0.3, 64, 32), 0.05),
     ];
     for (name, m, within) in meshes {
-        let (pos, _, _) = points(&m);
+        let (pos, _, _) = meshslim::cluster::unit_frame_points(&m);
         let locked = vec![false; pos.len()];
         let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
         let differ = ranks_differing(&mut gpu, &pos, &m.triangles);

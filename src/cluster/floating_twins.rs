@@ -8,7 +8,7 @@
 
 use super::floating::{UNCLAIMED, cells_around, grade, hash_grid, radius, rank};
 use super::grid::Grid;
-use super::stages::{self, Csr, Surface};
+use super::stages::{self, Csr};
 use super::twins::{self, CellsOut, ClusterBuild, FacesOut, cluster_params, grid_of, placed_of};
 use crate::cpu::common::{V3, dot, sub, xyz};
 use crate::gpu::types::{ClusterParams, ClusterPlaced, FloatParams, Params, Quadric};
@@ -235,19 +235,8 @@ pub fn fc_quadrics(
     cluster_placed: &mut [ClusterPlaced], // per cluster
     cluster_quadric: &mut [Quadric],      // per cluster
 ) {
-    let csr = Csr {
-        offsets: offsets.to_vec(),
-        vertex_faces: vertex_faces.to_vec(),
-    };
-    let border = vec![false; cluster.vertex_count as usize];
-    let surface = Surface {
-        positions,
-        faces: bytemuck::cast_slice(&indices[..3 * cluster.face_count as usize]),
-        planes: face_normals,
-        csr: &csr,
-        border: &border,
-        border_weight: 0.0,
-    };
+    let (csr, border) = twins::gather_lists(cluster, offsets, vertex_faces);
+    let surface = twins::gather_surface(cluster, positions, indices, face_normals, &csr, &border);
     for k in 0..cell_head[cluster.vertex_count as usize] as usize {
         let members = &sort_vals[cell_start[k] as usize..cell_start[k + 1] as usize];
         let centre = fc_centre[members[0] as usize] as usize;

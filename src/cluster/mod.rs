@@ -54,6 +54,43 @@ struct Points<'m> {
     stream: Option<stream::FileFaces>,
 }
 
+/// `mesh`'s positions in the unit-diagonal frame ([`frame_of`]), w = 1, as every clustering
+/// build takes them, and their box: what the GPU tests and examples upload too.
+pub fn unit_frame_points(mesh: &Mesh) -> (Vec<[f32; 4]>, V3, V3) {
+    let (center, scale) = frame_of(mesh);
+    let positions: Vec<[f32; 4]> = mesh
+        .positions
+        .par_iter()
+        .with_min_len(4096)
+        .map(|&p| {
+            let q = normalize(p, center, scale);
+            [q[0] as f32, q[1] as f32, q[2] as f32, 1.0]
+        })
+        .collect();
+    let (lo, hi) = positions
+        .par_iter()
+        .with_min_len(4096)
+        .fold(
+            || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+            |(lo, hi), p| {
+                (
+                    [0, 1, 2].map(|i| lo[i].min(p[i])),
+                    [0, 1, 2].map(|i| hi[i].max(p[i])),
+                )
+            },
+        )
+        .reduce(
+            || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+            |a, b| {
+                (
+                    [0, 1, 2].map(|i| a.0[i].min(b.0[i])),
+                    [0, 1, 2].map(|i| a.1[i].max(b.1[i])),
+                )
+            },
+        );
+    (positions, lo, hi)
+}
+
 impl<'m> Points<'m> {
     /// The input's vertices as they are: coincident ones share a cell anyway, and the
     /// connectivity split joins them.
@@ -65,35 +102,7 @@ impl<'m> Points<'m> {
     fn of(mesh: &Mesh, faces: std::borrow::Cow<'m, [[u32; 3]]>) -> Points<'m> {
         let (center, scale) = frame_of(mesh);
         let attr: Vec<u32> = (0..mesh.positions.len() as u32).collect();
-        let positions: Vec<[f32; 4]> = attr
-            .par_iter()
-            .with_min_len(4096)
-            .map(|&v| {
-                let q = normalize(mesh.positions[v as usize], center, scale);
-                [q[0] as f32, q[1] as f32, q[2] as f32, 1.0]
-            })
-            .collect();
-        let (lo, hi) = positions
-            .par_iter()
-            .with_min_len(4096)
-            .fold(
-                || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
-                |(lo, hi), p| {
-                    (
-                        [0, 1, 2].map(|i| lo[i].min(p[i])),
-                        [0, 1, 2].map(|i| hi[i].max(p[i])),
-                    )
-                },
-            )
-            .reduce(
-                || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
-                |a, b| {
-                    (
-                        [0, 1, 2].map(|i| a.0[i].min(b.0[i])),
-                        [0, 1, 2].map(|i| a.1[i].max(b.1[i])),
-                    )
-                },
-            );
+        let (positions, lo, hi) = unit_frame_points(mesh);
         Points {
             positions,
             faces,

@@ -358,3 +358,14 @@ pub fn gpu_context() -> Option<&'static meshslim::gpu::GpuContext> {
         }
     }
 }
+
+/// Within `tol` of the larger magnitude, or of `scale` when both are smaller (a sum's entry that
+/// cancels to near zero is as exact as the sum's largest term allows).
+pub fn close(a: f32, b: f32, tol: f32, scale: f32) -> bool {
+    (a - b).abs() <= tol * a.abs().max(b.abs()).max(scale).max(1e-30)
+}
+
+/// A GPU buffer's bytes as `T`s.
+pub fn pod<T: bytemuck::Pod>(bytes: Vec<u8>) -> Vec<T> {
+    bytemuck::pod_collect_to_vec(&bytes)
+}
