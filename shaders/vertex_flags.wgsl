@@ -70,7 +70,8 @@ fn vertex_flags(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     if (border && params.lock_border != 0u) {
         pinned = true;
     }
-    var fl = flags[v] & FLAG_SEAM;
+    // SEAM and the caller's pins come from the host; the rest is found here.
+    var fl = flags[v] & (FLAG_SEAM | FLAG_PINNED);
     if (border) { fl = fl | FLAG_BORDER; }
     if (pinned) { fl = fl | FLAG_PINNED; }
     flags[v] = fl;

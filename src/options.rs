@@ -103,6 +103,12 @@ pub struct SimplifyOptions {
     /// for meshes of 100,000 faces or more and 1 (purely sequential) below. The result depends
     /// on this number, never on the number of threads.
     pub partitions: Option<usize>,
+    /// Input vertex ids (indices into the positions) that keep their position and are never
+    /// removed, though a free neighbour may collapse onto them: a tile's border, so that the
+    /// neighbouring tile, simplified apart, still meets it there. QEM methods only. The `cpu`
+    /// backend also refuses a collapse that joins two pinned vertices by a new edge (the tile
+    /// next door may hold it); the rounds (`cpu-parallel`, `gpu`) keep the pins but not that.
+    pub pin: Vec<u32>,
     /// Set from another thread to stop a running simplification (the viewer's Cancel button):
     /// it then returns [`Error::Cancelled`] within one round or a few thousand collapses.
     pub cancel: Cancel,
@@ -160,6 +166,7 @@ impl SimplifyOptions {
             backend: Backend::Cpu,
             method: Method::Qem,
             partitions: None,
+            pin: Vec::new(),
             cancel: Cancel::default(),
         }
     }

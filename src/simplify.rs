@@ -26,6 +26,22 @@ pub fn simplify_with_progress(
             mesh.positions.len()
         )));
     }
+    if let Some(&v) = opts
+        .pin
+        .iter()
+        .find(|&&v| v as usize >= mesh.positions.len())
+    {
+        return Err(Error::InvalidOption(format!(
+            "pinned vertex {v} is past the mesh's {} vertices",
+            mesh.positions.len()
+        )));
+    }
+    if !opts.pin.is_empty() && opts.method != Method::Qem {
+        return Err(Error::InvalidOption(format!(
+            "--method {} cannot pin vertices (a cell merges whatever falls in it); use qem",
+            opts.method.name()
+        )));
+    }
     match opts.method {
         Method::Qem => {}
         Method::Cluster => return crate::cluster::simplify_cluster(mesh, opts, progress),
@@ -68,9 +84,12 @@ fn run(
     };
     match backend {
         Backend::Cpu => crate::greedy::simplify_greedy(mesh, opts, progress),
-        Backend::CpuParallel => {
-            crate::cpu::simplify_upload(&crate::parallel::Upload::new(mesh), mesh, opts, progress)
-        }
+        Backend::CpuParallel => crate::cpu::simplify_upload(
+            &crate::parallel::Upload::pinned(mesh, &opts.pin),
+            mesh,
+            opts,
+            progress,
+        ),
         Backend::Gpu => crate::gpu::simplify_gpu(mesh, opts, progress),
         Backend::Auto => Err(Error::Internal(
             "Backend::Auto reached a backend unresolved".into(),

@@ -47,7 +47,7 @@ pub fn vertex_flags(
     indices: &[u32],      // per face × 3
     offsets: &[u32],      // per vertex + 1
     vertex_faces: &[u32], // per corner
-    flags: &mut [u32],    // per vertex: in SEAM from the host, out with BORDER and PINNED
+    flags: &mut [u32],    // per vertex: in SEAM and the caller's PINNED, out with BORDER too
 ) {
     par_for_mut(&mut flags[..params.vertex_count as usize], |v, fl| {
         let list = faces_of(offsets, vertex_faces, v);
@@ -69,7 +69,7 @@ pub fn vertex_flags(
         if border && params.lock_border != 0 {
             pinned = true;
         }
-        *fl = (*fl & flag::SEAM)
+        *fl = (*fl & (flag::SEAM | flag::PINNED))
             | if border { flag::BORDER } else { 0 }
             | if pinned { flag::PINNED } else { 0 };
     });

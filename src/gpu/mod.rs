@@ -58,7 +58,14 @@ pub fn simplify_with(
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
-    simplify_upload(ctx, sim, &Upload::new(mesh), mesh, opts, progress)
+    simplify_upload(
+        ctx,
+        sim,
+        &Upload::pinned(mesh, &opts.pin),
+        mesh,
+        opts,
+        progress,
+    )
 }
 
 /// The rounds on a prepared upload (`hybrid` carries its clusters' quadrics in it); `mesh` is

@@ -273,6 +273,7 @@ impl<'a> State<'a> {
         let mut edge_faces = 0u32;
         let mut opposite = [u32::MAX; 2];
         let mut common = 0u32;
+        let held_k = self.p.held[k];
         for &f in self.vert_faces.get(r) {
             if self.topo_faces[f as usize][0] == DEAD {
                 continue;
@@ -289,11 +290,18 @@ impl<'a> State<'a> {
                 edge_faces += 1;
             }
             for u in t {
-                if u != keep && u != remove && self.mark[u as usize] == m {
-                    // Counted once however many of remove's faces it is on: re-marking
-                    // replaced collecting them all and sorting out the duplicates.
-                    self.mark[u as usize] = m + 1;
-                    common += 1;
+                if u != keep && u != remove {
+                    if self.mark[u as usize] == m {
+                        // Counted once however many of remove's faces it is on: re-marking
+                        // replaced collecting them all and sorting out the duplicates.
+                        self.mark[u as usize] = m + 1;
+                        common += 1;
+                    } else if held_k && self.mark[u as usize] != m + 1 && self.p.held[u as usize] {
+                        // A new edge between two caller-pinned vertices (a tile's border):
+                        // the tile next door may have that edge, and the weld would give it
+                        // three faces.
+                        return Evaluation::Refused;
+                    }
                 }
             }
         }

@@ -48,6 +48,9 @@ pub(crate) struct Prepared {
     pub pos: Vec<[f64; 3]>,
     pub quadrics: Vec<Quadric>,
     pub mobility: Vec<Mobility>,
+    /// Pinned by the caller (`SimplifyOptions::pin`, a tile's border): no collapse may join two
+    /// of these by a new edge, since the neighbouring tile may hold that edge already.
+    pub held: Vec<bool>,
     pub border: Vec<bool>,
     /// More than one attribute vertex at this position.
     pub seam: Vec<bool>,
@@ -67,7 +70,7 @@ impl Prepared {
             faces,
             face_origin,
             dropped_degenerate,
-            weld_remap: _,
+            weld_remap,
             center,
             scale,
         } = surface;
@@ -109,7 +112,8 @@ impl Prepared {
         // sequential pass over all edges with a union-find over all corners took 0.12 s.
         // Straight into the three arrays: collecting tuples and copying them out took 0.027 s,
         // on one core, of the 0.25 s set-up of the 1M scan.
-        let (quadrics, (mobility, border)): (Vec<Quadric>, (Vec<Mobility>, Vec<bool>)) = (0..nt)
+        let (quadrics, (mut mobility, border)): (Vec<Quadric>, (Vec<Mobility>, Vec<bool>)) = (0
+            ..nt)
             .into_par_iter()
             .map_init(
                 || (Vec::new(), Vec::new()),
@@ -223,6 +227,13 @@ impl Prepared {
                 },
             )
             .unzip();
+        // The caller's pins (a tile's border) override whatever the vertex would be.
+        let mut held = vec![false; nt];
+        for &v in &opts.pin {
+            let t = topo[weld_remap[v as usize] as usize] as usize;
+            mobility[t] = Mobility::Pinned;
+            held[t] = true;
+        }
         Prepared {
             mesh,
             topo,
@@ -233,6 +244,7 @@ impl Prepared {
             pos,
             quadrics,
             mobility,
+            held,
             border,
             seam: attr_count.iter().map(|&c| c > 1).collect(),
             center,
@@ -309,6 +321,7 @@ impl Prepared {
                     }
                 })
                 .collect(),
+            held: (0..n).map(|l| self.held[pick(l)]).collect(),
             border: (0..n).map(|l| self.border[pick(l)]).collect(),
             seam: (0..n).map(|l| self.seam[pick(l)]).collect(),
             center: self.center,

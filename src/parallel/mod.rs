@@ -109,7 +109,13 @@ pub struct Download {
 
 impl Upload {
     pub fn new(input: &Mesh) -> Upload {
-        Upload::from_surface(Surface::new(input), None)
+        Upload::pinned(input, &[])
+    }
+
+    /// As [`Upload::new`], with the input vertices `pin` flagged PINNED, which `vertex_flags`
+    /// keeps (`SimplifyOptions::pin`: a tile's border).
+    pub fn pinned(input: &Mesh, pin: &[u32]) -> Upload {
+        Upload::from_surface(Surface::new(input), None, pin)
     }
 
     /// The upload of `input` in the frame `(center, scale)`, with each input vertex's quadric
@@ -125,13 +131,14 @@ impl Upload {
             .zip(&surface.weld_remap)
             .map(|(q, &w)| (surface.class[w as usize], q))
             .collect::<Vec<_>>();
-        Upload::from_surface(surface, Some(carried))
+        Upload::from_surface(surface, Some(carried), &[])
     }
 
-    /// `carried`: (class, quadric) pairs to sum per class.
+    /// `carried`: (class, quadric) pairs to sum per class; `pin`: input vertices to pin.
     fn from_surface(
         surface: Surface,
         carried: Option<Vec<(u32, &crate::gpu::types::Quadric)>>,
+        pin: &[u32],
     ) -> Upload {
         let s = &surface;
         // Classes the faces use, renumbered densely (still in Morton order).
@@ -172,6 +179,12 @@ impl Upload {
             .map(|(&attr, &origin)| FaceExtra { attr, origin })
             .collect();
         let seams = flags.iter().filter(|&&f| f != 0).count();
+        for &v in pin {
+            let d = dense[s.class[s.weld_remap[v as usize] as usize] as usize];
+            if d != u32::MAX {
+                flags[d as usize] |= flag::PINNED;
+            }
+        }
         let quadrics = carried.map(|pairs| {
             let mut q = vec![crate::gpu::types::Quadric::default(); n as usize];
             for (c, x) in pairs {
