@@ -51,7 +51,7 @@ struct Points<'m> {
     area: f64,
     /// `--stream`: the faces stay in the file and are read a block at a time (`faces` is
     /// empty).
-    stream: Option<stream::FileFaces>,
+    stream: Option<crate::io::stream::FileFaces>,
 }
 
 /// `mesh`'s positions in the unit-diagonal frame ([`frame_of`]), w = 1, as every clustering
@@ -118,7 +118,7 @@ impl<'m> Points<'m> {
 
     /// Calls `f` with the faces in blocks, in face order, with each block's first face id: all
     /// at once in memory, a block at a time from the file when streaming.
-    fn blocks(&self, f: &mut stream::OnBlock) -> Result<()> {
+    fn blocks(&self, f: &mut crate::io::stream::OnBlock) -> Result<()> {
         match &self.stream {
             None => f(0, &self.faces),
             Some(s) => s.blocks(f),

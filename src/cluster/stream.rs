@@ -13,108 +13,12 @@
 
 use super::{Built, ClusterReport, Points, StopReason, cluster_to, max_error, prepare, tally};
 use crate::error::{Error, Result};
-use crate::io::sink::{Sink, Vertex};
+use crate::io::stream::{BLOCK, FileFaces, read_positions};
 use crate::mesh::Mesh;
 use crate::mesh::prepare::denormalize;
 use crate::options::{Backend, Method, SimplifyOptions, SimplifyReport};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
-
-/// Triangles a streaming pass holds at once: 12 MiB of indices.
-pub const BLOCK: usize = 1 << 20;
-
-/// The faces of a file, read again in blocks at each pass.
-pub struct FileFaces {
-    path: PathBuf,
-    /// Triangles a block holds ([`BLOCK`]; less in tests, to cross block borders).
-    block: usize,
-    /// Triangles in the file (after fan triangulation), counted by the first face pass.
-    pub faces: usize,
-}
-
-/// A consumer of faces in blocks: each block with its first face's id.
-pub type OnBlock<'f> = dyn FnMut(usize, &[[u32; 3]]) -> Result<()> + 'f;
-
-/// Hands blocks of triangles to a consumer as the reader produces them.
-struct Blocks<'f> {
-    buf: Vec<[u32; 3]>,
-    block: usize,
-    first: usize,
-    f: &'f mut OnBlock<'f>,
-    /// The consumer's first error: the rest of the file is read but not handed over.
-    failed: Option<Error>,
-}
-
-impl Blocks<'_> {
-    fn flush(&mut self) {
-        if self.failed.is_none()
-            && !self.buf.is_empty()
-            && let Err(e) = (self.f)(self.first, &self.buf)
-        {
-            self.failed = Some(e);
-        }
-        self.first += self.buf.len();
-        self.buf.clear();
-    }
-}
-
-impl Sink for Blocks<'_> {
-    fn wants_vertices(&self) -> bool {
-        false
-    }
-    fn vertex(&mut self, _: &Vertex) {}
-    fn triangle(&mut self, t: [u32; 3]) {
-        self.buf.push(t);
-        if self.buf.len() == self.block {
-            self.flush();
-        }
-    }
-}
-
-impl FileFaces {
-    /// Calls `f` with the file's triangles in blocks, in file order, with each block's first
-    /// face id.
-    pub fn blocks(&self, f: &mut OnBlock) -> Result<()> {
-        let mut b = Blocks {
-            buf: Vec::with_capacity(self.block),
-            block: self.block,
-            first: 0,
-            f,
-            failed: None,
-        };
-        read_into(&self.path, &mut b)?;
-        b.flush();
-        match b.failed {
-            Some(e) => Err(e),
-            None => Ok(()),
-        }
-    }
-}
-
-/// A streaming read of a PLY or an OBJ (by positions alone, `obj::read_into`).
-fn read_into(path: &Path, sink: &mut dyn Sink) -> Result<()> {
-    match crate::io::Format::from_path(path)? {
-        crate::io::Format::Obj => crate::io::obj::read_into(path, sink),
-        _ => crate::io::ply::read_into(path, sink),
-    }
-}
-
-/// The vertex pass: positions only, the faces not read.
-#[derive(Default)]
-struct Positions(Vec<[f32; 3]>);
-
-impl Sink for Positions {
-    fn wants_faces(&self) -> bool {
-        false
-    }
-    fn begin_vertices(&mut self, reserve: usize, _: crate::io::sink::VertexAttributes) {
-        self.0.reserve(reserve);
-    }
-    fn vertex(&mut self, v: &Vertex) {
-        self.0.push(v.position);
-    }
-    fn triangle(&mut self, _: [u32; 3]) {}
-}
 
 /// How many faces to keep, once the file's count is known.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -172,21 +76,16 @@ pub fn simplify_file_in_blocks(
         ));
     }
     let t = Instant::now();
-    let mut raw = Positions::default();
-    read_into(path, &mut raw)?;
-    let vertices = raw.0.len();
+    let positions = read_positions(path)?;
+    let vertices = positions.len();
     let mut pts = {
         let m = Mesh {
-            positions: raw.0,
+            positions,
             ..Mesh::default()
         };
         Points::of(&m, Vec::new().into())
     };
-    pts.stream = Some(FileFaces {
-        path: path.to_path_buf(),
-        block,
-        faces: 0,
-    });
+    pts.stream = Some(FileFaces::new(path, block));
     // The area pass counts the faces too: --ratio needs the count.
     let mut work = prepare(&mut pts, opts, hybrid)?;
     let faces = work.pts.face_count();

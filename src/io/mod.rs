@@ -15,6 +15,7 @@ pub mod obj;
 pub mod ply;
 pub mod sink;
 pub mod stl;
+pub mod stream;
 
 use std::io::{BufWriter, Write};
 use std::path::{Component, Path};
