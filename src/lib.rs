@@ -51,6 +51,7 @@ pub mod options;
 pub mod parallel;
 mod quadric;
 pub mod simplify;
+pub mod tiles;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 

@@ -20,6 +20,7 @@ mod info;
 mod memory;
 mod report;
 mod simplify;
+mod tiles;
 mod view;
 
 use std::process::ExitCode;
@@ -38,6 +39,8 @@ pub use info::InfoArgs;
 use info::{INFO_AFTER_HELP, run_info};
 pub use simplify::{BackendArg, GETTING_STARTED, SimplifyArgs};
 use simplify::{SIMPLIFY_AFTER_HELP, run_simplify};
+pub use tiles::TilesArgs;
+use tiles::{TILES_AFTER_HELP, run_tiles};
 pub use view::ViewArgs;
 use view::{VIEW_AFTER_HELP, run_view};
 
@@ -49,6 +52,7 @@ Examples:
   meshslim info builtin:torus --json
   meshslim compare scan.ply scan-5k.obj
   meshslim bench --json bench.json --plot bench.svg
+  meshslim tiles split scan.ply work --tiles 16 --ratio 0.01
 
 Run 'meshslim <COMMAND> --help' for every option of a command.";
 
@@ -80,6 +84,10 @@ pub enum Command {
     /// --screenshot, which needs no window system
     #[command(after_help = VIEW_AFTER_HELP)]
     View(ViewArgs),
+    /// Split a scan into tiles, simplify each as its own job (a Slurm array task, a Kubernetes
+    /// Indexed Job, or here), and merge them across the former borders
+    #[command(after_help = TILES_AFTER_HELP)]
+    Tiles(TilesArgs),
 }
 
 /// The exit code for an error [`run`] returned: 2 for bad usage, 1 for everything else.
@@ -104,6 +112,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Some(Command::Compare(args)) => run_compare(args),
         Some(Command::Bench(args)) => run_bench(args),
         Some(Command::View(args)) => run_view(args),
+        Some(Command::Tiles(args)) => run_tiles(args),
     }
 }
 

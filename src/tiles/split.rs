@@ -1,0 +1,271 @@
+//! `tiles split`: the input streamed into tiles. Memory holds the positions (12 B a vertex), each
+//! vertex's first tile and local id (8 B), a bit for the border, and the border vertices' other
+//! tiles; the faces pass through in blocks twice and go to one file per tile.
+
+use super::{FORMAT, Manifest, TILE_SHARE, Tile, at, grid_for};
+use crate::Backend;
+use crate::cluster::stream::Target;
+use crate::error::{Error, Result};
+use crate::io::stream::{FileFaces, read_positions};
+use rustc_hash::FxHashMap;
+use std::io::{BufWriter, Read, Write};
+use std::path::Path;
+
+/// At most this many tiles: a split keeps two files open per tile.
+pub const MAX_TILES: usize = 256;
+
+/// What `tiles split` is asked.
+#[derive(Debug, Clone)]
+pub struct SplitOptions {
+    pub tiles: usize,
+    /// The faces the merge ends at.
+    pub target: Target,
+    /// Simplifies the tiles and the merge: `cpu`, the one backend whose pins also refuse a new
+    /// edge between two pinned vertices (the rounds' do not yet, and two tiles could then
+    /// both hold an edge the weld would give three faces).
+    pub backend: Backend,
+    /// Triangles per streamed block ([`crate::io::stream::BLOCK`]; less in tests).
+    pub block: usize,
+}
+
+/// Splits the PLY or OBJ at `input` into `opts.tiles` tiles in `dir` (created if missing),
+/// writing each tile's PLY and ids and the manifest, which it returns. `progress` receives the
+/// fraction done.
+pub fn split(
+    input: &Path,
+    dir: &Path,
+    opts: &SplitOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<Manifest> {
+    if opts.tiles == 0 || opts.tiles > MAX_TILES {
+        return Err(Error::InvalidOption(format!(
+            "--tiles must be 1 to {MAX_TILES} (two files are open per tile while splitting), got {}",
+            opts.tiles
+        )));
+    }
+    if opts.backend != Backend::Cpu {
+        return Err(Error::InvalidOption(format!(
+            "tiles are simplified by the cpu backend; {} cannot keep two tiles' borders apart yet",
+            opts.backend.name()
+        )));
+    }
+    let format = crate::io::Format::from_path(input)?;
+    if !matches!(format, crate::io::Format::Ply | crate::io::Format::Obj) {
+        return Err(Error::InvalidOption(format!(
+            "tiles split streams PLY and OBJ files; {} is neither: convert it first \
+             (meshslim simplify IN OUT.ply --ratio 1)",
+            input.display()
+        )));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let positions = read_positions(input)?;
+    let cells = Cells::new(&positions, opts.tiles);
+    let faces = FileFaces::new(input, opts.block);
+    let tile_of = |t: &[u32; 3]| cells.tile(t.map(|v| positions[v as usize]));
+    progress(0.1);
+
+    // Pass 1: each vertex's first tile, and whether a face of another tile uses it too.
+    let nv = positions.len();
+    let mut first = vec![u32::MAX; nv];
+    let mut border = vec![false; nv];
+    let mut tile_faces = vec![0u64; opts.tiles];
+    faces.blocks(&mut |_, block| {
+        for t in block {
+            let k = tile_of(t);
+            tile_faces[k as usize] += 1;
+            for v in t.map(|v| v as usize) {
+                if first[v] == u32::MAX {
+                    first[v] = k;
+                } else if first[v] != k {
+                    border[v] = true;
+                }
+            }
+        }
+        Ok(())
+    })?;
+    let total: u64 = tile_faces.iter().sum();
+    if total == 0 {
+        return Err(Error::InvalidMesh(format!(
+            "{} has no faces, so there is nothing to split",
+            input.display()
+        )));
+    }
+    let target_faces = match opts.target {
+        Target::Faces(n) => n as u64,
+        Target::Ratio(r) => {
+            crate::SimplifyOptions::with_ratio(total as usize, r)?.target_faces as u64
+        }
+    };
+    drop(first);
+    progress(0.4);
+
+    // Pass 2: faces renumbered per tile in order of first use, written as binary PLY face
+    // records to a part file per tile; each tile's global ids appended as they are numbered.
+    let name = |i: usize, ext: &str| format!("tile-{i:04}{ext}");
+    let mut writers = Vec::with_capacity(opts.tiles);
+    for i in 0..opts.tiles {
+        let open = |ext: &str| -> Result<BufWriter<std::fs::File>> {
+            let p = at(dir, &name(i, ext));
+            let f = std::fs::File::create(&p).map_err(|e| Error::io(&p, e))?;
+            Ok(BufWriter::with_capacity(1 << 16, f))
+        };
+        writers.push((open(".faces.part")?, open(".ids.part")?));
+    }
+    let mut count = vec![0u32; opts.tiles];
+    // Non-border vertices have one tile and so one local id; border vertices one per tile.
+    let mut local = vec![u32::MAX; nv];
+    let mut local_border: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+    let mut done = 0u64;
+    faces.blocks(&mut |_, block| {
+        for t in block {
+            let k = tile_of(t);
+            let (fw, iw) = &mut writers[k as usize];
+            let mut rec = [0u8; 13];
+            rec[0] = 3;
+            for (c, &v) in t.iter().enumerate() {
+                let slot = if border[v as usize] {
+                    local_border.entry((k, v)).or_insert(u32::MAX)
+                } else {
+                    &mut local[v as usize]
+                };
+                if *slot == u32::MAX {
+                    *slot = count[k as usize];
+                    count[k as usize] += 1;
+                    iw.write_all(&v.to_le_bytes())
+                        .map_err(|e| Error::io(dir, e))?;
+                }
+                rec[1 + 4 * c..5 + 4 * c].copy_from_slice(&slot.to_le_bytes());
+            }
+            fw.write_all(&rec).map_err(|e| Error::io(dir, e))?;
+        }
+        done += block.len() as u64;
+        progress(0.4 + 0.4 * done as f32 / total as f32);
+        Ok(())
+    })?;
+    drop(local);
+    let mut borders: Vec<Vec<u32>> = vec![Vec::new(); opts.tiles];
+    for &(k, v) in local_border.keys() {
+        borders[k as usize].push(v);
+    }
+    drop(local_border);
+
+    // Each tile's PLY: the header, its vertices looked up by global id, its face records.
+    let mut tile = Vec::with_capacity(opts.tiles);
+    for (i, (fw, iw)) in writers.into_iter().enumerate() {
+        for w in [fw, iw] {
+            w.into_inner()
+                .map_err(|e| Error::io(dir, e.into_error()))?
+                .sync_all()
+                .map_err(|e| Error::io(dir, e))?;
+        }
+        let part = |ext: &str| at(dir, &name(i, ext));
+        let ids = super::read_ids(&part(".ids.part"))?;
+        let ply = part(".ply");
+        crate::io::write_atomic(&ply, |w| {
+            write!(
+                w,
+                "ply\nformat binary_little_endian 1.0\ncomment meshslim tile {i} of {}\n\
+                 element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+                 element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+                opts.tiles,
+                ids.len(),
+                tile_faces[i]
+            )?;
+            for &g in &ids {
+                for x in positions[g as usize] {
+                    w.write_all(&x.to_le_bytes())?;
+                }
+            }
+            let mut body = std::fs::File::open(part(".faces.part"))?;
+            let mut buf = vec![0u8; 1 << 16];
+            loop {
+                let n = body.read(&mut buf)?;
+                if n == 0 {
+                    break Ok(());
+                }
+                w.write_all(&buf[..n])?;
+            }
+        })?;
+        std::fs::remove_file(part(".faces.part"))
+            .map_err(|e| Error::io(&part(".faces.part"), e))?;
+        std::fs::rename(part(".ids.part"), part(".ids"))
+            .map_err(|e| Error::io(&part(".ids"), e))?;
+        let mut b = std::mem::take(&mut borders[i]);
+        b.sort_unstable();
+        let share = target_faces as f64 * TILE_SHARE * tile_faces[i] as f64 / total as f64;
+        tile.push(Tile {
+            file: name(i, ".ply"),
+            ids: name(i, ".ids"),
+            output: name(i, ".out.ply"),
+            output_ids: name(i, ".out.ids"),
+            faces: tile_faces[i],
+            vertices: ids.len() as u64,
+            target_faces: (share.round() as u64).min(tile_faces[i]),
+            border: b,
+        });
+        progress(0.8 + 0.2 * (i + 1) as f32 / opts.tiles as f32);
+    }
+    let manifest = Manifest {
+        format: FORMAT.into(),
+        input: input.display().to_string(),
+        input_faces: total,
+        input_vertices: nv as u64,
+        target_faces,
+        backend: opts.backend.name().into(),
+        grid: cells.grid,
+        tiles: opts.tiles,
+        tile,
+    };
+    // Outputs of an earlier split in this folder would be merged with the new tiles: remove them.
+    for t in &manifest.tile {
+        for f in [&t.output, &t.output_ids] {
+            let _ = std::fs::remove_file(at(dir, f));
+        }
+    }
+    manifest.write(dir)?;
+    Ok(manifest)
+}
+
+/// The grid of tiles over the box of the positions.
+struct Cells {
+    min: [f64; 3],
+    /// Cells per unit length, per axis.
+    inv: [f64; 3],
+    grid: [u32; 3],
+}
+
+impl Cells {
+    fn new(positions: &[[f32; 3]], tiles: usize) -> Cells {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in positions {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k] as f64);
+                hi[k] = hi[k].max(p[k] as f64);
+            }
+        }
+        let ext = [0, 1, 2].map(|k| (hi[k] - lo[k]).max(0.0));
+        let grid = grid_for(tiles, ext);
+        Cells {
+            min: lo,
+            inv: [0, 1, 2].map(|k| {
+                if ext[k] > 0.0 {
+                    grid[k] as f64 / ext[k]
+                } else {
+                    0.0
+                }
+            }),
+            grid,
+        }
+    }
+
+    /// The tile of a face: the cell its centroid falls in, clamped to the grid.
+    fn tile(&self, t: [[f32; 3]; 3]) -> u32 {
+        let c = [0, 1, 2].map(|k| {
+            let centroid = (t[0][k] as f64 + t[1][k] as f64 + t[2][k] as f64) / 3.0;
+            let x = ((centroid - self.min[k]) * self.inv[k]).floor();
+            (x.max(0.0) as u32).min(self.grid[k] - 1)
+        });
+        c[0] + self.grid[0] * (c[1] + self.grid[1] * c[2])
+    }
+}
