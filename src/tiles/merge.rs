@@ -44,6 +44,12 @@ pub fn merge(dir: &Path, progress: &mut dyn FnMut(f32)) -> Result<(Mesh, MergeRe
     ))
 }
 
+/// The simplified tiles of `dir` welded, before the merge simplifies them: the seams of pinned
+/// vertices still there (examples/tiles_borders.rs shows them).
+pub fn welded(dir: &Path) -> Result<Mesh> {
+    Ok(weld(dir, &Manifest::read(dir)?)?.0)
+}
+
 /// The tiles' outputs in index order as one mesh, vertices with the same global id joined;
 /// also how many vertices were joined to one of an earlier tile.
 fn weld(dir: &Path, m: &Manifest) -> Result<(Mesh, usize)> {

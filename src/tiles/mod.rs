@@ -23,7 +23,7 @@ mod merge;
 mod simplify;
 mod split;
 
-pub use merge::{MergeReport, merge};
+pub use merge::{MergeReport, merge, welded};
 pub use simplify::{TileReport, simplify_tile};
 pub use split::{SplitOptions, split};
 
