@@ -20,11 +20,9 @@ fn noisy_torus() -> Mesh {
 
 fn split_opts(tiles: usize, ratio: f64) -> SplitOptions {
     SplitOptions {
-        tiles,
-        target: Target::Ratio(ratio),
-        backend: Backend::Cpu,
         // Small blocks: the two face passes cross many block borders.
         block: 777,
+        ..SplitOptions::new(tiles, Target::Ratio(ratio))
     }
 }
 
@@ -169,7 +167,7 @@ fn the_merge_welds_the_tiles_shut_and_thins_the_former_borders() {
         assert_eq!(r.border_vertices, man.tile[i].border.len());
         assert!(r.output_faces < r.input_faces);
     }
-    let (out, report) = merge(&tiles, &mut |_| {}).unwrap();
+    let (out, report) = merge(&tiles, u64::MAX, &mut |_| {}).unwrap();
     assert_eq!(out.triangles.len() as u64, man.target_faces);
     assert!(report.joined_vertices > 0);
     // Welded shut: the torus is closed, and so is the result.
@@ -190,6 +188,50 @@ fn the_merge_welds_the_tiles_shut_and_thins_the_former_borders() {
     assert!(
         survivors * 5 < border.len(),
         "{survivors} of {} former border vertices left",
+        border.len()
+    );
+}
+
+#[test]
+fn a_merge_over_its_memory_tiles_again_with_the_cuts_moved() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = noisy_torus();
+    let input = dir.path().join("torus.ply");
+    meshslim::io::write(&input, &m).unwrap();
+    let tiles = dir.path().join("tiles");
+    let man = split(&input, &tiles, &split_opts(8, 0.05), &mut |_| {}).unwrap();
+    for i in 0..man.tiles {
+        simplify_tile(&tiles, i, &mut |_| {}).unwrap();
+    }
+    // One byte: nothing fits, so the coarser level is the last word.
+    let (out, report) = merge(&tiles, 1, &mut |_| {}).unwrap();
+    let coarser = report.coarser.as_ref().expect("tiled again");
+    assert!(report.simplify.is_none() && coarser.simplify.is_none());
+    let level = Manifest::read(&tiles.join("coarser")).unwrap();
+    assert_eq!(level.tiles, 2);
+    assert_ne!(level.shift, [0.0; 3]);
+    let target = man.target_faces as f64;
+    let faces = out.triangles.len() as f64;
+    assert!(
+        (faces - target).abs() < 0.1 * target,
+        "{faces} faces for {target}"
+    );
+    let topo = meshslim::mesh::topology(&out);
+    assert!(topo.is_closed() && topo.is_manifold(), "{topo:?}");
+    // The first level's seams were inside the coarser tiles, and thinned there.
+    let border: BTreeSet<[u32; 3]> = man
+        .tile
+        .iter()
+        .flat_map(|t| t.border.iter().map(|&v| bits(m.positions[v as usize])))
+        .collect();
+    let survivors = out
+        .positions
+        .iter()
+        .filter(|&&p| border.contains(&bits(p)))
+        .count();
+    assert!(
+        survivors * 4 < border.len(),
+        "{survivors} of {} first-level border vertices left",
         border.len()
     );
 }

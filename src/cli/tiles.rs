@@ -99,6 +99,10 @@ pub struct MergeArgs {
     /// The merged, simplified mesh (.ply, .obj, .stl, .gltf, .glb)
     #[arg(value_name = "OUT")]
     pub output: PathBuf,
+    /// What the final simplification may hold, as 4G, 512M or bytes; a welded mesh that needs
+    /// more is tiled again, coarser, in DIR/coarser [default: half the machine's memory]
+    #[arg(long, value_name = "SIZE", value_parser = super::memory::parse_size)]
+    pub memory: Option<u64>,
     /// Print one JSON object with the merge's report on stdout
     #[arg(long)]
     pub json: bool,
@@ -130,12 +134,7 @@ fn split(a: SplitArgs) -> Result<ExitCode> {
         (None, Some(r)) => Target::Ratio(r),
         (None, None) => unreachable!("clap requires --ratio or --faces"),
     };
-    let opts = SplitOptions {
-        tiles: a.tiles,
-        target,
-        backend: crate::Backend::Cpu,
-        block: crate::io::stream::BLOCK,
-    };
+    let opts = SplitOptions::new(a.tiles, target);
     let streamed = matches!(&a.input, Input::File(p)
         if matches!(crate::io::Format::from_path(p), Ok(crate::io::Format::Ply | crate::io::Format::Obj)));
     // Inputs that cannot stream are read whole and split from a PLY copy in the folder.
@@ -259,18 +258,32 @@ fn merge(a: MergeArgs) -> Result<ExitCode> {
     check_output(&Input::File(a.dir.join("manifest.json")), &a.output)?;
     let progress = Progress::new(!a.json && std::io::stderr().is_terminal());
     let (mesh, r) = progress
-        .bar("merging", |p| crate::tiles::merge(&a.dir, &mut |f| p(f)))
+        .bar("merging", |p| {
+            let memory = a.memory.unwrap_or_else(super::memory::default_budget);
+            crate::tiles::merge(&a.dir, memory, &mut |f| p(f))
+        })
         .map_err(lib)?;
     crate::io::write(&a.output, &mesh).map_err(lib)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&r)?);
     } else {
+        let mut level = &r;
+        let mut how = String::new();
+        while let Some(c) = &level.coarser {
+            how += &format!(
+                "; needing {} of {}, tiled again coarser ({} faces welded)",
+                super::memory::mib(level.needed_bytes),
+                super::memory::mib(level.memory_budget),
+                c.welded_faces
+            );
+            level = c;
+        }
         println!(
-            "merged {}: {} faces welded ({} border vertices joined) -> {} faces in {}",
+            "merged {}: {} faces welded ({} border vertices joined){how} -> {} faces in {}",
             a.dir.display(),
             r.welded_faces,
             r.joined_vertices,
-            r.simplify.output_faces,
+            mesh.triangles.len(),
             a.output.display()
         );
     }

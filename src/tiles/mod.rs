@@ -17,13 +17,16 @@
 //!   merge room to thin the seams like the rest. A tile's output depends only on its files and
 //!   the manifest, so the result is the same whoever ran it.
 //! - [`merge`] welds the tiles' outputs by the border vertices' global ids and runs the greedy
-//!   over the whole to the target, borders free.
+//!   over the whole to the target, borders free. When the welded mesh would not fit the memory
+//!   budget, it is tiled again, coarser, with the cuts moved away from the first level's, so its
+//!   seams are simplified inside the second level's tiles (meshoptimizer's clusterlod and
+//!   Nanite regroup the same way); the second level's tiles go straight to the target.
 
 mod merge;
 mod simplify;
 mod split;
 
-pub use merge::{MergeReport, merge, welded};
+pub use merge::{GREEDY_BYTES_PER_FACE, MergeReport, merge, welded};
 pub use simplify::{TileReport, simplify_tile};
 pub use split::{SplitOptions, split};
 
@@ -58,6 +61,10 @@ pub struct Manifest {
     pub grid: [u32; 3],
     /// The number of tiles (`grid`'s product): array indices run from 0 to `tiles - 1`.
     pub tiles: usize,
+    /// The cut planes' offset per axis, in cells: zero, or for a coarser level what moves its
+    /// cuts away from the level before's.
+    #[serde(default)]
+    pub shift: [f64; 3],
     pub tile: Vec<Tile>,
 }
 

@@ -26,6 +26,26 @@ pub struct SplitOptions {
     pub backend: Backend,
     /// Triangles per streamed block ([`crate::io::stream::BLOCK`]; less in tests).
     pub block: usize,
+    /// Each tile's target as a multiple of its share of the final one ([`TILE_SHARE`]; 1 for
+    /// a coarser level, whose merge has nothing left to simplify).
+    pub share: f64,
+    /// For a coarser level, the grid of the level before: the cuts are then moved, per axis,
+    /// as far from its cuts as they can be ([`Cells::moved`]).
+    pub after: Option<[u32; 3]>,
+}
+
+impl SplitOptions {
+    /// `tiles` tiles to `target`, the defaults for the rest.
+    pub fn new(tiles: usize, target: Target) -> SplitOptions {
+        SplitOptions {
+            tiles,
+            target,
+            backend: Backend::Cpu,
+            block: crate::io::stream::BLOCK,
+            share: TILE_SHARE,
+            after: None,
+        }
+    }
 }
 
 /// Splits the PLY or OBJ at `input` into `opts.tiles` tiles in `dir` (created if missing),
@@ -59,7 +79,7 @@ pub fn split(
     }
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let positions = read_positions(input)?;
-    let cells = Cells::new(&positions, opts.tiles);
+    let cells = Cells::new(&positions, opts.tiles, opts.after);
     let faces = FileFaces::new(input, opts.block);
     let tile_of = |t: &[u32; 3]| cells.tile(t.map(|v| positions[v as usize]));
     progress(0.1);
@@ -192,7 +212,7 @@ pub fn split(
             .map_err(|e| Error::io(&part(".ids"), e))?;
         let mut b = std::mem::take(&mut borders[i]);
         b.sort_unstable();
-        let share = target_faces as f64 * TILE_SHARE * tile_faces[i] as f64 / total as f64;
+        let share = target_faces as f64 * opts.share * tile_faces[i] as f64 / total as f64;
         tile.push(Tile {
             file: name(i, ".ply"),
             ids: name(i, ".ids"),
@@ -214,6 +234,7 @@ pub fn split(
         backend: opts.backend.name().into(),
         grid: cells.grid,
         tiles: opts.tiles,
+        shift: cells.shift,
         tile,
     };
     // Outputs of an earlier split in this folder would be merged with the new tiles: remove them.
@@ -232,10 +253,11 @@ struct Cells {
     /// Cells per unit length, per axis.
     inv: [f64; 3],
     grid: [u32; 3],
+    shift: [f64; 3],
 }
 
 impl Cells {
-    fn new(positions: &[[f32; 3]], tiles: usize) -> Cells {
+    fn new(positions: &[[f32; 3]], tiles: usize, after: Option<[u32; 3]>) -> Cells {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         for p in positions {
@@ -256,14 +278,35 @@ impl Cells {
                 }
             }),
             grid,
+            shift: after.map_or([0.0; 3], |a| [0, 1, 2].map(|k| Cells::moved(grid[k], a[k]))),
         }
     }
 
-    /// The tile of a face: the cell its centroid falls in, clamped to the grid.
+    /// The shift, in cells, that puts the boundaries of `g` cells (at `(j - s) / g` of the box)
+    /// farthest from those of the `before` cells of the level before (at `i / before`), so that
+    /// level's seams lie inside this level's tiles; the candidates are eighths of a cell.
+    fn moved(g: u32, before: u32) -> f64 {
+        let gap = |s: f64| {
+            (1..g)
+                .flat_map(|j| (1..before).map(move |i| (j, i)))
+                .map(|(j, i)| ((j as f64 - s) / g as f64 - i as f64 / before as f64).abs())
+                .fold(f64::INFINITY, f64::min)
+        };
+        (1..8)
+            .map(|e| e as f64 / 8.0)
+            .fold((0.0, f64::NEG_INFINITY), |best, s| {
+                let d = gap(s);
+                if d > best.1 { (s, d) } else { best }
+            })
+            .0
+    }
+
+    /// The tile of a face: the cell its centroid falls in, clamped to the grid (with a shift
+    /// `s`, the first cell is `1 - s` cells wide and the last `1 + s`).
     fn tile(&self, t: [[f32; 3]; 3]) -> u32 {
         let c = [0, 1, 2].map(|k| {
             let centroid = (t[0][k] as f64 + t[1][k] as f64 + t[2][k] as f64) / 3.0;
-            let x = ((centroid - self.min[k]) * self.inv[k]).floor();
+            let x = ((centroid - self.min[k]) * self.inv[k] + self.shift[k]).floor();
             (x.max(0.0) as u32).min(self.grid[k] - 1)
         });
         c[0] + self.grid[0] * (c[1] + self.grid[1] * c[2])
