@@ -16,7 +16,7 @@ use meshslim::tiles::{Manifest, welded};
 use std::path::{Path, PathBuf};
 
 /// The cut planes of the tiles' grid: (axis, coordinate), as `tiles split` placed them over the
-/// input's box.
+/// input's box (a first level's manifest: a coarser level's cuts are shifted).
 fn cuts(input: &Mesh, m: &Manifest) -> Vec<(usize, f64)> {
     let b = input.bounds().expect("a mesh with vertices");
     let mut out = Vec::new();
@@ -134,6 +134,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let input_mesh = meshslim::io::read(input)?;
     let manifest = Manifest::read(dir)?;
+    if manifest.shift != [0.0; 3] {
+        return Err("a coarser level's manifest: give the first level's folder".into());
+    }
     let tiled_mesh = meshslim::io::read(tiled)?;
     let whole_mesh = meshslim::io::read(whole)?;
     let cuts = cuts(&input_mesh, &manifest);

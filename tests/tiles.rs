@@ -320,3 +320,28 @@ fn the_tile_index_comes_from_the_scheduler_or_the_error_says_how() {
     let out = meshslim::io::read(&p.join("out.ply")).unwrap();
     assert_eq!(out.triangles.len(), 500);
 }
+
+#[test]
+fn a_manifest_that_cannot_be_trusted_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("torus.ply");
+    meshslim::io::write(&input, &noisy_torus()).unwrap();
+    let tiles = dir.path().join("tiles");
+    let man = split(&input, &tiles, &split_opts(4, 0.1), &mut |_| {}).unwrap();
+    let refused = |m: &Manifest, what: &str| {
+        m.write(&tiles).unwrap();
+        let e = simplify_tile(&tiles, 0, &mut |_| {})
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(what), "{e}");
+    };
+    let mut m = man.clone();
+    m.tile[0].output = "../escape.ply".into();
+    refused(&m, "not a file name inside the folder");
+    let mut m = man.clone();
+    m.tile[0].border.reverse();
+    refused(&m, "not strictly ascending");
+    let mut m = man.clone();
+    m.backend = "gpu".into();
+    refused(&m, "simplified by cpu");
+}

@@ -13,7 +13,8 @@ pub struct FileFaces {
     path: PathBuf,
     /// Triangles a block holds ([`BLOCK`]; less in tests, to cross block borders).
     block: usize,
-    /// Triangles in the file (after fan triangulation), counted by the first face pass.
+    /// Triangles in the file (after fan triangulation), where a pass has counted them (the
+    /// clustering's area pass).
     pub faces: usize,
 }
 

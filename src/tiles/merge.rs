@@ -2,7 +2,7 @@
 //! simplified as one mesh to the target, the former borders free, so that no seam of pinned
 //! full-resolution vertices survives.
 
-use super::{Manifest, at, read_ids};
+use super::{Manifest, at, read_ids_for};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::{SimplifyOptions, SimplifyReport};
@@ -54,15 +54,17 @@ pub fn merge(
         coarser: None,
         simplify: None,
     };
-    if needed > memory && m.tiles > 1 && m.shift == [0.0; 3] {
+    let coarser = m.shift != [0.0; 3];
+    if needed > memory && m.tiles > 1 && !coarser {
         let (out, coarser) = coarser_level(dir, &m, welded, memory, progress)?;
         report.coarser = Some(Box::new(coarser));
         return Ok((out, report));
     }
-    if needed > memory {
+    if needed > memory && coarser {
         // A coarser level that still does not fit: its tiles went to the target already.
         return Ok((welded, report));
     }
+    // Over the budget with one tile (nothing to tile again), or within it: the greedy.
     let opts = SimplifyOptions {
         backend: m.backend()?,
         ..SimplifyOptions::with_faces(m.target_faces as usize)
@@ -98,6 +100,7 @@ fn coarser_level(
         )
     };
     let c = super::split(&input, &level, &opts, &mut |f| progress(0.1 + 0.1 * f))?;
+    std::fs::remove_file(&input).map_err(|e| Error::io(&input, e))?;
     for i in 0..c.tiles {
         super::simplify_tile(&level, i, &mut |_| {})?;
         progress(0.2 + 0.7 * (i + 1) as f32 / c.tiles as f32);
@@ -129,19 +132,7 @@ fn weld(dir: &Path, m: &Manifest) -> Result<(Mesh, usize)> {
             )));
         }
         let mesh = crate::io::read(&path)?;
-        let ids_path = at(dir, &t.output_ids);
-        let ids = read_ids(&ids_path)?;
-        if ids.len() != mesh.positions.len() {
-            return Err(Error::parse(
-                &ids_path,
-                crate::Location::Unknown,
-                format!(
-                    "{} ids for the tile's {} output vertices: simplify tile {i} again",
-                    ids.len(),
-                    mesh.positions.len()
-                ),
-            ));
-        }
+        let ids = read_ids_for(&at(dir, &t.output_ids), mesh.positions.len(), i)?;
         let map: Vec<u32> = mesh
             .positions
             .iter()

@@ -5,8 +5,7 @@
 //! The scheme is Hoppe's for terrain ("Smooth view-dependent level-of-detail control and its
 //! application to terrain rendering", IEEE Visualization 1998): blocks simplified with their
 //! shared borders preserved, then stitched, then simplified again so that no seam of
-//! full-resolution vertices survives; meshoptimizer's clusterlod and Nanite regroup the same
-//! way. Here:
+//! full-resolution vertices survives. Here:
 //! - [`split`] streams the input (the positions held, the faces read twice in blocks) and
 //!   writes each tile as a binary PLY of the faces whose centroid falls in its cell of a grid
 //!   over the box, with its vertices' global ids beside it, and a manifest naming each tile's
@@ -17,8 +16,8 @@
 //!   merge room to thin the seams like the rest. A tile's output depends only on its files and
 //!   the manifest, so the result is the same whoever ran it.
 //! - [`merge`] welds the tiles' outputs by the border vertices' global ids and runs the greedy
-//!   over the whole to the target, borders free. When the welded mesh would not fit the memory
-//!   budget, it is tiled again, coarser, with the cuts moved away from the first level's, so its
+//!   over the whole to the target, borders free. When the greedy over the welded mesh would
+//!   need more than the memory budget, it is tiled again, coarser, with the cuts moved away from the first level's, so its
 //!   seams are simplified inside the second level's tiles (meshoptimizer's clusterlod and
 //!   Nanite regroup the same way); the second level's tiles go straight to the target.
 
@@ -108,6 +107,39 @@ impl Manifest {
                 ),
             });
         }
+        // Checked here, so no later step works from a list it cannot trust.
+        let bad = |message: String| {
+            Err(Error::parse(
+                &path,
+                crate::error::Location::Unknown,
+                message,
+            ))
+        };
+        if m.backend != "cpu" {
+            return bad(format!(
+                "backend {:?}: tiles are simplified by cpu",
+                m.backend
+            ));
+        }
+        for (i, t) in m.tile.iter().enumerate() {
+            let names = [&t.file, &t.ids, &t.output, &t.output_ids];
+            if let Some(n) = names.iter().find(|n| {
+                let mut c = Path::new(n.as_str()).components();
+                !matches!(
+                    (c.next(), c.next()),
+                    (Some(std::path::Component::Normal(_)), None)
+                )
+            }) {
+                return bad(format!(
+                    "tile {i}: {n:?} is not a file name inside the folder"
+                ));
+            }
+            if !t.border.windows(2).all(|w| w[0] < w[1]) {
+                return bad(format!(
+                    "tile {i}: its border ids are not strictly ascending"
+                ));
+            }
+        }
         Ok(m)
     }
 
@@ -181,6 +213,23 @@ pub(crate) fn read_ids(path: &Path) -> Result<Vec<u32>> {
         .chunks_exact(4)
         .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
         .collect())
+}
+
+/// Reads the ids file of tile `tile`, which must hold one id per vertex of its mesh (`n`).
+pub(crate) fn read_ids_for(path: &Path, n: usize, tile: usize) -> Result<Vec<u32>> {
+    let ids = read_ids(path)?;
+    if ids.len() != n {
+        return Err(Error::parse(
+            path,
+            crate::error::Location::Unknown,
+            format!(
+                "{} ids for tile {tile}'s {n} vertices: the folder is damaged; split or \
+                 simplify the tile again",
+                ids.len()
+            ),
+        ));
+    }
+    Ok(ids)
 }
 
 /// Writes an ids file atomically.

@@ -1,7 +1,7 @@
 //! `tiles simplify`: one tile, its border pinned, to its share of the target.
 
-use super::{Manifest, at, read_ids, write_ids};
-use crate::error::{Error, Result};
+use super::{Manifest, at, read_ids_for, write_ids};
+use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::{SimplifyOptions, StopReason};
 use rustc_hash::FxHashMap;
@@ -33,19 +33,7 @@ pub fn simplify_tile(
     let m = Manifest::read(dir)?;
     let tile = m.tile(index)?;
     let mesh = crate::io::read(&at(dir, &tile.file))?;
-    let ids_path = at(dir, &tile.ids);
-    let ids = read_ids(&ids_path)?;
-    if ids.len() != mesh.positions.len() {
-        return Err(Error::parse(
-            &ids_path,
-            crate::Location::Unknown,
-            format!(
-                "{} ids for the tile's {} vertices: the folder is damaged, split again",
-                ids.len(),
-                mesh.positions.len()
-            ),
-        ));
-    }
+    let ids = read_ids_for(&at(dir, &tile.ids), mesh.positions.len(), index)?;
     let pin: Vec<u32> = (0..ids.len() as u32)
         .filter(|&l| tile.border.binary_search(&ids[l as usize]).is_ok())
         .collect();
@@ -81,7 +69,7 @@ pub fn simplify_tile(
 /// Per output vertex, the global id of the pinned vertex it is, else `u32::MAX`. Pinned
 /// vertices keep their input coordinates bit for bit (every backend writes an unmoved vertex's
 /// input position), so they are found by position; inputs that repeat a position under several
-/// ids get the smallest, and the merge's weld by position joins the rest.
+/// ids get the smallest, and the merge's greedy, which welds equal positions, joins the rest.
 fn output_ids(mesh: &Mesh, ids: &[u32], pin: &[u32], out: &Mesh) -> Vec<u32> {
     let key = |p: &[f32; 3]| p.map(f32::to_bits);
     let mut gid: FxHashMap<[u32; 3], u32> = FxHashMap::default();

@@ -1,6 +1,7 @@
-//! `tiles split`: the input streamed into tiles. Memory holds the positions (12 B a vertex), each
-//! vertex's first tile and local id (8 B), a bit for the border, and the border vertices' other
-//! tiles; the faces pass through in blocks twice and go to one file per tile.
+//! `tiles split`: the input streamed into tiles. Memory holds the positions (12 B a vertex), a
+//! border flag (1 B), each vertex's first tile in the first face pass and its local id in the
+//! second (4 B), and a map from (tile, border vertex) to its local id; the faces pass through
+//! in blocks twice and go to one part file per tile.
 
 use super::{FORMAT, Manifest, TILE_SHARE, Tile, at, grid_for};
 use crate::Backend;
@@ -30,7 +31,7 @@ pub struct SplitOptions {
     /// a coarser level, whose merge has nothing left to simplify).
     pub share: f64,
     /// For a coarser level, the grid of the level before: the cuts are then moved, per axis,
-    /// as far from its cuts as they can be ([`Cells::moved`]).
+    /// as far from its cuts as they can be.
     pub after: Option<[u32; 3]>,
 }
 
@@ -78,6 +79,14 @@ pub fn split(
         )));
     }
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    // An earlier split's manifest goes first, so a split that fails leaves no manifest that
+    // names these tiles with its old borders; its outputs go at the end.
+    match std::fs::remove_file(dir.join(super::MANIFEST)) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            return Err(Error::io(&dir.join(super::MANIFEST), e));
+        }
+        _ => {}
+    }
     let positions = read_positions(input)?;
     let cells = Cells::new(&positions, opts.tiles, opts.after);
     let faces = FileFaces::new(input, opts.block);
@@ -122,6 +131,10 @@ pub fn split(
     // Pass 2: faces renumbered per tile in order of first use, written as binary PLY face
     // records to a part file per tile; each tile's global ids appended as they are numbered.
     let name = |i: usize, ext: &str| format!("tile-{i:04}{ext}");
+    let _parts = Parts {
+        dir,
+        tiles: opts.tiles,
+    };
     let mut writers = Vec::with_capacity(opts.tiles);
     for i in 0..opts.tiles {
         let open = |ext: &str| -> Result<BufWriter<std::fs::File>> {
@@ -172,11 +185,9 @@ pub fn split(
     // Each tile's PLY: the header, its vertices looked up by global id, its face records.
     let mut tile = Vec::with_capacity(opts.tiles);
     for (i, (fw, iw)) in writers.into_iter().enumerate() {
+        // Scratch files: flushed, not synced (the tile's PLY is written atomically from them).
         for w in [fw, iw] {
-            w.into_inner()
-                .map_err(|e| Error::io(dir, e.into_error()))?
-                .sync_all()
-                .map_err(|e| Error::io(dir, e))?;
+            w.into_inner().map_err(|e| Error::io(dir, e.into_error()))?;
         }
         let part = |ext: &str| at(dir, &name(i, ext));
         let ids = super::read_ids(&part(".ids.part"))?;
@@ -245,6 +256,22 @@ pub fn split(
     }
     manifest.write(dir)?;
     Ok(manifest)
+}
+
+/// Removes the part files a split left when it fails (on success they are gone already).
+struct Parts<'d> {
+    dir: &'d Path,
+    tiles: usize,
+}
+
+impl Drop for Parts<'_> {
+    fn drop(&mut self) {
+        for i in 0..self.tiles {
+            for ext in ["faces.part", "ids.part"] {
+                let _ = std::fs::remove_file(self.dir.join(format!("tile-{i:04}.{ext}")));
+            }
+        }
+    }
 }
 
 /// The grid of tiles over the box of the positions.
