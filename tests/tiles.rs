@@ -153,6 +153,22 @@ fn a_split_puts_every_face_in_one_tile_and_names_the_shared_vertices() {
     }
 }
 
+/// How many of the split's border vertices are still in `out` at their input position, and
+/// how many there were.
+fn border_survivors(man: &Manifest, input: &Mesh, out: &Mesh) -> (usize, usize) {
+    let border: BTreeSet<[u32; 3]> = man
+        .tile
+        .iter()
+        .flat_map(|t| t.border.iter().map(|&v| bits(input.positions[v as usize])))
+        .collect();
+    let survivors = out
+        .positions
+        .iter()
+        .filter(|&&p| border.contains(&bits(p)))
+        .count();
+    (survivors, border.len())
+}
+
 #[test]
 fn the_merge_welds_the_tiles_shut_and_thins_the_former_borders() {
     let dir = tempfile::tempdir().unwrap();
@@ -175,20 +191,11 @@ fn the_merge_welds_the_tiles_shut_and_thins_the_former_borders() {
     assert!(topo.is_closed() && topo.is_manifold(), "{topo:?}");
     // No seam of pinned vertices survives: former border vertices still at their input
     // position are rare, as rare as the vertices kept overall.
-    let border: BTreeSet<[u32; 3]> = man
-        .tile
-        .iter()
-        .flat_map(|t| t.border.iter().map(|&v| bits(m.positions[v as usize])))
-        .collect();
-    let survivors = out
-        .positions
-        .iter()
-        .filter(|&&p| border.contains(&bits(p)))
-        .count();
+    let (survivors, border) = border_survivors(&man, &m, &out);
     assert!(
-        survivors * 5 < border.len(),
+        survivors * 5 < border,
         "{survivors} of {} former border vertices left",
-        border.len()
+        border
     );
 }
 
@@ -219,20 +226,11 @@ fn a_merge_over_its_memory_tiles_again_with_the_cuts_moved() {
     let topo = meshslim::mesh::topology(&out);
     assert!(topo.is_closed() && topo.is_manifold(), "{topo:?}");
     // The first level's seams were inside the coarser tiles, and thinned there.
-    let border: BTreeSet<[u32; 3]> = man
-        .tile
-        .iter()
-        .flat_map(|t| t.border.iter().map(|&v| bits(m.positions[v as usize])))
-        .collect();
-    let survivors = out
-        .positions
-        .iter()
-        .filter(|&&p| border.contains(&bits(p)))
-        .count();
+    let (survivors, border) = border_survivors(&man, &m, &out);
     assert!(
-        survivors * 4 < border.len(),
+        survivors * 4 < border,
         "{survivors} of {} first-level border vertices left",
-        border.len()
+        border
     );
 }
 
