@@ -40,6 +40,7 @@ pub mod cluster;
 // the integration tests can diff the GPU's buffers stage by stage.
 #[doc(hidden)]
 pub mod cpu;
+pub mod decimate;
 pub mod error;
 pub mod gpu;
 mod greedy;

@@ -47,6 +47,18 @@ pub fn simplify_with_progress(
         Method::Cluster => return crate::cluster::simplify_cluster(mesh, opts, progress),
         Method::Hybrid => return crate::cluster::simplify_hybrid(mesh, opts, progress),
         Method::FloatingCell => return crate::cluster::simplify_floating(mesh, opts, progress),
+        Method::Decimate => {
+            return match opts.backend {
+                Backend::Cpu | Backend::Auto => {
+                    crate::decimate::simplify_decimate(mesh, opts, progress)
+                }
+                b => Err(Error::InvalidOption(format!(
+                    "--method decimate runs on the CPU only (it removes one vertex at a time); \
+                     use --backend cpu or auto, not {}",
+                    b.name()
+                ))),
+            };
+        }
     }
     let (chosen, mut auto) = match opts.backend {
         Backend::Auto => {

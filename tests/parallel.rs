@@ -286,6 +286,7 @@ fn a_resumed_run_lands_each_target_and_keeps_the_invariants() {
             rounds: None,
             blocked: None,
             clustering: None,
+            decimation: None,
         };
         check_invariants(&format!("resumed to {ratio}"), &m, &out, &report);
     }

@@ -88,6 +88,17 @@ pub static BACKENDS: &[BenchBackend] = &[
         band: crate::cluster::BAND,
     },
     BenchBackend {
+        name: "decimate",
+        about: "meshslim's vertex decimation, Schroeder (cpu; keeps a subset of the vertices)",
+        simplify: |m, faces| {
+            let mut o = with_method(faces, crate::Method::Decimate);
+            o.backend = crate::Backend::Cpu;
+            Ok(crate::simplify(m, &o)?.0)
+        },
+        device: cpu_name,
+        band: 0.0,
+    },
+    BenchBackend {
         name: "hybrid",
         about: "meshslim's clustering to 2x the target + 20k faces, then the rounds (cpu-parallel)",
         simplify: |m, faces| Ok(crate::simplify(m, &with_method(faces, crate::Method::Hybrid))?.0),

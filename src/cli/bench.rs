@@ -42,7 +42,7 @@ pub struct BenchArgs {
     pub ratios: Vec<f64>,
 
     /// Backends to run, comma-separated: cpu (meshslim's greedy), cpu-parallel and gpu (its
-    /// rounds), cluster, floating-cell and hybrid (--method), each also as NAME-gpu,
+    /// rounds), cluster, floating-cell and hybrid (--method), each also as NAME-gpu, decimate,
     /// meshopt (meshoptimizer's simplify), meshopt-sloppy (its clustering simplifySloppy)
     /// [default: all of them; the *gpu ones where there is an adapter]
     #[arg(long, value_name = "B,...", value_delimiter = ',', value_parser = parse_bench_backend)]

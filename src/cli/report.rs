@@ -67,6 +67,7 @@ pub(super) fn simplify_json(
         "seconds": { "load": t.load, "simplify": t.simplify, "save": t.save },
         "rounds": r.rounds,
         "clustering": r.clustering,
+        "decimation": r.decimation,
         "topology": topology,
     })
 }
@@ -180,6 +181,20 @@ pub(super) fn write_summary(
                 c.placed_solve,
                 c.placed_member,
                 c.placed_centroid
+            )?;
+        }
+        if let Some(d) = &r.decimation {
+            writeln!(
+                out,
+                "decimation          {} removal; input vertices: {} simple, {} boundary, {} interior edge, {} corner, {} complex; {} removed, {} refused by the checks",
+                d.removal.name(),
+                d.simple,
+                d.boundary,
+                d.interior_edge,
+                d.corner,
+                d.complex,
+                d.removed,
+                d.refused
             )?;
         }
         if let Some(rr) = &r.rounds {

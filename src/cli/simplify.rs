@@ -41,6 +41,8 @@ Examples:
   meshslim simplify terrain.obj terrain-small.obj --ratio 0.05 --lock-border
   # simplify as far as an error of 0.1% of the bounding-box diagonal allows
   meshslim simplify scan.ply scan-err.ply --faces 0 --max-error 0.001
+  # keep a subset of the scan's own vertices (no moved points), topology and borders kept
+  meshslim simplify scan.ply scan-kept.ply --ratio 0.1 --method decimate
   # a PLY larger than memory: vertex clustering with the faces streamed from the file
   meshslim simplify huge.ply huge-1m.ply --faces 1000000 --method cluster --stream
   # machine-readable report
@@ -98,9 +100,20 @@ pub struct SimplifyArgs {
     pub backend: BackendArg,
 
     /// Which algorithm: qem for the best surface, cluster for speed, hybrid for near-qem
-    /// quality at clustering speed on big scans (see the choices below)
+    /// quality at clustering speed on big scans, decimate to keep the input's own vertices
+    /// (see the choices below)
     #[arg(long, value_enum, default_value_t = MethodArg::Qem)]
     pub method: MethodArg,
+
+    /// --method decimate: faces meeting at a dihedral angle over DEG degrees make a feature
+    /// edge; a vertex on exactly two is removed along the feature line, a vertex on one or on
+    /// three and more (a corner) is kept
+    #[arg(long = "feature-angle", value_name = "DEG", default_value_t = 60.0, value_parser = parse_angle, allow_negative_numbers = true)]
+    pub feature_angle: f64,
+
+    /// --method decimate: how the hole a removed vertex leaves is filled
+    #[arg(long, value_enum, default_value_t = RemovalArg::HalfEdge)]
+    pub removal: RemovalArg,
 
     /// Stream the input (a PLY or OBJ file, --method cluster or hybrid): hold its vertices and read
     /// its faces again in blocks at each clustering pass, so memory follows the vertices and
@@ -162,6 +175,30 @@ pub enum MethodArg {
     /// clusters' quadrics: near-qem error in a fraction of the time on large scans; closes UV
     /// seams (cpu-parallel, or gpu for the rounds)
     Hybrid,
+    /// Schroeder's vertex decimation: removes vertices and fills their holes, so the output's
+    /// vertices are a subset of the input's, unmoved, with their normals, UVs and colours;
+    /// topology and borders kept; exactly on target; creases (--feature-angle), seams and
+    /// corners respected (cpu)
+    Decimate,
+}
+
+/// The `--removal` choices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RemovalArg {
+    /// Remove the vertex and triangulate its hole by recursive loop splitting (Schroeder 1992)
+    LoopSplit,
+    /// Collapse the vertex into the allowed neighbour of least error (a half-edge collapse,
+    /// Schroeder 1997): lower error than loop-split on the scans
+    HalfEdge,
+}
+
+impl RemovalArg {
+    pub fn removal(self) -> crate::decimate::Removal {
+        match self {
+            RemovalArg::LoopSplit => crate::decimate::Removal::LoopSplit,
+            RemovalArg::HalfEdge => crate::decimate::Removal::HalfEdge,
+        }
+    }
 }
 
 impl MethodArg {
@@ -171,6 +208,7 @@ impl MethodArg {
             MethodArg::Cluster => crate::Method::Cluster,
             MethodArg::FloatingCell => crate::Method::FloatingCell,
             MethodArg::Hybrid => crate::Method::Hybrid,
+            MethodArg::Decimate => crate::Method::Decimate,
         }
     }
 }
@@ -275,6 +313,8 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     opts.quality_threshold = args.quality_threshold;
     opts.backend = args.backend.backend();
     opts.method = method;
+    opts.feature_angle_deg = args.feature_angle;
+    opts.removal = args.removal.removal();
 
     let (simplified, report, load_s, simplify_s, topology, streamed) =
         if let Some((path, why)) = stream {

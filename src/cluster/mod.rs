@@ -776,5 +776,6 @@ fn clustered_report(
         rounds: None,
         blocked: None,
         clustering: Some(report),
+        decimation: None,
     }
 }

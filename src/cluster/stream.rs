@@ -147,6 +147,7 @@ pub fn simplify_file_in_blocks(
             rounds: None,
             blocked: None,
             clustering: Some(report),
+            decimation: None,
         };
         return Ok((out, r));
     }

@@ -18,17 +18,18 @@
 
 mod collapse;
 mod evaluate;
-mod output;
+pub(crate) mod output;
 mod partition;
-mod prepare;
-mod queue;
-mod state;
+pub(crate) mod prepare;
+pub(crate) mod queue;
+pub(crate) mod state;
 mod vec;
 
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::options::{SimplifyOptions, SimplifyReport, StopReason};
-use output::build_output;
+pub(crate) use evaluate::triangle_quality;
+use output::{OutputNormals, build_output};
 use partition::{Cuts, LevelStats, SECOND_LEVEL_REGIONS, partitioned_level, partitioned_stop};
 use prepare::{Mobility, Prepared};
 use state::State;
@@ -106,7 +107,12 @@ pub fn simplify_greedy(
     } else {
         StopReason::NoValidCollapse
     };
-    let out = build_output(&s.p, &s.face_alive, &s.alive, input.normals.is_some());
+    let out = build_output(
+        &s.p,
+        &s.face_alive,
+        &s.alive,
+        OutputNormals::recompute_if(input.normals.is_some()),
+    );
     let report = SimplifyReport {
         backend: opts.backend,
         auto: None,
@@ -123,6 +129,7 @@ pub fn simplify_greedy(
         rounds: None,
         blocked: None,
         clustering: None,
+        decimation: None,
     };
     Ok((out, report))
 }

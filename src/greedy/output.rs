@@ -3,18 +3,41 @@
 use super::prepare::Prepared;
 use crate::mesh::Mesh;
 
+/// What the output's normals are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum OutputNormals {
+    None,
+    /// From the output's faces (the QEM methods move vertices).
+    Recompute,
+    /// The input's, per kept vertex (decimation keeps vertices where they were).
+    Keep,
+}
+
+impl OutputNormals {
+    pub(crate) fn recompute_if(had: bool) -> OutputNormals {
+        if had {
+            OutputNormals::Recompute
+        } else {
+            OutputNormals::None
+        }
+    }
+}
+
 /// The output mesh: live faces with their materials and groups, positions moved back out of the
-/// normalized frame, unused vertices dropped, normals recomputed when the input had normals.
+/// normalized frame, unused vertices dropped, normals as `normals` says.
 pub(crate) fn build_output(
     p: &Prepared,
     face_alive: &[bool],
     vertex_alive: &[bool],
-    normals: bool,
+    normals: OutputNormals,
 ) -> Mesh {
     let mut out = p.mesh.clone_without_geometry();
     out.positions = p.mesh.positions.clone();
     out.uvs = p.mesh.uvs.clone();
     out.colors = p.mesh.colors.clone();
+    if normals == OutputNormals::Keep {
+        out.normals = p.mesh.normals.clone();
+    }
     for (v, pos) in out.positions.iter_mut().enumerate() {
         let t = p.topo[v] as usize;
         // Only moved vertices go back through the frame: a round trip through f64 could shift
@@ -37,7 +60,7 @@ pub(crate) fn build_output(
         .as_ref()
         .map(|g| live.iter().map(|&f| g[origin(f)]).collect());
     out.remove_unused_vertices();
-    if normals {
+    if normals == OutputNormals::Recompute {
         out.recompute_normals();
     }
     out

@@ -9,7 +9,7 @@ use crate::options::SimplifyOptions;
 /// side; a list that outgrows its room moves into the removed vertex's (a neighbour's, so still
 /// nearby) or else to the end. Measured on the 1M scan at 10%: one `Vec` per vertex spent
 /// 0.45 G of 15 G instructions in malloc/realloc/free, and each list was a cache miss of its own.
-pub(super) struct VertFaces {
+pub(crate) struct VertFaces {
     /// Per vertex: start, len, cap.
     span: Vec<[u32; 3]>,
     data: Vec<u32>,
@@ -17,7 +17,7 @@ pub(super) struct VertFaces {
 
 impl VertFaces {
     /// Lists in face order, from each face's vertices.
-    pub(super) fn new(nt: usize, topo_faces: &[[u32; 3]]) -> VertFaces {
+    pub(crate) fn new(nt: usize, topo_faces: &[[u32; 3]]) -> VertFaces {
         let mut span = vec![[0u32; 3]; nt];
         for t in topo_faces {
             for &v in t {
@@ -43,14 +43,14 @@ impl VertFaces {
     }
 
     #[inline]
-    pub(super) fn get(&self, v: usize) -> &[u32] {
+    pub(crate) fn get(&self, v: usize) -> &[u32] {
         let [start, len, _] = self.span[v];
         &self.data[start as usize..(start + len) as usize]
     }
 
     /// Replaces `keep`'s list by its own entries that pass `live`, then `extra`; `remove`'s list
     /// is emptied and its room may be reused.
-    pub(super) fn merge_into(
+    pub(crate) fn merge_into(
         &mut self,
         keep: usize,
         remove: usize,

@@ -448,6 +448,7 @@ pub fn simplify_rounds(
         rounds: Some(rounds_report),
         blocked: None,
         clustering: None,
+        decimation: None,
     };
     Ok((out, report))
 }

@@ -141,20 +141,31 @@ impl ViewerApp {
                     Method::Hybrid,
                     "grid to 2x the target + 20k faces, then edge collapse: near-qem quality, faster",
                 ),
+                (
+                    Method::Decimate,
+                    "vertex removal: keeps a subset of the input's vertices, unmoved; topology \
+                     kept; exact target (cpu)",
+                ),
             ];
             for (m, about) in methods {
                 ui.selectable_value(&mut self.method, m, m.name())
                     .on_hover_text(about);
             }
-            // hybrid runs on the CPU's cores here.
-            if !self.gpu_draws(self.method) && self.backend == Backend::Gpu {
+            // hybrid runs on the CPU's cores here; decimate on one core (it is sequential).
+            if self.method == Method::Decimate {
+                self.backend = Backend::Cpu;
+            } else if !self.gpu_draws(self.method) && self.backend == Backend::Gpu {
                 self.backend = Backend::CpuParallel;
             }
         });
         ui.horizontal(|ui| {
             ui.label("backend");
             for b in [Backend::Gpu, Backend::CpuParallel, Backend::Cpu] {
-                let enabled = b != Backend::Gpu || self.gpu_draws(self.method);
+                let enabled = if self.method == crate::Method::Decimate {
+                    b == Backend::Cpu
+                } else {
+                    b != Backend::Gpu || self.gpu_draws(self.method)
+                };
                 ui.add_enabled_ui(enabled, |ui| {
                     ui.selectable_value(&mut self.backend, b, b.name());
                 });
