@@ -45,6 +45,7 @@ pub mod error;
 pub mod gpu;
 mod greedy;
 pub mod io;
+pub mod lod;
 pub mod mesh;
 pub mod metrics;
 pub mod options;

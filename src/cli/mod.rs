@@ -5,7 +5,7 @@
 //! `main.rs` that uses `anyhow`: errors of the library arrive as [`meshslim::Error`] and leave
 //! as messages for the user.
 //!
-//! One file per command (`simplify`, `info`, `compare`, `bench`, `view`) holds its arguments, its
+//! One file per command (`simplify`, `info`, `compare`, `bench`, `view`, `tiles`, `lods` with `pareto`) holds its arguments, its
 //! help text and its runner; `args` the argument types and parsers they share, `builtins` the
 //! generated meshes, `files` reading inputs and checking output paths, `report` what the
 //! commands print and the progress bars, `error` the usage error and the library's errors.
@@ -17,6 +17,7 @@ mod compare;
 mod error;
 mod files;
 mod info;
+mod lods;
 mod memory;
 mod report;
 mod simplify;
@@ -37,6 +38,8 @@ use compare::{COMPARE_AFTER_HELP, run_compare};
 pub use error::UsageError;
 pub use info::InfoArgs;
 use info::{INFO_AFTER_HELP, run_info};
+use lods::{LODS_AFTER_HELP, PARETO_AFTER_HELP, run_lods, run_pareto};
+pub use lods::{LodsArgs, ParetoArgs};
 pub use simplify::{BackendArg, GETTING_STARTED, SimplifyArgs};
 use simplify::{SIMPLIFY_AFTER_HELP, run_simplify};
 pub use tiles::TilesArgs;
@@ -53,6 +56,8 @@ Examples:
   meshslim compare scan.ply scan-5k.obj
   meshslim bench --json bench.json --plot bench.svg
   meshslim tiles split scan.ply work --tiles 16 --ratio 0.01
+  meshslim lods scan.ply lods --ratios 0.5,0.25,0.1,0.05,0.01
+  meshslim pareto scan.ply front --population 100 --generations 20
 
 Run 'meshslim <COMMAND> --help' for every option of a command.";
 
@@ -88,6 +93,14 @@ pub enum Command {
     /// Indexed Job, or here), and merge them across the former borders
     #[command(after_help = TILES_AFTER_HELP)]
     Tiles(TilesArgs),
+    /// Levels of detail in one run, each going on from the one before: files and a manifest
+    /// with each level's error against the original
+    #[command(after_help = LODS_AFTER_HELP)]
+    Lods(LodsArgs),
+    /// Pareto sets of vertex-removal levels of detail by NSGA-II (vertices against error):
+    /// the front's meshes, its hypervolume per generation, a plot
+    #[command(after_help = PARETO_AFTER_HELP)]
+    Pareto(ParetoArgs),
 }
 
 /// The exit code for an error [`run`] returned: 2 for bad usage, 1 for everything else.
@@ -113,6 +126,8 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Some(Command::Bench(args)) => run_bench(args),
         Some(Command::View(args)) => run_view(args),
         Some(Command::Tiles(args)) => run_tiles(args),
+        Some(Command::Lods(args)) => run_lods(args),
+        Some(Command::Pareto(args)) => run_pareto(args),
     }
 }
 

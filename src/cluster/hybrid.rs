@@ -126,8 +126,24 @@ pub fn simplify_hybrid(
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
+    let (up, built_error, report, opts) = hybrid_upload(mesh, opts)?;
+    opts.cancel.check()?;
+    let (out, mut r) = rounds(&up, mesh, &opts, progress)?;
+    r.max_collapse_error = r.max_collapse_error.max(built_error);
+    r.collapses = mesh.positions.len().saturating_sub(out.positions.len());
+    r.clustering = Some(report);
+    Ok((out, r))
+}
+
+/// The hybrid's first phase: the clusters for `opts.target_faces` as the rounds' upload, with
+/// their quadrics, the clustering's largest error and its report, and the options with the
+/// backend resolved (the levels of detail go on from this upload through several targets).
+pub(crate) fn hybrid_upload(
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+) -> Result<(crate::parallel::Upload, f64, ClusterReport, SimplifyOptions)> {
     let backend = check_backend(opts)?;
-    let opts = &SimplifyOptions {
+    let opts = SimplifyOptions {
         backend,
         ..opts.clone()
     };
@@ -143,7 +159,7 @@ pub fn simplify_hybrid(
         (crate::parallel::Upload::new(mesh), 0.0)
     } else {
         let mut pts = Points::new(mesh);
-        let mut work = prepare(&mut pts, opts, true)?;
+        let mut work = prepare(&mut pts, &opts, true)?;
         let (grid, built) =
             cluster_repaired(&mut work, intermediate, opts.target_faces, &mut report)?;
         tally(&mut report, &built);
@@ -157,10 +173,5 @@ pub fn simplify_hybrid(
         )
     };
     report.seconds = t.elapsed().as_secs_f64();
-    opts.cancel.check()?;
-    let (out, mut r) = rounds(&up, mesh, opts, progress)?;
-    r.max_collapse_error = r.max_collapse_error.max(built_error);
-    r.collapses = mesh.positions.len().saturating_sub(out.positions.len());
-    r.clustering = Some(report);
-    Ok((out, r))
+    Ok((up, built_error, report, opts))
 }

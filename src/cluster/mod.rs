@@ -23,6 +23,7 @@ pub mod stream;
 pub mod twins;
 
 pub use floating::simplify_floating;
+pub(crate) use hybrid::hybrid_upload;
 pub use hybrid::{HYBRID_EXTRA, HYBRID_FACTOR, HYBRID_MIN_SHARE, HYBRID_SKIP, simplify_hybrid};
 
 use crate::cpu::common::{V3, xyz};

@@ -88,6 +88,7 @@ pub(crate) fn key(cost: f64) -> u32 {
     (cost as f32).to_bits()
 }
 
+#[derive(Clone)]
 pub(crate) struct Engine {
     pub p: Prepared,
     pub params: Params,

@@ -56,7 +56,7 @@ impl VertexClass {
 /// The faces around `v` in winding order: face `i` is `(v, x[i], x[i + 1])`; a closed fan has
 /// as many loop vertices as faces (x wraps around), an open one (a border vertex) one more.
 /// Reused from vertex to vertex: no allocation per evaluation once the buffers have grown.
-#[derive(Default)]
+#[derive(Default, Clone)]
 pub(super) struct Fan {
     pub v: u32,
     pub class: Option<VertexClass>,

@@ -60,7 +60,9 @@ pub enum Outcome {
     Refused(Refusal),
 }
 
-/// The vertex decimation engine on one mesh.
+/// The vertex decimation engine on one mesh. A clone goes on independently (the Pareto
+/// search decodes each candidate on a clone of one prepared engine).
+#[derive(Clone)]
 pub struct Decimator {
     e: Engine,
     normals: bool,
@@ -222,6 +224,25 @@ impl Decimator {
             refused,
             census,
         })
+    }
+
+    /// The vertex-to-plane error of the mesh as it is now: the area-weighted RMS distance of
+    /// the live vertices from the planes of the original faces each one stands for (its own,
+    /// and those the removals around it handed on), relative to the bounding-box diagonal.
+    /// A removal moves no vertex, so this is what the removed vertices' planes say of the
+    /// vertices that took them over: the Pareto search's cheap error.
+    pub fn vertex_plane_error(&self) -> f64 {
+        let p = &self.e.p;
+        let (mut sum, mut weight) = (0.0, 0.0);
+        for (v, _) in self.e.alive.iter().enumerate().filter(|a| *a.1) {
+            sum += p.quadrics[v].eval(p.pos[v]);
+            weight += p.quadrics[v].weight;
+        }
+        if weight > 0.0 {
+            (sum / weight).sqrt()
+        } else {
+            0.0
+        }
     }
 
     /// The mesh as it is now: the input's vertices that are left, with their attributes.

@@ -70,43 +70,13 @@ pub fn simplify_greedy(
     let nf = p.faces.len();
     let target = opts.target_faces;
     let need = nf.saturating_sub(target).max(1) as f32;
-    let regions = opts.partitions.unwrap_or(if nf >= PARTITION_MIN_FACES {
-        (nf / REGION_FACES).clamp(8, 32)
-    } else {
-        1
-    });
     let mut levels = LevelStats::default();
-    let p = if regions > 1 && target < nf {
-        let mut report = |faces: usize| progress((nf - faces) as f32 / need);
-        let first = Cuts::first(p.pos.len(), regions);
-        let p = partitioned_level(p, opts, first, None, &mut levels, &mut report);
-        if p.faces.len() > partitioned_stop(target) && !opts.cancel.is_cancelled() {
-            // The second level: fewer, larger regions, each cut half a first-level region
-            // along the Morton order from a first-level cut, so the vertices the first level
-            // had to pin are interior now and thin out with the rest.
-            let second = first.second(SECOND_LEVEL_REGIONS);
-            partitioned_level(p, opts, second, None, &mut levels, &mut report)
-        } else {
-            p
-        }
-    } else {
-        p
-    };
-    opts.cancel.check()?;
-    let (mut s, mut heap) = State::new(p, opts);
-    s.run(&mut heap, target, u32::MAX, &mut |faces| {
+    let s = reduce(p, opts, &mut levels, &mut |faces| {
         progress((nf - faces) as f32 / need)
-    });
-    opts.cancel.check()?;
+    })?;
     progress(1.0);
 
-    let stop_reason = if s.faces <= target {
-        StopReason::TargetReached
-    } else if s.hit_max_error || levels.hit_max_error {
-        StopReason::MaxError
-    } else {
-        StopReason::NoValidCollapse
-    };
+    let stop_reason = stop_reason(&s, &levels);
     let out = build_output(
         &s.p,
         &s.face_alive,
@@ -122,7 +92,7 @@ pub fn simplify_greedy(
         input_vertices: input.positions.len(),
         output_vertices: out.positions.len(),
         collapses: s.collapses + levels.collapses,
-        max_collapse_error: s.max_collapse_err2.max(levels.max_collapse_err2).sqrt(),
+        max_collapse_error: max_error(&s, &levels),
         stop_reason,
         dropped_degenerate_faces: s.p.dropped_degenerate,
         pinned_vertices,
@@ -132,4 +102,98 @@ pub fn simplify_greedy(
         decimation: None,
     };
     Ok((out, report))
+}
+
+/// The partitioned levels (on meshes large enough) and then the one sequential queue, from `p`
+/// down to `opts.target_faces`; `progress` gets the face count now and then.
+fn reduce<'a>(
+    p: Prepared,
+    opts: &'a SimplifyOptions,
+    levels: &mut LevelStats,
+    progress: &mut dyn FnMut(usize),
+) -> Result<State<'a>> {
+    let nf = p.faces.len();
+    let target = opts.target_faces;
+    let regions = opts.partitions.unwrap_or(if nf >= PARTITION_MIN_FACES {
+        (nf / REGION_FACES).clamp(8, 32)
+    } else {
+        1
+    });
+    let p = if regions > 1 && target < nf {
+        let first = Cuts::first(p.pos.len(), regions);
+        let p = partitioned_level(p, opts, first, None, levels, progress);
+        if p.faces.len() > partitioned_stop(target) && !opts.cancel.is_cancelled() {
+            // The second level: fewer, larger regions, each cut half a first-level region
+            // along the Morton order from a first-level cut, so the vertices the first level
+            // had to pin are interior now and thin out with the rest.
+            let second = first.second(SECOND_LEVEL_REGIONS);
+            partitioned_level(p, opts, second, None, levels, progress)
+        } else {
+            p
+        }
+    } else {
+        p
+    };
+    opts.cancel.check()?;
+    let (mut s, mut heap) = State::new(p, opts);
+    s.run(&mut heap, target, u32::MAX, progress);
+    opts.cancel.check()?;
+    Ok(s)
+}
+
+fn stop_reason(s: &State, levels: &LevelStats) -> StopReason {
+    if s.faces <= s.opts.target_faces {
+        StopReason::TargetReached
+    } else if s.hit_max_error || levels.hit_max_error {
+        StopReason::MaxError
+    } else {
+        StopReason::NoValidCollapse
+    }
+}
+
+/// The largest collapse error so far, relative to the bounding-box diagonal.
+fn max_error(s: &State, levels: &LevelStats) -> f64 {
+    s.max_collapse_err2.max(levels.max_collapse_err2).sqrt()
+}
+
+/// Levels of detail by the greedy queue, one per target (falling): each level goes on from the
+/// one before, positions and quadrics as they are (cut into regions again while it is large),
+/// so the chain costs about what its smallest level alone does. `level` gets each level's
+/// mesh, why it stopped and the largest collapse error so far.
+pub(crate) fn chain_greedy(
+    input: &Mesh,
+    opts: &SimplifyOptions,
+    targets: &[usize],
+    progress: &mut dyn FnMut(f32),
+    level: &mut dyn FnMut(Mesh, StopReason, f64) -> Result<()>,
+) -> Result<()> {
+    let mut p = Prepared::new(input, opts);
+    let nf = p.faces.len();
+    let need = nf.saturating_sub(*targets.last().unwrap_or(&nf)).max(1) as f32;
+    let mut levels = LevelStats::default();
+    let mut err2 = 0.0f64;
+    for &target in targets {
+        let opts = SimplifyOptions {
+            target_faces: target,
+            ..opts.clone()
+        };
+        let s = reduce(p, &opts, &mut levels, &mut |faces| {
+            progress((nf - faces) as f32 / need)
+        })?;
+        err2 = err2.max(s.max_collapse_err2);
+        let out = build_output(
+            &s.p,
+            &s.face_alive,
+            &s.alive,
+            OutputNormals::recompute_if(input.normals.is_some()),
+        );
+        level(
+            out,
+            stop_reason(&s, &levels),
+            err2.max(levels.max_collapse_err2).sqrt(),
+        )?;
+        p = s.into_prepared();
+    }
+    progress(1.0);
+    Ok(())
 }

@@ -28,6 +28,7 @@ pub(crate) enum Mobility {
 
 /// The prepared surface: welded topology, normalized positions, per-vertex quadrics and flags.
 /// Shared by the greedy backend and (later) the parallel ones, which start from the same state.
+#[derive(Clone)]
 pub(crate) struct Prepared {
     /// Mesh after exact welding; its vertices are the "attribute vertices" written out.
     pub mesh: Mesh,

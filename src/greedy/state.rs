@@ -9,6 +9,7 @@ use crate::options::SimplifyOptions;
 /// side; a list that outgrows its room moves into the removed vertex's (a neighbour's, so still
 /// nearby) or else to the end. Measured on the 1M scan at 10%: one `Vec` per vertex spent
 /// 0.45 G of 15 G instructions in malloc/realloc/free, and each list was a cache miss of its own.
+#[derive(Clone)]
 pub(crate) struct VertFaces {
     /// Per vertex: start, len, cap.
     span: Vec<[u32; 3]>,
@@ -132,6 +133,19 @@ impl<'a> State<'a> {
         let m = self.mark_gen + 1;
         self.mark_gen += n;
         m
+    }
+
+    /// The live mesh as a prepared problem (positions, quadrics and flags as they are now), to
+    /// go on from with a new state: the next level of detail.
+    pub(super) fn into_prepared(self) -> Prepared {
+        fn live<T: Copy>(v: &[T], alive: &[bool]) -> Vec<T> {
+            v.iter().zip(alive).filter(|p| *p.1).map(|p| *p.0).collect()
+        }
+        let mut p = self.p;
+        p.faces = live(&p.faces, &self.face_alive);
+        p.face_origin = live(&p.face_origin, &self.face_alive);
+        p.ref_normal = live(&p.ref_normal, &self.face_alive);
+        p
     }
 
     pub(super) fn stamp(&self, a: u32, b: u32) -> u32 {

@@ -243,7 +243,7 @@ pub fn compare(a: &Mesh, b: &Mesh, opts: &CompareOptions) -> Result<Comparison> 
     let (na, nb) = (opts.face_samples(fa, fb), opts.face_samples(fb, fa));
     // The two directions use different streams of the one seed.
     let seed_ab = opts.seed;
-    let seed_ba = opts.seed ^ 0xA076_1D64_78BD_642F;
+    let seed_ba = opts.seed ^ SEED_BA;
 
     let ((ta, tb), (a_to_b, b_to_a)) = rayon::join(
         || rayon::join(|| topology(a), || topology(b)),
@@ -309,6 +309,67 @@ pub fn compare(a: &Mesh, b: &Mesh, opts: &CompareOptions) -> Result<Comparison> 
             genus_b: tb.genus,
         },
     })
+}
+
+/// The stream of B's samples: A's seed with these bits flipped.
+const SEED_BA: u64 = 0xA076_1D64_78BD_642F;
+
+/// The two-sided mean distance of many meshes from one reference A, as [`compare`] measures it
+/// with the same options: the same face samples from the same seeds, so the same figure to the
+/// last bit, without what a mean does not need (A's BVH is built once; no vertex or edge
+/// samples, topology or quality). The Pareto search measures hundreds of candidates this way.
+pub struct MeanDistance<'a> {
+    a: &'a Mesh,
+    bvh_a: TriangleBvh,
+    diagonal: f64,
+    opts: CompareOptions,
+}
+
+impl<'a> MeanDistance<'a> {
+    pub fn new(a: &'a Mesh, opts: &CompareOptions) -> Result<MeanDistance<'a>> {
+        a.validate()
+            .map_err(|e| Error::InvalidMesh(format!("mesh A: {e}")))?;
+        if a.triangles.is_empty() {
+            return Err(Error::InvalidMesh("mesh A has no faces".into()));
+        }
+        Ok(MeanDistance {
+            a,
+            bvh_a: TriangleBvh::new(a),
+            diagonal: a.bounds().map_or(0.0, |bb| bb.diagonal()),
+            opts: opts.clone(),
+        })
+    }
+
+    /// `compare(A, b, opts).distance.two_sided.mean_rel`.
+    pub fn mean_rel(&self, b: &Mesh) -> Result<f64> {
+        if b.triangles.is_empty() || self.opts.samples == Some(0) {
+            return Ok(compare(self.a, b, &self.opts)?.distance.two_sided.mean_rel);
+        }
+        let (fa, fb) = (self.a.face_count(), b.face_count());
+        let (na, nb) = (
+            self.opts.face_samples(fa, fb),
+            self.opts.face_samples(fb, fa),
+        );
+        let seed = self.opts.seed;
+        let bvh_b = TriangleBvh::new(b);
+        let (ab, ba) = rayon::join(
+            || distance::one_direction(self.a, &bvh_b, na, false, seed, self.diagonal),
+            || {
+                let seed_ba = seed ^ SEED_BA;
+                distance::one_direction(b, &self.bvh_a, nb, false, seed_ba, self.diagonal)
+            },
+        );
+        if ab.face_samples == 0 || ba.face_samples == 0 {
+            // A surface of no area: its mean comes from vertex and edge samples.
+            return Ok(compare(self.a, b, &self.opts)?.distance.two_sided.mean_rel);
+        }
+        let mean = 0.5 * (ab.mean + ba.mean);
+        Ok(if self.diagonal > 0.0 {
+            mean / self.diagonal
+        } else {
+            0.0
+        })
+    }
 }
 
 /// Smallest angle (degrees) and aspect ratio of one face; `None` when it has no area.

@@ -402,10 +402,15 @@ impl Driver {
         Ok(reason)
     }
 
+    /// The largest collapse error so far (relative RMS distance).
+    pub fn max_error(&self) -> f64 {
+        (self.max_err2 as f64).sqrt()
+    }
+
     pub fn finish(self, stop_reason: StopReason) -> Driven {
         Driven {
             stop_reason,
-            max_error: (self.max_err2 as f64).sqrt(),
+            max_error: self.max_error(),
             removed: self.removed,
             collapses: self.collapses,
         }
