@@ -353,6 +353,37 @@ pub struct SimplifyReport {
     pub decimation: Option<DecimateReport>,
 }
 
+impl SimplifyReport {
+    /// The counts of `output`, a result of `input` by `backend`, with nothing else done yet:
+    /// each method fills in the rest, and a result made elsewhere (a level read back from its
+    /// file, a Pareto front member) is shown with this alone.
+    pub fn counts(
+        backend: Backend,
+        input: &crate::Mesh,
+        output: &crate::Mesh,
+        stop_reason: StopReason,
+    ) -> SimplifyReport {
+        SimplifyReport {
+            backend,
+            auto: None,
+            input_faces: input.triangles.len(),
+            target_faces: output.triangles.len(),
+            output_faces: output.triangles.len(),
+            input_vertices: input.positions.len(),
+            output_vertices: output.positions.len(),
+            collapses: input.positions.len().saturating_sub(output.positions.len()),
+            max_collapse_error: 0.0,
+            stop_reason,
+            dropped_degenerate_faces: 0,
+            pinned_vertices: 0,
+            rounds: None,
+            blocked: None,
+            clustering: None,
+            decimation: None,
+        }
+    }
+}
+
 /// What decimation did, in the report of `--stats` and `--json`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct DecimateReport {

@@ -271,22 +271,10 @@ fn a_resumed_run_lands_each_target_and_keeps_the_invariants() {
         );
         let out = up.build_output(&rounds.download().unwrap(), false);
         let report = meshslim::SimplifyReport {
-            backend: Backend::CpuParallel,
-            auto: None,
             input_faces: n,
             target_faces: target,
-            output_faces: out.triangles.len(),
-            input_vertices: m.positions.len(),
-            output_vertices: out.positions.len(),
             collapses: 0,
-            max_collapse_error: 0.0,
-            stop_reason: reason,
-            dropped_degenerate_faces: 0,
-            pinned_vertices: 0,
-            rounds: None,
-            blocked: None,
-            clustering: None,
-            decimation: None,
+            ..meshslim::SimplifyReport::counts(Backend::CpuParallel, &m, &out, reason)
         };
         check_invariants(&format!("resumed to {ratio}"), &m, &out, &report);
     }

@@ -35,6 +35,17 @@ fn finish_job(h: &mut Harness<'static, ViewerApp>) -> u64 {
     h.state().frames - f0
 }
 
+/// The faces of the LOD scene's levels, the original first.
+fn level_faces(h: &Harness<'static, ViewerApp>) -> Vec<usize> {
+    h.state()
+        .lod
+        .as_ref()
+        .unwrap_or_else(|| panic!("no levels: {}", h.state().status))
+        .iter()
+        .map(|l| l.faces)
+        .collect()
+}
+
 fn read_buffer(app: &ViewerApp, buf: &wgpu::Buffer, bytes: u64) -> Vec<u8> {
     let (device, queue) = app.device();
     let staging = device.create_buffer(&wgpu::BufferDescriptor {
@@ -231,14 +242,7 @@ fn lod_levels_come_from_one_gpu_run_and_switch_by_size_on_screen() {
     h.step();
     h.state_mut().make_lod();
     finish_job(&mut h);
-    let faces: Vec<usize> = h
-        .state()
-        .lod
-        .as_ref()
-        .unwrap_or_else(|| panic!("{}", h.state().status))
-        .iter()
-        .map(|l| l.faces)
-        .collect();
+    let faces = level_faces(&h);
     assert_eq!(faces.len(), 1 + meshslim::viewer::app::LOD_RATIOS.len());
     assert_eq!(faces[0], input);
     for (f, r) in faces[1..].iter().zip(meshslim::viewer::app::LOD_RATIOS) {
@@ -414,4 +418,196 @@ fn clustering_on_the_window_device_is_drawn_from_its_buffers() {
             "{method:?}: the result is drawn"
         );
     }
+}
+
+/// A click of the primary button at `at` with `modifiers` held, as winit hands it to egui.
+fn click_at(h: &mut Harness<'static, ViewerApp>, at: egui::Pos2, modifiers: egui::Modifiers) {
+    h.input_mut().events.push(egui::Event::PointerMoved(at));
+    h.step();
+    h.input_mut()
+        .events
+        .push(egui::Event::ModifiersChanged(modifiers));
+    for pressed in [true, false] {
+        h.input_mut().events.push(egui::Event::PointerButton {
+            pos: at,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers,
+        });
+        h.step();
+    }
+    h.input_mut()
+        .events
+        .push(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.step();
+}
+
+/// Where member `k` of the front is drawn, checked to be on screen and to hit that member.
+fn front_point(h: &Harness<'static, ViewerApp>, k: usize) -> egui::Pos2 {
+    let st = h.state();
+    let rect = st.front_rect.expect("the front's plot is drawn");
+    let front = st.front.as_ref().expect("a front");
+    let at = front.member_at(rect, k).expect("a member");
+    assert!(
+        egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1000.0, 900.0)).contains(at),
+        "member {k} at {at:?}, off the screen"
+    );
+    assert_eq!(front.hit(rect, at), Some(k), "member {k} at {at:?}");
+    at
+}
+
+/// `meshslim lods` and `meshslim pareto` manifests open in the window with the mesh they name,
+/// from another folder: the levels go to the LOD scene (each instance drawing the level its
+/// size calls for), the front to the side panel's plot. Clicking a point shows that member;
+/// Ctrl+click chooses members, and the LOD scene takes its levels from the chosen ones. A
+/// manifest of a generated mesh says how to open it.
+#[test]
+fn manifests_open_into_the_lod_scene_and_the_front_plot() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let ball = meshslim::mesh::noisy_sphere(4, 0.01, 7);
+    meshslim::io::write(&dir.path().join("ball.ply"), &ball).unwrap();
+    let run = |args: &[&str]| expect_code(&meshslim(args, dir.path()), 0);
+    run(&["lods", "ball.ply", "out", "--ratios", "0.5,0.2,0.05", "-q"]);
+    run(&[
+        "pareto",
+        "ball.ply",
+        "front",
+        "--population",
+        "12",
+        "--generations",
+        "2",
+        "--offspring",
+        "4",
+        "-q",
+    ]);
+    run(&["lods", "builtin:sphere:500", "made", "-q"]);
+    let json = |p: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join(p)).unwrap()).unwrap()
+    };
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1000.0, 900.0))
+        .wgpu_setup(meshslim::viewer::app::wgpu_setup())
+        .build_eframe(|cc| ViewerApp::new(cc, Start::Nothing).expect("the viewer starts"));
+
+    h.state_mut().open(dir.path().join("out/ball.lods.json"));
+    finish_job(&mut h);
+    let manifest = json("out/ball.lods.json");
+    let mut want = vec![ball.triangles.len()];
+    for l in manifest["levels"].as_array().unwrap() {
+        want.push(l["faces"].as_u64().unwrap() as usize);
+    }
+    let st = h.state();
+    let levels = st
+        .lod
+        .as_ref()
+        .unwrap_or_else(|| panic!("no levels: {}", st.status));
+    assert_eq!(levels.iter().map(|l| l.faces).collect::<Vec<_>>(), want);
+    assert!(st.lod_scene && st.lod_source.contains("lods"));
+    h.step();
+    let hist = h.state().lod_histogram();
+    assert_eq!(hist.iter().sum::<usize>(), 21 * 21);
+    assert!(
+        hist.iter().all(|&n| n > 0),
+        "from the first view, every level has its instances: {hist:?}"
+    );
+
+    h.state_mut()
+        .open(dir.path().join("front/ball.pareto.json"));
+    finish_job(&mut h);
+    let manifest = json("front/ball.pareto.json");
+    let members = manifest["front"].as_array().unwrap();
+    {
+        let st = h.state();
+        assert!(st.lod.is_none(), "the levels were of the model before");
+        let front = st
+            .front
+            .as_ref()
+            .unwrap_or_else(|| panic!("no front: {}", st.status));
+        assert!(members.len() >= 2, "{members:?}");
+        assert_eq!(front.members.len(), members.len());
+        for (m, e) in front.members.iter().zip(members) {
+            assert_eq!(m.vertices as u64, e["vertices"].as_u64().unwrap());
+        }
+        assert_eq!(
+            front.baseline.len(),
+            members.len(),
+            "the greedy chain, dashed"
+        );
+    }
+    h.step();
+    let last = members.len() - 1;
+    let at = front_point(&h, 1);
+    click_at(&mut h, at, egui::Modifiers::NONE);
+    finish_job(&mut h);
+    let st = h.state();
+    let shown = st
+        .simplified
+        .as_ref()
+        .unwrap_or_else(|| panic!("nothing shown: {}", st.status));
+    assert_eq!(
+        shown.mesh.triangles.len() as u64,
+        members[1]["faces"].as_u64().unwrap()
+    );
+    assert_eq!(st.front.as_ref().unwrap().selected, Some(1));
+    assert!(shown.error.is_some_and(|(mean, _)| mean > 0.0));
+    h.state_mut().side_by_side = true;
+    h.step();
+    assert!(drawn_share(&h.render().unwrap()) > 0.05);
+
+    let ctrl = egui::Modifiers {
+        ctrl: true,
+        command: true,
+        ..Default::default()
+    };
+    for k in [0, last] {
+        let at = front_point(&h, k);
+        click_at(&mut h, at, ctrl);
+    }
+    assert_eq!(
+        h.state().front.as_ref().unwrap().chosen,
+        [0, last].into_iter().collect()
+    );
+    assert!(h.state().job.is_none(), "Ctrl+click only chooses");
+    h.get_by_label("LOD scene from 2 chosen").click();
+    h.step();
+    finish_job(&mut h);
+    let faces = level_faces(&h);
+    let member_faces = |k: usize| members[k]["faces"].as_u64().unwrap() as usize;
+    assert_eq!(
+        faces,
+        [ball.triangles.len(), member_faces(last), member_faces(0)]
+    );
+
+    // The panel's Search runs the same NSGA-II on the open mesh, here and now.
+    h.state_mut().pareto.population = 10;
+    h.state_mut().pareto.generations = 2;
+    h.get_by_label("Search").click();
+    h.step();
+    finish_job(&mut h);
+    let st = h.state();
+    let front = st
+        .front
+        .as_ref()
+        .unwrap_or_else(|| panic!("no front: {}", st.status));
+    assert!(front.source.contains("searched here"), "{}", front.source);
+    assert!(!front.members.is_empty() && front.members.len() <= 10);
+    assert!(
+        front.baseline.is_empty(),
+        "the window does not measure the chain"
+    );
+    if let Ok(p) = std::env::var("MESHSLIM_FRONT_PNG") {
+        h.render().unwrap().save(p).unwrap();
+    }
+
+    h.state_mut()
+        .open(dir.path().join("made/builtin-sphere.lods.json"));
+    finish_job(&mut h);
+    let status = &h.state().status;
+    assert!(
+        status.contains("builtin:sphere:500") && status.contains("meshslim view"),
+        "{status}"
+    );
 }

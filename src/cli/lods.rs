@@ -8,7 +8,6 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use serde_json::{Value, json};
 
 use super::args::{Input, parse_angle, parse_input_arg};
 use super::error::lib;
@@ -16,7 +15,7 @@ use super::files::load;
 use super::report::Progress;
 use super::simplify::{BackendArg, MethodArg, RemovalArg};
 use crate::io::Format;
-use crate::lod::{self, ErrorMeasure, Initialisation, ParetoOptions, Variation};
+use crate::lod::{self, ErrorMeasure, Initialisation, ParetoOptions, Variation, manifest};
 use crate::metrics::{CompareOptions, compare};
 use crate::{Mesh, SimplifyOptions};
 
@@ -227,8 +226,9 @@ fn write_mesh(path: &Path, m: &Mesh) -> Result<()> {
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
-fn write_json(path: &Path, v: &Value) -> Result<()> {
-    std::fs::write(path, serde_json::to_string_pretty(v)? + "\n")
+fn write_json<T: serde::Serialize>(path: &Path, v: &T) -> Result<()> {
+    manifest::write(path, v)
+        .map_err(lib)
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
@@ -276,36 +276,40 @@ pub(super) fn run_lods(args: LodsArgs) -> Result<ExitCode> {
     for (k, (l, c)) in levels.iter().zip(&measured).enumerate() {
         let file = args.outdir.join(format!("{stem}.lod{}.{ext}", k + 1));
         write_mesh(&file, &l.mesh)?;
-        let error = c.as_ref().map(|c| {
-            json!({
-                "mean_rel": c.distance.two_sided.mean_rel,
-                "rms_rel": c.distance.two_sided.rms_rel,
-                "hausdorff_rel": c.distance.two_sided.max_rel,
-            })
+        let error = c.as_ref().map(|c| manifest::LevelError {
+            mean_rel: c.distance.two_sided.mean_rel,
+            rms_rel: c.distance.two_sided.rms_rel,
+            hausdorff_rel: c.distance.two_sided.max_rel,
         });
-        rows.push(json!({
-            "level": k + 1,
-            "file": file.display().to_string(),
-            "ratio": l.ratio,
-            "target_faces": l.target_faces,
-            "faces": l.mesh.face_count(),
-            "vertices": l.mesh.positions.len(),
-            "stop_reason": format!("{:?}", l.stop_reason),
-            "max_collapse_error": l.max_error,
-            "error": error,
-            "ready_after_seconds": l.seconds,
-        }));
+        rows.push(manifest::LodsEntry {
+            level: k + 1,
+            file: file.display().to_string(),
+            ratio: l.ratio,
+            target_faces: l.target_faces,
+            faces: l.mesh.face_count(),
+            vertices: l.mesh.positions.len(),
+            stop_reason: format!("{:?}", l.stop_reason),
+            max_collapse_error: Some(l.max_error).filter(|e| e.is_finite()),
+            error,
+            ready_after_seconds: l.seconds,
+        });
     }
     let save_s = t.elapsed().as_secs_f64();
-    let manifest = json!({
-        "input": args.input.display(),
-        "faces": mesh.face_count(),
-        "vertices": mesh.positions.len(),
-        "method": opts.method.name(),
-        "backend": backend.name(),
-        "levels": rows,
-        "seconds": {"load": load_s, "simplify": simplify_s, "measure": measure_s, "save": save_s},
-    });
+    let manifest = manifest::LodsManifest {
+        input: args.input.display(),
+        input_from_manifest: input_from(&args.input, &args.outdir),
+        faces: mesh.face_count(),
+        vertices: mesh.positions.len(),
+        method: opts.method.name().into(),
+        backend: backend.name().into(),
+        levels: rows,
+        seconds: manifest::LodsSeconds {
+            load: load_s,
+            simplify: simplify_s,
+            measure: measure_s,
+            save: save_s,
+        },
+    };
     let manifest_path = args.outdir.join(format!("{stem}.lods.json"));
     write_json(&manifest_path, &manifest)?;
     if args.json {
@@ -394,9 +398,11 @@ pub(super) fn run_pareto(args: ParetoArgs) -> Result<ExitCode> {
             .outdir
             .join(format!("{stem}.pareto-{}v.{ext}", c.vertices));
         write_mesh(&file, &run.front_meshes[k])?;
-        let greedy = run.baseline.get(k).map(|b| {
-            json!({"vertices": b.vertices, "faces": b.faces, "objective": b.objective,
-                   "metro_mean": finite(b.metro_mean)})
+        let greedy = run.baseline.get(k).map(|b| manifest::GreedyEntry {
+            vertices: b.vertices,
+            faces: b.faces,
+            objective: b.objective,
+            metro_mean: finite(b.metro_mean),
         });
         if args.write_baseline {
             let file = args
@@ -404,46 +410,60 @@ pub(super) fn run_pareto(args: ParetoArgs) -> Result<ExitCode> {
                 .join(format!("{stem}.greedy-{}v.{ext}", c.vertices));
             write_mesh(&file, &run.baseline_meshes[k])?;
         }
-        members.push(json!({
-            "file": file.display().to_string(),
-            "vertices": c.vertices,
-            "faces": c.faces,
-            "objective": c.error,
-            "metro_mean": finite(m.metro_mean),
-            "greedy_at_same_vertices": greedy,
-        }));
+        members.push(manifest::MemberEntry {
+            file: file.display().to_string(),
+            vertices: c.vertices,
+            faces: c.faces,
+            objective: c.error,
+            metro_mean: finite(m.metro_mean),
+            greedy_at_same_vertices: greedy,
+        });
     }
     let measured = !run.baseline.is_empty();
     let hv = |of: &[crate::lod::Measured]| measured.then(|| run.metro_hypervolume(of));
-    let generations: Vec<Value> = run
+    let generations = run
         .generations
         .iter()
         .enumerate()
-        .map(|(g, gen_)| {
-            json!({"generation": g, "hypervolume": gen_.hypervolume, "front": gen_.front})
+        .map(|(g, gen_)| manifest::GenerationEntry {
+            generation: g,
+            hypervolume: gen_.hypervolume,
+            front: gen_.front.clone(),
         })
         .collect();
-    let out = json!({
-        "input": args.input.display(),
-        "vertices": run.input_vertices,
-        "removable": run.removable,
-        "options": {
-            "population": opts.population, "generations": opts.generations,
-            "offspring": opts.offspring, "mutation": opts.mutation,
-            "tournament": opts.tournament, "seed": opts.seed,
-            "error": format!("{:?}", args.error), "init": format!("{:?}", args.init),
-            "crossover": format!("{:?}", args.crossover),
-            "mutation_at": format!("{:?}", args.mutation_at),
-            "anchor": opts.anchor, "search_samples": opts.search_samples,
+    let out = manifest::ParetoManifest {
+        input: args.input.display(),
+        input_from_manifest: input_from(&args.input, &args.outdir),
+        vertices: run.input_vertices,
+        removable: run.removable,
+        options: manifest::ParetoManifestOptions {
+            population: opts.population,
+            generations: opts.generations,
+            offspring: opts.offspring,
+            mutation: opts.mutation,
+            tournament: opts.tournament,
+            seed: opts.seed,
+            error: format!("{:?}", args.error),
+            init: format!("{:?}", args.init),
+            crossover: format!("{:?}", args.crossover),
+            mutation_at: format!("{:?}", args.mutation_at),
+            anchor: opts.anchor,
+            search_samples: opts.search_samples,
         },
-        "reference_point": run.reference,
-        "objective_axes": ["share of the vertices kept", "error relative to the diagonal"],
-        "evaluations": run.evaluations,
-        "generations": generations,
-        "front": members,
-        "metro_hypervolume": {"front": hv(&run.front_measured), "greedy_chain": hv(&run.baseline)},
-        "seconds": search_s,
-    });
+        reference_point: run.reference,
+        objective_axes: vec![
+            "share of the vertices kept".into(),
+            "error relative to the diagonal".into(),
+        ],
+        evaluations: run.evaluations,
+        generations,
+        front: members,
+        metro_hypervolume: manifest::MetroHypervolume {
+            front: hv(&run.front_measured),
+            greedy_chain: hv(&run.baseline),
+        },
+        seconds: search_s,
+    };
     let json_path = args.outdir.join(format!("{stem}.pareto.json"));
     write_json(&json_path, &out)?;
     let fronts: Vec<Vec<crate::lod::nsga::Point>> =
@@ -499,7 +519,15 @@ pub(super) fn run_pareto(args: ParetoArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The input file's path from the output folder (where the manifest goes).
+fn input_from(input: &Input, outdir: &Path) -> Option<String> {
+    match input {
+        Input::File(p) => manifest::path_from(outdir, p),
+        Input::Builtin { .. } => None,
+    }
+}
+
 /// NaN (not measured) as JSON null.
-fn finite(x: f64) -> Value {
-    if x.is_finite() { json!(x) } else { Value::Null }
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
 }

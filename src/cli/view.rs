@@ -8,9 +8,11 @@ use anyhow::{Context, Result};
 use clap::Args;
 
 use super::args::{Input, parse_input_arg, parse_ratio, parse_size};
+use super::builtins::BUILTIN_PREFIX;
 use super::error::{UsageError, lib};
 use super::files::{check_directory, load};
 use super::report::Progress;
+use crate::lod::manifest::{self, ManifestKind};
 
 pub(super) const VIEW_AFTER_HELP: &str = "\
 In the window: left drag orbits, right or middle drag pans, the wheel zooms, G flies (W A S D),
@@ -19,16 +21,26 @@ Enter simplifies to the target, Esc cancels, Ctrl+O opens, Ctrl+S saves, P takes
 F1 lists them all. Simplification runs beside the drawing: the window keeps drawing (frame time
 in the side panel) and the run can be cancelled.
 
+A manifest opens with the mesh it was made from: X.lods.json (from 'meshslim lods') puts its
+levels in the LOD scene, a 21x21 grid where each instance draws the level its size on screen
+calls for (L toggles LOD; the panel shows the frame time with and without). X.pareto.json (from
+'meshslim pareto') plots its front in the side panel: click a point to show that member (B for
+side by side with the original), Ctrl+click to choose members for the LOD scene. The panel's
+Search runs the same NSGA-II on the open mesh.
+
 Examples:
   meshslim view ../shared/models/horse.ply
   meshslim view ../shared/models/spot/spot_triangulated.obj --mode texture --screenshot spot.png
   meshslim view ../shared/models/horse.ply --screenshot horse.png --ratio 0.1
+  meshslim view lods/horse.lods.json
+  meshslim view front/horse.pareto.json
   meshslim view scan.ply --screenshot err.png --ratio 0.01 --mode heatmap --size 1600x1200";
 
 #[derive(Debug, Args)]
 pub struct ViewArgs {
-    /// The mesh: a file or builtin:NAME[:FACES]; without one the window opens empty (Ctrl+O or
-    /// drop a file on it)
+    /// The mesh: a file or builtin:NAME[:FACES], or a manifest of `meshslim lods` or `pareto`
+    /// (X.lods.json, X.pareto.json); without one the window opens empty (Ctrl+O or drop a file
+    /// on it)
     #[arg(value_name = "MESH", value_parser = parse_input_arg)]
     pub input: Option<Input>,
 
@@ -118,6 +130,21 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
                 .context("cannot read the input")?;
         }
         let start = match &args.input {
+            Some(Input::File(p)) if ManifestKind::of(p).is_some() => {
+                // A manifest made from a generated mesh: made again here, where the builtins
+                // are; a file is read by the window.
+                let input = manifest::input_of(p)
+                    .map_err(lib)
+                    .context("cannot read the manifest")?;
+                if input.starts_with(BUILTIN_PREFIX) {
+                    let made = parse_input_arg(&input).map_err(|e| {
+                        UsageError(format!("{}: its input {input}: {e}", p.display()))
+                    })?;
+                    crate::viewer::Start::Manifest(p.clone(), model(&made)?)
+                } else {
+                    crate::viewer::Start::Open(p.clone())
+                }
+            }
             Some(Input::File(p)) if args.texture.is_none() => crate::viewer::Start::Open(p.clone()),
             Some(input) => crate::viewer::Start::Model(model(input)?),
             None => crate::viewer::Start::Nothing,
@@ -137,6 +164,16 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     let Some(input) = &args.input else {
         return Err(UsageError("--screenshot needs a MESH to draw".into()).into());
     };
+    if let Input::File(p) = input
+        && ManifestKind::of(p).is_some()
+    {
+        return Err(UsageError(format!(
+            "{}: a manifest opens in the window (without --screenshot); a screenshot draws one \
+             mesh: give one of its files",
+            p.display()
+        ))
+        .into());
+    }
     if !png
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("png"))

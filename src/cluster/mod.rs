@@ -762,21 +762,9 @@ fn clustered_report(
     report: ClusterReport,
 ) -> SimplifyReport {
     SimplifyReport {
-        backend,
-        auto: None,
-        input_faces: mesh.triangles.len(),
         target_faces: opts.target_faces,
-        output_faces: out.triangles.len(),
-        input_vertices: mesh.positions.len(),
-        output_vertices: out.positions.len(),
-        collapses: mesh.positions.len().saturating_sub(out.positions.len()),
         max_collapse_error: max_error(built),
-        stop_reason: stop,
-        dropped_degenerate_faces: 0,
-        pinned_vertices: 0,
-        rounds: None,
-        blocked: None,
         clustering: Some(report),
-        decimation: None,
+        ..SimplifyReport::counts(backend, mesh, out, stop)
     }
 }

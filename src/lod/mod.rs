@@ -4,6 +4,7 @@
 //! Campomanes-Álvarez et al., "Multi-objective optimization of level-of-detail meshes", 2012).
 
 mod chain;
+pub mod manifest;
 pub mod nsga;
 mod pareto;
 pub mod svg;

@@ -13,29 +13,10 @@ const BOTTOM: f64 = 60.0;
 
 /// The plot: `fronts` in order (the last drawn darkest), `baseline` dashed, `title` on top.
 pub fn fronts_svg(title: &str, fronts: &[Vec<Point>], baseline: &[Point]) -> String {
-    let all = || {
-        fronts
-            .iter()
-            .flatten()
-            .chain(baseline)
-            .filter(|p| p[1] > 0.0)
-    };
-    let x_max = all().map(|p| p[0]).fold(0.0, f64::max).max(1e-9);
-    let (mut y_lo, mut y_hi) = all().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
-        (lo.min(p[1]), hi.max(p[1]))
-    });
-    if y_lo > y_hi {
-        (y_lo, y_hi) = (1e-6, 1e-2);
-    }
-    let (l0, l1) = (
-        y_lo.log10().floor(),
-        y_hi.log10().ceil().max(y_lo.log10().floor() + 1.0),
-    );
-    let px = |x: f64| LEFT + x / x_max * (W - LEFT - RIGHT);
-    let py = |y: f64| {
-        let t = (y.max(10f64.powf(l0)).log10() - l0) / (l1 - l0);
-        H - BOTTOM - t * (H - TOP - BOTTOM)
-    };
+    let axes = Axes::fit(fronts.iter().flatten().chain(baseline));
+    let (x_max, (l0, l1)) = (axes.x_max, axes.decades);
+    let px = |x: f64| LEFT + axes.unit([x, 1.0]).0 * (W - LEFT - RIGHT);
+    let py = |y: f64| H - BOTTOM - axes.unit([0.0, y]).1 * (H - TOP - BOTTOM);
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -127,6 +108,42 @@ pub fn fronts_svg(title: &str, fronts: &[Vec<Point>], baseline: &[Point]) -> Str
     );
     s.push_str("</svg>\n");
     s
+}
+
+/// The plot's axes, shared by the SVG and the viewer's front: the share of vertices kept from 0
+/// to the largest, and the error on a log scale over whole decades.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Axes {
+    pub x_max: f64,
+    /// The first and last decade (powers of ten) of the error axis.
+    pub decades: (f64, f64),
+}
+
+impl Axes {
+    /// Axes holding every point with a positive error (a zero error has no place on a log
+    /// scale; it is drawn at the bottom).
+    pub fn fit<'a>(points: impl Iterator<Item = &'a Point> + Clone) -> Axes {
+        let all = || points.clone().filter(|p| p[1] > 0.0);
+        let x_max = all().map(|p| p[0]).fold(0.0, f64::max).max(1e-9);
+        let (mut y_lo, mut y_hi) = all().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+            (lo.min(p[1]), hi.max(p[1]))
+        });
+        if y_lo > y_hi {
+            (y_lo, y_hi) = (1e-6, 1e-2);
+        }
+        let l0 = y_lo.log10().floor();
+        Axes {
+            x_max,
+            decades: (l0, y_hi.log10().ceil().max(l0 + 1.0)),
+        }
+    }
+
+    /// Where `p` falls in the plot, each coordinate in [0, 1] (y up).
+    pub fn unit(&self, p: Point) -> (f64, f64) {
+        let (l0, l1) = self.decades;
+        let y = (p[1].max(10f64.powf(l0)).log10() - l0) / (l1 - l0);
+        (p[0] / self.x_max, y.min(1.0))
+    }
 }
 
 fn escape(t: &str) -> String {

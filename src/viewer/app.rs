@@ -13,9 +13,10 @@
 use super::camera::{Camera, Up};
 use super::file_browser::{Browser, BrowserResult};
 // The tests name the levels' ratios through the app, as before the LOD scene had a file.
+use super::front::Front;
 pub use super::lod::LOD_RATIOS;
 use super::render::{Mode, Renderer, SceneMesh, Style, Target};
-use super::scene::{Model, Simplified};
+use super::scene::{Loaded, Model, Simplified};
 use crate::error::{Error, Result};
 use crate::gpu::GpuSimplifier;
 use crate::options::{Backend, Cancel};
@@ -35,8 +36,11 @@ const JOB_FRAME_INTERVAL: std::time::Duration = std::time::Duration::from_millis
 pub enum Start {
     Nothing,
     Model(Model),
-    /// Read on a worker thread once the window is up.
+    /// Read on a worker thread once the window is up: a mesh, or a `meshslim lods` or
+    /// `meshslim pareto` manifest with the mesh it names.
     Open(PathBuf),
+    /// A manifest whose mesh the command line has made (a `builtin:` input).
+    Manifest(PathBuf, Model),
 }
 
 /// The device the window draws with, and the simplifier's pipelines on it.
@@ -53,9 +57,13 @@ pub(super) struct Gpu {
 
 /// A finished job's result (boxed: the variants differ in size by hundreds of bytes).
 pub(super) enum Done {
-    Loaded(Result<Box<(Model, SceneMesh)>>),
+    Loaded(Result<Box<Loaded>>),
     Simplified(Result<Box<Simplified>>),
     Lod(Result<Vec<SceneMesh>>),
+    /// A search's front.
+    Front(Result<Box<Front>>),
+    /// Member `k` of the front, ready to show.
+    Member(Result<Box<(usize, Simplified)>>),
 }
 
 /// Work on a worker thread.
@@ -126,7 +134,16 @@ pub struct ViewerApp {
     pub model: Option<Arc<Model>>,
     pub original: Option<Arc<SceneMesh>>,
     pub simplified: Option<Simplified>,
+    /// The LOD scene's levels, the original first.
     pub lod: Option<Vec<SceneMesh>>,
+    /// Where the levels came from (shown in the panel).
+    pub lod_source: String,
+    /// A Pareto front of the model: searched here or read from a manifest.
+    pub front: Option<Front>,
+    /// The search the window runs.
+    pub pareto: crate::lod::ParetoOptions,
+    /// Where the front's plot was last drawn.
+    pub front_rect: Option<egui::Rect>,
     pub job: Option<Job>,
     pub camera: Camera,
     pub style: Style,
@@ -210,6 +227,10 @@ impl ViewerApp {
             original: None,
             simplified: None,
             lod: None,
+            lod_source: String::new(),
+            front: None,
+            pareto: super::front::window_search(),
+            front_rect: None,
             job: None,
             camera: Camera::default(),
             style: Style::default(),
@@ -252,6 +273,7 @@ impl ViewerApp {
                 app.set_model(m, original);
             }
             Start::Open(p) => app.open(p),
+            Start::Manifest(p, m) => app.open_with(p, Some(m)),
         }
         Ok(app)
     }
@@ -375,6 +397,8 @@ impl ViewerApp {
         self.lod = None;
         self.lod_scene = false;
         self.lod_frame = [None, None];
+        self.front = None;
+        self.front_rect = None;
     }
 
     pub(super) fn aspect(&self) -> f32 {

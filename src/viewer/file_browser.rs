@@ -51,7 +51,10 @@ impl Browser {
                         .is_some_and(|x| {
                             MESH_EXTENSIONS.contains(&x.to_ascii_lowercase().as_str())
                         });
-                    if (is_dir || is_mesh) && !name.starts_with('.') {
+                    // The manifests of `meshslim lods` and `pareto` open with their mesh.
+                    let is_manifest =
+                        crate::lod::manifest::ManifestKind::of(Path::new(&name)).is_some();
+                    if (is_dir || is_mesh || is_manifest) && !name.starts_with('.') {
                         self.entries.push((name, is_dir));
                     }
                 }

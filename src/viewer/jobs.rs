@@ -3,9 +3,11 @@
 //! their results when they are done.
 
 use super::app::{Done, Job, ViewerApp};
+use super::front::Front;
 use super::lod::LOD_RATIOS;
 use super::panels::error_text;
-use super::scene::{self, Model};
+use super::render::SceneMesh;
+use super::scene::{self, Loaded, Model, Simplified};
 use crate::error::{Error, Result};
 use crate::options::{Cancel, SimplifyOptions};
 use std::path::PathBuf;
@@ -15,18 +17,114 @@ use std::sync::mpsc;
 use std::time::Instant;
 
 impl ViewerApp {
-    /// Reads `path` on a worker thread.
+    /// Reads `path` on a worker thread: a mesh, or a manifest of `meshslim lods` (its levels
+    /// go to the LOD scene) or `meshslim pareto` (its front to the panel) with its mesh.
     pub fn open(&mut self, path: PathBuf) {
+        self.open_with(path, None);
+    }
+
+    /// As [`ViewerApp::open`], with the manifest's mesh already made.
+    pub fn open_with(&mut self, path: PathBuf, model: Option<Model>) {
         let device = self.gpu.device.clone();
         let label = format!("reading {}", path.display());
         self.spawn(
             label,
-            move |_, _, _| {
-                let m = Model::open(&path, None)?;
-                let original = m.original(&device)?;
-                Ok(Box::new((m, original)))
-            },
+            move |_, progress, _| scene::open(&device, &path, model, progress).map(Box::new),
             Done::Loaded,
+        );
+    }
+
+    /// Searches the Pareto front of the model (NSGA-II, [`crate::lod::pareto_front`]) with
+    /// [`ViewerApp::pareto`]'s settings on a worker thread.
+    pub fn search_front(&mut self) {
+        let Some(model) = self.model.clone() else {
+            self.status = "nothing to search: open a mesh first".into();
+            return;
+        };
+        let mut opts = self.pareto.clone();
+        let label = format!(
+            "searching the Pareto front (population {}, {} generations)",
+            opts.population, opts.generations
+        );
+        let source = format!(
+            "searched here: population {}, {} generations, seed {}",
+            opts.population, opts.generations, opts.seed
+        );
+        self.spawn(
+            label,
+            move |cancel, progress, _| {
+                opts.engine.cancel = cancel;
+                let run = crate::lod::pareto_front(&model.mesh, &opts, progress)?;
+                Ok(Box::new(Front::from_run(run, source)))
+            },
+            Done::Front,
+        );
+    }
+
+    /// Shows member `k` of the front in the view (and the side-by-side) as the simplified mesh.
+    pub fn show_member(&mut self, k: usize) {
+        let (Some(model), Some(front)) = (self.model.clone(), &self.front) else {
+            return;
+        };
+        let Some(member) = front.members.get(k).cloned() else {
+            return;
+        };
+        let device = self.gpu.device.clone();
+        let label = format!("showing the member of {} vertices", member.vertices);
+        self.spawn(
+            label,
+            move |cancel, _, phase| {
+                let mesh = member.mesh.load()?;
+                let report = crate::SimplifyReport::counts(
+                    crate::Backend::Cpu,
+                    &model.mesh,
+                    &mesh,
+                    crate::options::StopReason::TargetReached,
+                );
+                let mut s = scene::show(&device, &model, (*mesh).clone(), report, &cancel, phase)?;
+                s.made_by = Some(format!(
+                    "member {} of the Pareto front: error {:.3e} by its search",
+                    k + 1,
+                    member.error
+                ));
+                Ok(Box::new((k, s)))
+            },
+            Done::Member,
+        );
+    }
+
+    /// The LOD scene from the chosen members of the front, the original first and then the
+    /// members by falling face count.
+    pub fn lod_from_front(&mut self) {
+        let (Some(model), Some(front)) = (self.model.clone(), &self.front) else {
+            return;
+        };
+        let mut members: Vec<_> = front
+            .chosen
+            .iter()
+            .map(|&k| front.members[k].clone())
+            .filter(|m| m.faces < model.faces())
+            .collect();
+        if members.is_empty() {
+            self.status = "choose members of the front first (Ctrl+click)".into();
+            return;
+        }
+        members.sort_by_key(|m| std::cmp::Reverse(m.faces));
+        let device = self.gpu.device.clone();
+        self.lod_source = format!("{} members of the Pareto front", members.len());
+        self.spawn(
+            "making the LOD scene from the front".into(),
+            move |cancel, progress, _| {
+                let mut levels = vec![model.original(&device)?];
+                for (i, m) in members.iter().enumerate() {
+                    cancel.check()?;
+                    let mesh = m.mesh.load()?;
+                    levels.push(model.level(&device, &mesh)?);
+                    progress((i + 1) as f32 / members.len() as f32);
+                }
+                Ok(levels)
+            },
+            Done::Lod,
         );
     }
 
@@ -88,6 +186,7 @@ impl ViewerApp {
             return;
         };
         let device = self.gpu.device.clone();
+        self.lod_source = "GPU snapshots of one run".into();
         self.spawn(
             "making levels of detail on the GPU".into(),
             move |cancel, progress, _| {
@@ -178,8 +277,43 @@ impl ViewerApp {
         };
         match done {
             Done::Loaded(Ok(loaded)) => {
-                let (m, original) = *loaded;
-                self.set_model(m, original)
+                let Loaded {
+                    model,
+                    original,
+                    levels,
+                    front,
+                } = *loaded;
+                self.set_model(model, original);
+                if let Some(levels) = levels {
+                    self.lod_source =
+                        format!("the {} levels of a meshslim lods run", levels.len() - 1);
+                    self.show_levels(levels);
+                }
+                if let Some(f) = front {
+                    self.status = format!(
+                        "{}; Pareto front of {} members",
+                        self.status,
+                        f.members.len()
+                    );
+                    self.front = Some(f);
+                }
+            }
+            Done::Front(Ok(f)) => {
+                self.status = format!("Pareto front of {} members in {secs:.1} s", f.members.len());
+                self.front = Some(*f);
+            }
+            Done::Member(Ok(m)) => {
+                let (k, s) = *m;
+                if let Some(f) = &mut self.front {
+                    f.selected = Some(k);
+                }
+                self.status = format!(
+                    "front member: {} faces, {} vertices, {}",
+                    s.report.output_faces,
+                    s.report.output_vertices,
+                    error_text(s.error)
+                );
+                self.show_simplified(s);
             }
             Done::Simplified(Ok(s)) => {
                 self.status = format!(
@@ -190,10 +324,7 @@ impl ViewerApp {
                     s.report.backend.name(),
                     error_text(s.error)
                 );
-                self.style.error_scale = s.scene.max_error;
-                self.simplified = Some(*s);
-                self.generation += 1;
-                self.show_original = false;
+                self.show_simplified(*s);
             }
             Done::Lod(Ok(levels)) => {
                 let faces: Vec<String> = levels.iter().map(|l| l.faces.to_string()).collect();
@@ -201,14 +332,30 @@ impl ViewerApp {
                     "levels of detail in {secs:.2} s: {} faces",
                     faces.join(" / ")
                 );
-                self.lod = Some(levels);
-                self.generation += 1;
-                self.lod_scene = true;
-                self.camera = self.lod_home();
+                self.show_levels(levels);
             }
-            Done::Loaded(Err(e)) | Done::Simplified(Err(e)) | Done::Lod(Err(e)) => {
-                self.status = failed(e)
-            }
+            Done::Loaded(Err(e))
+            | Done::Simplified(Err(e))
+            | Done::Lod(Err(e))
+            | Done::Front(Err(e))
+            | Done::Member(Err(e)) => self.status = failed(e),
         }
+    }
+}
+
+impl ViewerApp {
+    fn show_simplified(&mut self, s: Simplified) {
+        self.style.error_scale = s.scene.max_error;
+        self.simplified = Some(s);
+        self.generation += 1;
+        self.show_original = false;
+    }
+
+    fn show_levels(&mut self, levels: Vec<SceneMesh>) {
+        self.lod = Some(levels);
+        self.lod_frame = [None, None];
+        self.generation += 1;
+        self.lod_scene = true;
+        self.camera = self.lod_home();
     }
 }

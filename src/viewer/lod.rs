@@ -9,17 +9,16 @@ pub const LOD_RATIOS: [f64; 3] = [0.25, 0.06, 0.015];
 /// Instances this many diagonals apart.
 pub(super) const LOD_SPACING: f32 = 1.25;
 
-/// The level an instance `pixels` tall on screen draws: the original from
-/// [`LOD_FULL_PIXELS`] up, each coarser level below half the size of the one before (the levels'
-/// face counts fall about 4× apart, so the faces per pixel stay about even).
-pub fn lod_level(pixels: f32, levels: usize) -> usize {
-    let mut level = 0;
-    let mut size = LOD_FULL_PIXELS;
-    while pixels < size && level + 1 < levels {
-        level += 1;
-        size *= 0.5;
-    }
-    level
+/// The level an instance `pixels` tall on screen draws, of levels keeping `fractions` of the
+/// original's faces (the original first, 1): the finest whose faces per square pixel stay
+/// within the original's at [`LOD_FULL_PIXELS`] tall, else the coarsest. Levels 4× apart in
+/// faces change at each halving of the size.
+pub fn lod_level(pixels: f32, fractions: &[f64]) -> usize {
+    let budget = (pixels as f64 / LOD_FULL_PIXELS as f64).powi(2);
+    fractions
+        .iter()
+        .position(|&f| f <= budget)
+        .unwrap_or(fractions.len().saturating_sub(1))
 }
 
 /// On-screen height from which the LOD scene draws the original.
@@ -31,15 +30,26 @@ mod tests {
 
     #[test]
     fn larger_instances_draw_finer_levels() {
-        let levels = 4;
-        assert_eq!(lod_level(1e4, levels), 0, "large on screen: the original");
+        let levels = [1.0, 0.25, 0.0625, 0.015625];
+        assert_eq!(lod_level(1e4, &levels), 0, "large on screen: the original");
         let mut last = 0;
         for px in [500.0, 240.0, 200.0, 100.0, 50.0, 20.0, 1.0, 0.0] {
-            let l = lod_level(px, levels);
-            assert!(l >= last && l < levels, "{px} px: level {l}");
+            let l = lod_level(px, &levels);
+            assert!(l >= last && l < levels.len(), "{px} px: level {l}");
             last = l;
         }
-        assert_eq!(last, levels - 1, "tiny is the coarsest");
-        assert_eq!(lod_level(0.0, 1), 0, "one level only");
+        assert_eq!(last, levels.len() - 1, "tiny is the coarsest");
+        assert_eq!(lod_level(0.0, &[1.0]), 0, "one level only");
+        // 4x apart in faces: a level per halving of the size.
+        for (px, level) in [(241.0, 0), (239.0, 1), (121.0, 1), (119.0, 2), (59.0, 3)] {
+            assert_eq!(lod_level(px, &levels), level, "{px} px");
+        }
+        // Levels of a lods run (0.5 .. 0.01): each its own size band, in order.
+        let run = [1.0, 0.5, 0.25, 0.1, 0.05, 0.01];
+        let bands: Vec<usize> = [240.0, 200.0, 150.0, 100.0, 60.0, 30.0, 10.0]
+            .iter()
+            .map(|&px| lod_level(px, &run))
+            .collect();
+        assert_eq!(bands, [0, 1, 2, 3, 4, 5, 5]);
     }
 }

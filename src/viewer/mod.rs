@@ -7,6 +7,7 @@
 pub mod app;
 pub mod camera;
 mod file_browser;
+pub mod front;
 mod jobs;
 pub mod lod;
 pub mod panels;

@@ -1,9 +1,10 @@
-//! The egui side panel (target, backend, view options, LOD scene, statistics, save and
-//! screenshot), the keyboard shortcuts, the help window and dropped files.
+//! The egui side panel (target, backend, view options, LOD scene, Pareto front, statistics,
+//! save and screenshot), the keyboard shortcuts, the help window and dropped files.
 
 use super::app::ViewerApp;
 use super::camera::Up;
 use super::file_browser::Browser;
+use super::front::FrontClick;
 use super::lod::LOD_GRID;
 use super::render::Mode;
 use crate::options::Backend;
@@ -284,6 +285,7 @@ impl ViewerApp {
         if let Some(levels) = &self.lod {
             let f: Vec<String> = levels.iter().map(|l| l.faces.to_string()).collect();
             ui.label(format!("levels: {} faces", f.join(" / ")));
+            ui.label(format!("from {}", self.lod_source));
             let ms = |v: Option<f64>| {
                 v.map_or("-".into(), |s| {
                     format!("{:.1} ms ({:.1} FPS)", s * 1e3, 1.0 / s)
@@ -292,6 +294,8 @@ impl ViewerApp {
             ui.label(format!("LOD on: {}", ms(self.lod_frame[0])));
             ui.label(format!("LOD off: {}", ms(self.lod_frame[1])));
         }
+        ui.separator();
+        self.front_ui(ui);
         ui.separator();
         self.stats_ui(ui);
         ui.separator();
@@ -315,6 +319,85 @@ impl ViewerApp {
                 self.screenshot();
             }
         });
+    }
+
+    /// The side panel's front section: the search, the plot, the member shown and the LOD
+    /// scene from the chosen ones.
+    pub(super) fn front_ui(&mut self, ui: &mut egui::Ui) {
+        ui.label("Pareto front (vertex removal)");
+        ui.horizontal(|ui| {
+            let can = self.job.is_none() && self.model.is_some();
+            if ui
+                .add_enabled(can, egui::Button::new("Search"))
+                .on_hover_text(
+                    "NSGA-II over which vertices to remove, as meshslim pareto: vertices \
+                     against error; or open a .pareto.json it wrote",
+                )
+                .clicked()
+            {
+                self.search_front();
+            }
+            ui.add(
+                egui::DragValue::new(&mut self.pareto.population)
+                    .range(2..=1000)
+                    .prefix("pop "),
+            );
+            ui.add(
+                egui::DragValue::new(&mut self.pareto.generations)
+                    .range(0..=500)
+                    .prefix("gen "),
+            );
+        });
+        let Some(front) = &self.front else { return };
+        let (click, rect) = front.plot_ui(ui);
+        self.front_rect = Some(rect);
+        ui.label(format!(
+            "{} members; click one to show it, Ctrl+click to choose levels",
+            front.members.len()
+        ));
+        if let Some(k) = front.selected {
+            let m = &front.members[k];
+            ui.label(format!(
+                "shown: {} vertices, {} faces, error {:.3e}",
+                m.vertices, m.faces, m.error
+            ));
+        }
+        let chosen = front.chosen.len();
+        ui.horizontal(|ui| {
+            let can = chosen > 0 && self.job.is_none();
+            if ui
+                .add_enabled(
+                    can,
+                    egui::Button::new(format!("LOD scene from {chosen} chosen")),
+                )
+                .on_disabled_hover_text("Ctrl+click points of the front to choose them")
+                .clicked()
+            {
+                self.lod_from_front();
+            }
+            if ui
+                .add_enabled(chosen > 0, egui::Button::new("Clear"))
+                .clicked()
+                && let Some(f) = &mut self.front
+            {
+                f.chosen.clear();
+            }
+        });
+        match click {
+            Some(FrontClick::Show(k)) => self.show_member(k),
+            Some(FrontClick::Choose(k)) => self.choose_member(k),
+            None => {}
+        }
+    }
+
+    /// Chooses member `k` for the LOD scene, or takes it back.
+    pub fn choose_member(&mut self, k: usize) {
+        if let Some(f) = &mut self.front
+            && k < f.members.len()
+            && !f.chosen.remove(&k)
+        {
+            f.chosen.insert(k);
+        }
     }
 
     fn stats_ui(&self, ui: &mut egui::Ui) {
@@ -348,12 +431,15 @@ impl ViewerApp {
             }
         });
         let Some(s) = &self.simplified else { return };
-        ui.label(format!(
-            "{}: {:.3} s, stop: {:?}",
-            s.report.backend.name(),
-            s.seconds,
-            s.report.stop_reason
-        ));
+        match &s.made_by {
+            Some(m) => ui.label(m),
+            None => ui.label(format!(
+                "{}: {:.3} s, stop: {:?}",
+                s.report.backend.name(),
+                s.seconds,
+                s.report.stop_reason
+            )),
+        };
         ui.label(error_text(s.error));
         if let Some(r) = &s.report.rounds {
             ui.label(format!("{} rounds; time per stage:", r.rounds));
@@ -407,6 +493,11 @@ pub const HELP: &[(&str, &str)] = &[
     ("B", "side by side: original | simplified"),
     ("O", "show the original instead of the result"),
     ("L", "LOD on/off in the LOD scene"),
+    (
+        "click a front point",
+        "show that member of the Pareto front",
+    ),
+    ("Ctrl+click", "choose a front member for the LOD scene"),
     ("Enter", "simplify to the target"),
     ("Esc", "cancel the running job (or close this)"),
     ("Ctrl+O", "open a mesh (or drop a file on the window)"),

@@ -3,10 +3,12 @@
 //! detail. Nothing here touches egui; the window (`app.rs`) and the tests drive it alike.
 
 use super::camera::Up;
+use super::front::Front;
 use super::render::{Extras, SceneMesh, vertex_normals};
 use crate::cluster::gpu::GpuClusterer;
 use crate::error::{Error, Result};
 use crate::gpu::{GpuMesh, GpuRounds, GpuSimplifier};
+use crate::lod::manifest::{self, ManifestKind};
 use crate::mesh::{Mesh, UvOrigin};
 use crate::metrics::{CompareOptions, TriangleBvh, compare};
 use crate::options::{Backend, SimplifyOptions, SimplifyReport};
@@ -42,6 +44,96 @@ pub struct Model {
     pub load_seconds: f64,
     /// The axis drawn up: its file format's convention ([`Up::of_file`]), +Y when generated.
     pub up_axis: Up,
+}
+
+/// What opening a file gives: the model and its original drawn, and from a manifest the levels
+/// of a `meshslim lods` run (for the LOD scene, the original first) or the front of a
+/// `meshslim pareto` run.
+pub struct Loaded {
+    pub model: Model,
+    pub original: SceneMesh,
+    pub levels: Option<Vec<SceneMesh>>,
+    pub front: Option<Front>,
+}
+
+/// Opens `path`: a mesh, or a manifest (`X.lods.json`, `X.pareto.json`) with the mesh it was
+/// made from, read from where it names it — or `given`, when the command line has made it
+/// (a `builtin:` input). `progress` gets the fraction of the level files read.
+pub fn open(
+    device: &wgpu::Device,
+    path: &Path,
+    given: Option<Model>,
+    progress: &mut dyn FnMut(f32),
+) -> Result<Loaded> {
+    let model_of = |input: &str, relative: Option<&str>, given: Option<Model>| -> Result<Model> {
+        if let Some(m) = given {
+            return Ok(m);
+        }
+        if input.starts_with("builtin:") {
+            return Err(Error::InvalidOption(format!(
+                "{}: made from {input}, a generated mesh; `meshslim view {}` makes it again",
+                path.display(),
+                path.display()
+            )));
+        }
+        Model::open(&manifest::resolve_input(path, input, relative)?, None)
+    };
+    let Some(kind) = ManifestKind::of(path) else {
+        let model = Model::open(path, None)?;
+        let original = model.original(device)?;
+        return Ok(Loaded {
+            model,
+            original,
+            levels: None,
+            front: None,
+        });
+    };
+    match kind {
+        ManifestKind::Lods => {
+            let m: manifest::LodsManifest = manifest::read(path)?;
+            let model = model_of(&m.input, m.input_from_manifest.as_deref(), given)?;
+            if model.faces() != m.faces {
+                return Err(Error::InvalidOption(format!(
+                    "{}: made from a mesh of {} faces, but {} has {}: the levels are of                      another mesh",
+                    path.display(),
+                    m.faces,
+                    model.name,
+                    model.faces()
+                )));
+            }
+            if m.levels.is_empty() {
+                return Err(Error::InvalidOption(format!(
+                    "{}: no levels",
+                    path.display()
+                )));
+            }
+            let mut levels = vec![model.original(device)?];
+            for (k, e) in m.levels.iter().enumerate() {
+                let mesh = crate::io::read(&manifest::resolve(path, &e.file)?)?;
+                levels.push(model.level(device, &mesh)?);
+                progress((k + 1) as f32 / m.levels.len() as f32);
+            }
+            let original = model.original(device)?;
+            Ok(Loaded {
+                model,
+                original,
+                levels: Some(levels),
+                front: None,
+            })
+        }
+        ManifestKind::Pareto => {
+            let m: manifest::ParetoManifest = manifest::read(path)?;
+            let model = model_of(&m.input, m.input_from_manifest.as_deref(), given)?;
+            let front = Front::from_manifest(path, &m)?;
+            let original = model.original(device)?;
+            Ok(Loaded {
+                model,
+                original,
+                levels: None,
+                front: Some(front),
+            })
+        }
+    }
 }
 
 impl Model {
@@ -294,6 +386,8 @@ pub struct Simplified {
     /// Two-sided distance to the original, relative to its diagonal: mean and max; `None` when
     /// the result has no faces to measure.
     pub error: Option<(f64, f64)>,
+    /// What made it when not a run in the window (a Pareto front member), for the panel.
+    pub made_by: Option<String>,
 }
 
 /// The pipelines made on the drawing device: the rounds' and `cluster`'s, each absent when
@@ -376,24 +470,110 @@ pub fn simplify(
         _ => {
             let (mesh, report) =
                 crate::simplify::simplify_with_progress(&model.mesh, opts, progress)?;
-            let positions = model.normalized(&mesh);
-            let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
-            let gpu = GpuMesh::from_arrays(
-                device,
-                &positions,
-                &indices,
-                model.up.center,
-                model.up.scale,
-            )?;
-            let uvs = mesh
-                .uvs_from(UvOrigin::BottomLeft)
-                .map(|uv| indices.iter().map(|&v| uv[v as usize]).collect());
-            (gpu, positions, indices, mesh, report, uvs)
+            let d = model.upload(device, &mesh)?;
+            (d.gpu, d.positions, d.indices, mesh, report, d.uvs)
         }
     };
     let seconds = t.elapsed().as_secs_f64();
-    opts.cancel.check()?;
+    let drawn = Drawn {
+        gpu,
+        positions,
+        indices,
+        uvs,
+    };
+    finish(
+        device,
+        model,
+        drawn,
+        mesh,
+        report,
+        seconds,
+        &opts.cancel,
+        phase,
+    )
+}
+
+/// A result made elsewhere (a Pareto front member, a level read back from its file), shown as
+/// a simplification of `model`: uploaded, its heatmap and two-sided error measured.
+pub fn show(
+    device: &wgpu::Device,
+    model: &Model,
+    mesh: Mesh,
+    report: SimplifyReport,
+    cancel: &crate::options::Cancel,
+    phase: &dyn Fn(&str),
+) -> Result<Simplified> {
+    let drawn = model.upload(device, &mesh)?;
+    finish(device, model, drawn, mesh, report, 0.0, cancel, phase)
+}
+
+/// A result ready to be drawn: its buffers on the device, and on the host the positions (in
+/// the normalized frame) and corners its extras are made from.
+struct Drawn {
+    gpu: GpuMesh,
+    positions: Vec<[f32; 4]>,
+    indices: Vec<u32>,
+    uvs: Option<Vec<[f32; 2]>>,
+}
+
+impl Model {
+    /// Uploads `mesh`, a result of this model, in the model's normalized frame, so that one
+    /// renderer draws it beside the GPU's own results.
+    fn upload(&self, device: &wgpu::Device, mesh: &Mesh) -> Result<Drawn> {
+        let positions = self.normalized(mesh);
+        let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+        let gpu =
+            GpuMesh::from_arrays(device, &positions, &indices, self.up.center, self.up.scale)?;
+        let uvs = mesh
+            .uvs_from(UvOrigin::BottomLeft)
+            .map(|uv| indices.iter().map(|&v| uv[v as usize]).collect());
+        Ok(Drawn {
+            gpu,
+            positions,
+            indices,
+            uvs,
+        })
+    }
+
+    /// A level of detail of this model made elsewhere (a `meshslim lods` file, a Pareto front
+    /// member), ready for the LOD scene.
+    pub fn level(&self, device: &wgpu::Device, mesh: &Mesh) -> Result<SceneMesh> {
+        let d = self.upload(device, mesh)?;
+        let extras = Extras {
+            error: Vec::new(),
+            normals: vertex_normals(&d.positions, &d.indices),
+            uvs: d.uvs,
+        };
+        SceneMesh::new(
+            device,
+            d.gpu,
+            d.positions.len(),
+            d.indices.len() / 3,
+            &extras,
+        )
+    }
+}
+
+/// The heatmap, normals and two-sided error of a result, and its [`SceneMesh`].
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    device: &wgpu::Device,
+    model: &Model,
+    drawn: Drawn,
+    mesh: Mesh,
+    report: SimplifyReport,
+    seconds: f64,
+    cancel: &crate::options::Cancel,
+    phase: &dyn Fn(&str),
+) -> Result<Simplified> {
+    cancel.check()?;
     phase("measuring the error");
+    let Drawn {
+        gpu,
+        positions,
+        indices,
+        uvs,
+    } = drawn;
     let extras = Extras {
         error: model.errors(&positions),
         normals: vertex_normals(&positions, &indices),
@@ -412,13 +592,14 @@ pub fn simplify(
         let d = compare(&model.mesh, &mesh, &sampling)?.distance.two_sided;
         Some((d.mean_rel, d.max_rel))
     };
-    opts.cancel.check()?;
+    cancel.check()?;
     Ok(Simplified {
         scene,
         mesh,
         report,
         seconds,
         error,
+        made_by: None,
     })
 }
 

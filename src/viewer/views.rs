@@ -17,10 +17,13 @@ impl ViewerApp {
         let half = LOD_GRID as f32 * LOD_SPACING * 0.5;
         let mut c = Camera {
             yaw: 0.6,
-            pitch: 0.3,
+            pitch: 0.15,
             ..self.camera
         };
-        c.fit(Vec3::ZERO, half * 0.6, self.aspect());
+        // Low over the grid's edge, whatever the view's shape: the nearest instances in view
+        // (about 4 diagonals away) draw the original, the far side the coarsest level.
+        c.target = Vec3::ZERO;
+        c.distance = half * 1.05;
         c
     }
 
@@ -48,6 +51,8 @@ impl ViewerApp {
         // Pixels per unit of length at distance 1.
         let px_per_unit = view_px / (2.0 * (0.5 * self.camera.fov_y).tan());
         let n = LOD_GRID as f32;
+        let full = levels[0].faces.max(1) as f64;
+        let fractions: Vec<f64> = levels.iter().map(|l| l.faces as f64 / full).collect();
         let mut items = Vec::with_capacity(LOD_GRID * LOD_GRID);
         for i in 0..LOD_GRID {
             for j in 0..LOD_GRID {
@@ -60,7 +65,7 @@ impl ViewerApp {
                 let level = if self.lod_on {
                     // An instance's diagonal is 1: its height on screen in pixels.
                     let px = px_per_unit / eye.distance(at).max(1e-3);
-                    lod_level(px, levels.len())
+                    lod_level(px, &fractions)
                 } else {
                     0
                 };
