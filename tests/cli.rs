@@ -260,6 +260,20 @@ fn info_reports_topology_of_a_builtin() {
     assert_eq!(v["genus"], 1);
     assert_eq!(v["boundary_loops"], 0);
     assert_eq!(v["normals"], false);
+    // The triangle quality, as compare reports it for B. The valences count every vertex
+    // once, and on a closed torus (Euler 0, so 3 edges per vertex) they average 6.
+    let q = &v["quality"];
+    let bins = q["valence_histogram"].as_array().unwrap();
+    let count =
+        |b: &serde_json::Value| b["interior"].as_u64().unwrap() + b["border"].as_u64().unwrap();
+    let counted: u64 = bins.iter().map(count).sum();
+    let ends: u64 = bins
+        .iter()
+        .map(|b| b["valence"].as_u64().unwrap() * count(b))
+        .sum();
+    assert_eq!(counted, v["vertices"].as_u64().unwrap(), "{q}");
+    assert_eq!(ends, 6 * counted, "{q}");
+    assert!(q["share_under_30_deg"].is_f64() && q["mean_min_angle_deg"].is_f64());
     let o = meshslim(&["info", "builtin:grid:200"], dir.path());
     expect_code(&o, 0);
     let out = stdout(&o);
@@ -271,6 +285,9 @@ fn info_reports_topology_of_a_builtin() {
         "area",
         "volume",
         "diagonal",
+        "smallest angle",
+        "under 30 deg",
+        "valence",
     ] {
         assert!(out.contains(word), "{word} missing from:\n{out}");
     }
@@ -394,7 +411,14 @@ fn compare_json_has_every_field() {
         );
     }
     let q = &v["quality_b"];
-    for key in ["min_angle_deg", "mean_min_angle_deg", "max_aspect_ratio"] {
+    for key in [
+        "min_angle_deg",
+        "mean_min_angle_deg",
+        "max_aspect_ratio",
+        "share_under_30_deg",
+        "share_under_10_deg",
+        "regular_valence_share",
+    ] {
         assert!(q[key].is_f64(), "quality_b.{key} in {q}");
     }
     assert_eq!(q["degenerate_faces"], 0);
@@ -431,8 +455,10 @@ fn compare_prints_a_table_and_names_a_missing_file() {
         "RMS",
         "area",
         "volume",
-        "min angle",
+        "smallest angle",
+        "under 30 deg",
         "aspect ratio",
+        "valence",
         "euler",
         "boundary loops",
     ] {

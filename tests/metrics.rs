@@ -231,6 +231,15 @@ fn triangle_quality_and_topology_of_a_simplified_mesh() {
     assert_eq!(q.aspect_ratio_histogram[0].count, b.face_count());
     assert_eq!(q.aspect_ratio_histogram.last().unwrap().upper, None);
     assert_eq!(q.degenerate_faces, 0);
+    assert_eq!((q.share_under_30_deg, q.share_under_10_deg), (0.0, 0.0));
+    // A grid's inner vertices have valence 6, its corners 2 or 3 and its sides 4: regular
+    // inside and along the sides (4 on a border), not at the corners or the hole's rim.
+    let inner = q
+        .valence_histogram
+        .iter()
+        .find(|b| b.valence == 6)
+        .map_or(0, |b| b.interior);
+    assert!(inner > 0 && q.regular_valence_share > 0.5 && q.regular_valence_share < 1.0);
     let t = &c.topology;
     assert_eq!(t.a.boundary_loops, 1);
     assert_eq!(t.difference.boundary_loops, 1, "{t:?}");

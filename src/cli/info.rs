@@ -32,7 +32,12 @@ pub struct InfoArgs {
 pub(super) fn run_info(args: InfoArgs) -> Result<ExitCode> {
     let progress = Progress::new(!args.json && std::io::stderr().is_terminal());
     let mesh = load(&args.input, &progress)?;
-    let topo = progress.spinner("measuring".to_string(), || mesh::topology(&mesh));
+    let (topo, quality) = progress.spinner("measuring".to_string(), || {
+        (
+            mesh::topology(&mesh),
+            crate::metrics::triangle_quality(&mesh),
+        )
+    });
     let diagonal = mesh.bounds().map_or(0.0, |b| b.diagonal());
     let out = std::io::stdout();
     let mut out = out.lock();
@@ -54,6 +59,7 @@ pub(super) fn run_info(args: InfoArgs) -> Result<ExitCode> {
             "materials": mesh.materials.len(),
             "texture_images": mesh.textures.images.len(),
             "groups": mesh.groups.len(),
+            "quality": quality,
         });
         obj.extend(extra.as_object().cloned().unwrap_or_default());
         writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
@@ -102,6 +108,7 @@ pub(super) fn run_info(args: InfoArgs) -> Result<ExitCode> {
         }
         writeln!(out, "  degenerate faces   {}", t.degenerate_faces)?;
         writeln!(out, "  duplicate faces    {}", t.duplicate_faces)?;
+        super::report::write_quality(&mut out, &quality, "  ")?;
         writeln!(out, "  area               {:.6}", t.surface_area)?;
         writeln!(out, "  volume             {:.6} (signed)", t.signed_volume)?;
         writeln!(

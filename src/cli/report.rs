@@ -312,25 +312,8 @@ pub(super) fn write_comparison(
         c.volume.b,
         pct(c.volume.relative)
     )?;
-    let q = &c.quality_b;
-    writeln!(
-        out,
-        "\ntriangle quality of B: min angle {:.2} deg, mean smallest angle {:.2} deg, {} degenerate",
-        q.min_angle_deg, q.mean_min_angle_deg, q.degenerate_faces
-    )?;
-    writeln!(
-        out,
-        "  aspect ratio (circumradius / 2 inradius, 1 = equilateral):"
-    )?;
-    let mut lower = 1.0;
-    for bin in &q.aspect_ratio_histogram {
-        let range = match bin.upper {
-            Some(u) => format!("[{lower}, {u})"),
-            None => format!(">= {lower}"),
-        };
-        writeln!(out, "    {range:<12} {}", bin.count)?;
-        lower = bin.upper.unwrap_or(lower);
-    }
+    writeln!(out, "\ntriangle quality of B:")?;
+    write_quality(out, &c.quality_b, "  ")?;
     let tp = &c.topology;
     writeln!(
         out,
@@ -441,4 +424,47 @@ impl Progress {
         pb.finish_and_clear();
         result
     }
+}
+
+/// A mesh's triangle quality as `compare` and `info` print it, each line after `indent`.
+pub(super) fn write_quality(
+    out: &mut dyn std::io::Write,
+    q: &crate::metrics::TriangleQuality,
+    indent: &str,
+) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "{indent}smallest angle     min {:.2} deg, mean {:.2} deg; {:.2}% of the faces under 30 deg, \
+         {:.2}% under 10; {} degenerate",
+        q.min_angle_deg,
+        q.mean_min_angle_deg,
+        100.0 * q.share_under_30_deg,
+        100.0 * q.share_under_10_deg,
+        q.degenerate_faces
+    )?;
+    writeln!(
+        out,
+        "{indent}aspect ratio       (circumradius / 2 inradius, 1 = equilateral), faces:"
+    )?;
+    let mut lower = 1.0;
+    for bin in &q.aspect_ratio_histogram {
+        let range = match bin.upper {
+            Some(u) => format!("[{lower}, {u})"),
+            None => format!(">= {lower}"),
+        };
+        writeln!(out, "{indent}  {range:<12} {}", bin.count)?;
+        lower = bin.upper.unwrap_or(lower);
+    }
+    let bins: Vec<String> = q
+        .valence_histogram
+        .iter()
+        .map(|b| format!("{}: {}/{}", b.valence, b.interior, b.border))
+        .collect();
+    writeln!(
+        out,
+        "{indent}valence            {:.1}% regular (6 inside, 4 on a border); vertices inside/on a \
+         border by valence: {}",
+        100.0 * q.regular_valence_share,
+        bins.join(", ")
+    )
 }

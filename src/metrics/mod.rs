@@ -143,6 +143,72 @@ pub struct TriangleQuality {
     pub aspect_ratio_histogram: Vec<HistogramBin>,
     /// Largest aspect ratio; `None` (JSON null) when a face is degenerate (infinite).
     pub max_aspect_ratio: Option<f64>,
+    /// Share of the faces whose smallest angle is under 30 degrees (degenerate ones included):
+    /// what remeshing is judged by.
+    pub share_under_30_deg: f64,
+    /// Share of the faces whose smallest angle is under 10 degrees (degenerate ones included).
+    pub share_under_10_deg: f64,
+    /// The vertices in faces by valence (the edges meeting there), fewest first; only the
+    /// valences that occur.
+    pub valence_histogram: Vec<ValenceBin>,
+    /// Share of the vertices in faces with the regular valence: 6 inside, 4 on a border (the
+    /// valences of an equilateral tiling, which isotropic remeshing flips towards).
+    pub regular_valence_share: f64,
+}
+
+/// Vertices of one valence, inside and on a border.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct ValenceBin {
+    pub valence: usize,
+    pub interior: usize,
+    pub border: usize,
+}
+
+/// The valence histogram of `m` and the share of regular vertices: each distinct edge counts
+/// once at both ends, and an edge of one face makes its ends border vertices.
+fn valences(m: &Mesh) -> (Vec<ValenceBin>, f64) {
+    let mut edges: Vec<(u32, u32)> = m
+        .triangles
+        .iter()
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .filter(|(a, b)| a != b)
+        .map(|(a, b)| (a.min(b), a.max(b)))
+        .collect();
+    edges.sort_unstable();
+    let n = m.positions.len();
+    let (mut valence, mut border) = (vec![0usize; n], vec![false; n]);
+    for run in edges.chunk_by(|x, y| x == y) {
+        let (a, b) = (run[0].0 as usize, run[0].1 as usize);
+        valence[a] += 1;
+        valence[b] += 1;
+        if run.len() == 1 {
+            border[a] = true;
+            border[b] = true;
+        }
+    }
+    let mut bins: std::collections::BTreeMap<usize, ValenceBin> = Default::default();
+    let (mut used, mut regular) = (0usize, 0usize);
+    for (v, &k) in valence.iter().enumerate().filter(|(_, k)| **k > 0) {
+        let bin = bins.entry(k).or_insert(ValenceBin {
+            valence: k,
+            interior: 0,
+            border: 0,
+        });
+        used += 1;
+        if border[v] {
+            bin.border += 1;
+            regular += (k == 4) as usize;
+        } else {
+            bin.interior += 1;
+            regular += (k == 6) as usize;
+        }
+    }
+    let share = if used > 0 {
+        regular as f64 / used as f64
+    } else {
+        0.0
+    };
+    (bins.into_values().collect(), share)
 }
 
 /// One bin of a histogram: values below `upper` (and at or above the previous bin's upper).
@@ -400,7 +466,7 @@ fn face_shape(p: [[f64; 3]; 3]) -> Option<(f64, f64)> {
     Some((angle, aspect))
 }
 
-/// B's triangle quality: minimum angle and aspect-ratio histogram.
+/// A mesh's triangle quality: smallest angles, aspect ratios and valences.
 pub fn triangle_quality(m: &Mesh) -> TriangleQuality {
     let mut counts = [0usize; ASPECT_RATIO_BINS.len()];
     let mut min_angle = f64::INFINITY;
@@ -408,10 +474,13 @@ pub fn triangle_quality(m: &Mesh) -> TriangleQuality {
     let mut good = 0usize;
     let mut degenerate = 0usize;
     let mut max_aspect: f64 = 1.0;
+    let (mut under_30, mut under_10) = (0usize, 0usize);
     for t in &m.triangles {
         let p = t.map(|v| m.positions[v as usize].map(|c| c as f64));
         match face_shape(p) {
             Some((angle, aspect)) => {
+                under_30 += (angle < 30.0) as usize;
+                under_10 += (angle < 10.0) as usize;
                 min_angle = min_angle.min(angle);
                 angle_sum += angle;
                 good += 1;
@@ -431,7 +500,13 @@ pub fn triangle_quality(m: &Mesh) -> TriangleQuality {
     if degenerate > 0 {
         max_aspect = f64::INFINITY;
     }
+    let share = |k: usize| k as f64 / m.triangles.len().max(1) as f64;
+    let (valence_histogram, regular_valence_share) = valences(m);
     TriangleQuality {
+        share_under_30_deg: share(under_30 + degenerate),
+        share_under_10_deg: share(under_10 + degenerate),
+        valence_histogram,
+        regular_valence_share,
         min_angle_deg: if good > 0 { min_angle } else { 0.0 },
         mean_min_angle_deg: if good > 0 {
             angle_sum / good as f64
@@ -471,5 +546,58 @@ mod tests {
             "{aspect}"
         );
         assert!(face_shape([[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]).is_none());
+    }
+
+    /// An icosphere has 12 vertices of valence 5 and the rest 6; a lone triangle's corners
+    /// are border vertices of valence 2; slivers count under 30 and 10 degrees, and so do
+    /// degenerate faces.
+    #[test]
+    fn valences_and_small_angle_shares() {
+        let m = crate::mesh::icosphere(2);
+        let q = triangle_quality(&m);
+        let n = m.positions.len();
+        assert_eq!(
+            q.valence_histogram,
+            [
+                ValenceBin {
+                    valence: 5,
+                    interior: 12,
+                    border: 0
+                },
+                ValenceBin {
+                    valence: 6,
+                    interior: n - 12,
+                    border: 0
+                }
+            ]
+        );
+        assert!((q.regular_valence_share - (n - 12) as f64 / n as f64).abs() < 1e-12);
+        assert_eq!((q.share_under_30_deg, q.share_under_10_deg), (0.0, 0.0));
+
+        let lone = Mesh {
+            positions: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.5, 0.05, 0.0],
+                [3.0, 0.0, 0.0],
+                [4.0, 0.0, 0.0],
+                [3.0, 0.3, 0.0],
+                [5.0, 0.0, 0.0],
+            ],
+            // A sliver (about 5.7 degrees), a 16.7-degree triangle, and a face with no area.
+            triangles: vec![[0, 1, 2], [3, 4, 5], [4, 6, 4]],
+            ..Mesh::default()
+        };
+        let q = triangle_quality(&lone);
+        assert_eq!(q.share_under_30_deg, 1.0);
+        assert!((q.share_under_10_deg - 2.0 / 3.0).abs() < 1e-12);
+        assert_eq!(q.degenerate_faces, 1);
+        // The degenerate face adds the edge 4-6 twice (so not a border edge): vertex 4 has
+        // valence 3, vertex 6 valence 1.
+        let by = |k: usize| q.valence_histogram.iter().find(|b| b.valence == k).cloned();
+        assert_eq!(by(1).map(|b| (b.interior, b.border)), Some((1, 0)));
+        assert_eq!(by(2).map(|b| b.border), Some(5));
+        assert_eq!(by(3).map(|b| b.border), Some(1));
+        assert_eq!(q.regular_valence_share, 0.0);
     }
 }
