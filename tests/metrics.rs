@@ -2,7 +2,7 @@
 
 use meshslim::Mesh;
 use meshslim::mesh::{self, icosphere};
-use meshslim::metrics::{CompareOptions, Comparison, compare};
+use meshslim::metrics::{CompareOptions, Comparison, ValenceBin, compare};
 
 fn translated(m: &Mesh, d: [f32; 3]) -> Mesh {
     let mut t = m.clone();
@@ -232,14 +232,28 @@ fn triangle_quality_and_topology_of_a_simplified_mesh() {
     assert_eq!(q.aspect_ratio_histogram.last().unwrap().upper, None);
     assert_eq!(q.degenerate_faces, 0);
     assert_eq!((q.share_under_30_deg, q.share_under_10_deg), (0.0, 0.0));
-    // A grid's inner vertices have valence 6, its corners 2 or 3 and its sides 4: regular
-    // inside and along the sides (4 on a border), not at the corners or the hole's rim.
-    let inner = q
-        .valence_histogram
-        .iter()
-        .find(|b| b.valence == 6)
-        .map_or(0, |b| b.interior);
-    assert!(inner > 0 && q.regular_valence_share > 0.5 && q.regular_valence_share < 1.0);
+    // The grid alternates its diagonals, so an inner vertex with i + j even meets eight edges
+    // and one with i + j odd meets four (41 and 40 of the 9 × 9). The hole (cell i = 5, j = 4)
+    // drops only its diagonal, between two even corners: they become border vertices of
+    // valence 7, its two odd corners border vertices of valence 4. The four corners have
+    // valence 3 and the 36 side vertices alternate 3 and 5. Only those two valence-4 border
+    // vertices are regular.
+    let bin = |valence, interior, border| ValenceBin {
+        valence,
+        interior,
+        border,
+    };
+    assert_eq!(
+        q.valence_histogram,
+        [
+            bin(3, 0, 24),
+            bin(4, 38, 2),
+            bin(5, 0, 16),
+            bin(7, 0, 2),
+            bin(8, 39, 0)
+        ]
+    );
+    assert!(close(q.regular_valence_share, 2.0 / 121.0, 1e-12), "{q:?}");
     let t = &c.topology;
     assert_eq!(t.a.boundary_loops, 1);
     assert_eq!(t.difference.boundary_loops, 1, "{t:?}");
