@@ -52,6 +52,7 @@ pub mod options;
 #[doc(hidden)]
 pub mod parallel;
 mod quadric;
+pub mod remesh;
 pub mod simplify;
 pub mod tiles;
 #[cfg(feature = "viewer")]

@@ -5,7 +5,7 @@
 //! `main.rs` that uses `anyhow`: errors of the library arrive as [`meshslim::Error`] and leave
 //! as messages for the user.
 //!
-//! One file per command (`simplify`, `info`, `compare`, `bench`, `view`, `tiles`, `lods` with `pareto`) holds its arguments, its
+//! One file per command (`simplify`, `info`, `compare`, `bench`, `view`, `tiles`, `lods` with `pareto`, `remesh`) holds its arguments, its
 //! help text and its runner; `args` the argument types and parsers they share, `builtins` the
 //! generated meshes, `files` reading inputs and checking output paths, `report` what the
 //! commands print and the progress bars, `error` the usage error and the library's errors.
@@ -19,6 +19,7 @@ mod files;
 mod info;
 mod lods;
 mod memory;
+mod remesh;
 mod report;
 mod simplify;
 mod tiles;
@@ -40,6 +41,8 @@ pub use info::InfoArgs;
 use info::{INFO_AFTER_HELP, run_info};
 use lods::{LODS_AFTER_HELP, PARETO_AFTER_HELP, run_lods, run_pareto};
 pub use lods::{LodsArgs, ParetoArgs};
+pub use remesh::RemeshArgs;
+use remesh::{REMESH_AFTER_HELP, run_remesh};
 pub use simplify::{BackendArg, GETTING_STARTED, SimplifyArgs};
 use simplify::{SIMPLIFY_AFTER_HELP, run_simplify};
 pub use tiles::TilesArgs;
@@ -58,6 +61,7 @@ Examples:
   meshslim tiles split scan.ply work --tiles 16 --ratio 0.01
   meshslim lods scan.ply lods --ratios 0.5,0.25,0.1,0.05,0.01
   meshslim pareto scan.ply front --population 100 --generations 20
+  meshslim remesh scan.ply even.ply --edge-factor 2
 
 Run 'meshslim <COMMAND> --help' for every option of a command.";
 
@@ -101,6 +105,10 @@ pub enum Command {
     /// the front's meshes, its hypervolume per generation, a plot
     #[command(after_help = PARETO_AFTER_HELP)]
     Pareto(ParetoArgs),
+    /// Remesh to one edge length with well-shaped triangles (split, collapse, flip, relax,
+    /// project), keeping sharp features and borders
+    #[command(after_help = REMESH_AFTER_HELP)]
+    Remesh(RemeshArgs),
 }
 
 /// The exit code for an error [`run`] returned: 2 for bad usage, 1 for everything else.
@@ -128,6 +136,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Some(Command::Tiles(args)) => run_tiles(args),
         Some(Command::Lods(args)) => run_lods(args),
         Some(Command::Pareto(args)) => run_pareto(args),
+        Some(Command::Remesh(args)) => run_remesh(args),
     }
 }
 

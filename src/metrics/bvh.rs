@@ -99,6 +99,15 @@ impl TriangleBvh {
     /// The face closest to `p` and its squared distance; `None` for an index without faces.
     /// `hint`, a face likely to be near (the previous query's answer), only speeds the search:
     /// the distance returned is the minimum over all faces either way.
+    /// The closest point of the surface to `p`, and the face it is on (see [`Self::closest`]).
+    /// The remesher projects its vertices with it.
+    pub fn closest_point(&self, p: DVec3, hint: Option<u32>) -> Option<(DVec3, Hit)> {
+        let hit = self.closest(p.to_array(), hint)?;
+        let t = self.tris[self.slot_of_face[hit.face as usize] as usize]
+            .map(|v| Vec3::from_array(v).as_dvec3());
+        Some((closest_on_triangle(p, t[0], t[1], t[2]), hit))
+    }
+
     pub fn closest(&self, p: [f64; 3], hint: Option<u32>) -> Option<Hit> {
         if self.nodes.is_empty() {
             return None;

@@ -1,0 +1,297 @@
+//! Isotropic remeshing: triangles of one edge length, nearly equilateral, on the input's
+//! surface (M. Botsch, L. Kobbelt, "A Remeshing Approach to Multiresolution Modeling",
+//! SGP 2004).
+//!
+//! Each iteration splits edges longer than 4/3 L, collapses those shorter than 4/5 L (never
+//! making one longer than 4/3 L), flips edges where that brings valences nearer 6 (4 on a
+//! border), relaxes every vertex tangentially towards the area-weighted centroid of its faces
+//! and projects it back onto the input through the metrics' BVH. Feature edges (a dihedral
+//! angle over the threshold) and borders are kept: they are only split or collapsed along
+//! themselves, and their vertices slide along them and are projected back onto the input's
+//! lines; corners where the lines meet or end stay put.
+
+mod halfedge;
+mod steps;
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::metrics::TriangleBvh;
+use crate::{Error, Mesh, Result};
+use halfedge::{HalfEdges, NONE, twin};
+use steps::{FEATURE, FIXED, LOCKED, ON_FEATURE, Remesher};
+
+/// The length the remesher aims every edge at.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EdgeTarget {
+    /// The input's mean edge length: same resolution, better triangles.
+    MeanEdge,
+    /// Times the input's mean edge length.
+    MeanEdgeTimes(f64),
+    /// An absolute length, in the mesh's units.
+    Length(f64),
+    /// The length at which equilateral triangles would cover the input's area with about
+    /// this many faces: L = sqrt(4 A / (sqrt(3) N)).
+    Faces(usize),
+}
+
+#[derive(Debug, Clone)]
+pub struct RemeshOptions {
+    pub target: EdgeTarget,
+    /// Split–collapse–flip–relax iterations; Botsch and Kobbelt use 5 to 10.
+    pub iterations: usize,
+    /// Relaxation-and-projection steps per iteration. Three gave better triangles than
+    /// Botsch and Kobbelt's one on horse at twice the mean edge length (mean smallest angle
+    /// 53.44 against 52.78 degrees) for 0.15 s more; the distance grew by 2%.
+    pub relax_steps: usize,
+    /// Edges whose faces meet at more than this angle (degrees, between their normals) are
+    /// features: kept sharp. 180 turns feature detection off.
+    pub feature_angle_deg: f64,
+    /// Leave borders exactly as they are: their vertices neither move nor go, their edges are
+    /// neither split nor collapsed. Otherwise borders are feature lines.
+    pub lock_border: bool,
+}
+
+impl Default for RemeshOptions {
+    fn default() -> Self {
+        RemeshOptions {
+            target: EdgeTarget::MeanEdge,
+            iterations: 5,
+            relax_steps: 3,
+            feature_angle_deg: 45.0,
+            lock_border: false,
+        }
+    }
+}
+
+/// What a remeshing run did and how long each step took.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct RemeshReport {
+    pub edge_length: f64,
+    pub iterations: usize,
+    pub input_faces: usize,
+    pub output_faces: usize,
+    pub feature_edges: usize,
+    pub corners: usize,
+    pub splits: usize,
+    pub collapses: usize,
+    pub flips: usize,
+    pub seconds: RemeshSeconds,
+}
+
+/// Seconds per step, summed over the iterations.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct RemeshSeconds {
+    /// Half-edges, features and the two BVHs.
+    pub setup: f64,
+    pub split: f64,
+    pub collapse: f64,
+    pub flip: f64,
+    /// Relaxation and projection (parallel).
+    pub relax: f64,
+    pub total: f64,
+}
+
+/// Remeshes `mesh`; see the module documentation. The input must be a manifold, consistently
+/// oriented triangle mesh. Only positions and faces come out: normals, UVs, colours and
+/// materials are not carried.
+pub fn remesh(mesh: &Mesh, opts: &RemeshOptions) -> Result<(Mesh, RemeshReport)> {
+    remesh_with_progress(mesh, opts, &|_| {})
+}
+
+/// [`remesh`], calling `progress` with the finished share (0..=1) after each iteration.
+pub fn remesh_with_progress(
+    mesh: &Mesh,
+    opts: &RemeshOptions,
+    progress: &dyn Fn(f32),
+) -> Result<(Mesh, RemeshReport)> {
+    let start = Instant::now();
+    if !(0.0..=180.0).contains(&opts.feature_angle_deg) {
+        return Err(Error::InvalidOption(format!(
+            "the feature angle is in degrees from 0 to 180, got {}",
+            opts.feature_angle_deg
+        )));
+    }
+    let he = HalfEdges::from_mesh(mesh)?;
+    if he.fhe.is_empty() {
+        return Err(Error::InvalidMesh("the mesh has no faces to remesh".into()));
+    }
+    let length = edge_length(&he, opts.target)?;
+    let (edge_flags, vertex_flags) = features(&he, opts, length);
+    let mut report = RemeshReport {
+        edge_length: length,
+        iterations: opts.iterations,
+        input_faces: mesh.face_count(),
+        feature_edges: edge_flags.iter().filter(|&&f| f & FEATURE != 0).count(),
+        corners: vertex_flags.iter().filter(|&&f| f & FIXED != 0).count(),
+        ..Default::default()
+    };
+    let surface = TriangleBvh::new(mesh);
+    let lines = TriangleBvh::new(&feature_lines(&he, &edge_flags, mesh));
+    let mut r = Remesher::new(he, edge_flags, vertex_flags, &surface, &lines, length);
+    report.seconds.setup = start.elapsed().as_secs_f64();
+    let (low, high) = (length * 4.0 / 5.0, length * 4.0 / 3.0);
+    // Seconds since the last lap, and a new lap.
+    let lap = |t: &mut Instant| {
+        let s = t.elapsed().as_secs_f64();
+        *t = Instant::now();
+        s
+    };
+    for i in 0..opts.iterations {
+        let mut t = Instant::now();
+        report.splits += r.split_long(high);
+        report.seconds.split += lap(&mut t);
+        report.collapses += r.collapse_short(low, high);
+        report.seconds.collapse += lap(&mut t);
+        report.flips += r.flip_towards_regular();
+        report.seconds.flip += lap(&mut t);
+        for _ in 0..opts.relax_steps {
+            r.relax_and_project();
+        }
+        report.seconds.relax += lap(&mut t);
+        progress((i + 1) as f32 / opts.iterations.max(1) as f32);
+    }
+    let out = r.he.to_mesh();
+    report.output_faces = out.face_count();
+    report.seconds.total = start.elapsed().as_secs_f64();
+    Ok((out, report))
+}
+
+/// The target length for `target` on this mesh.
+fn edge_length(he: &HalfEdges, target: EdgeTarget) -> Result<f64> {
+    let mean = || {
+        let n = he.edge_count();
+        (0..n as u32).map(|e| he.edge_len2(e).sqrt()).sum::<f64>() / n as f64
+    };
+    let l = match target {
+        EdgeTarget::MeanEdge => mean(),
+        EdgeTarget::MeanEdgeTimes(k) => k * mean(),
+        EdgeTarget::Length(l) => l,
+        EdgeTarget::Faces(n) => {
+            let area: f64 = he
+                .fhe
+                .iter()
+                .map(|&h| he.face_normal(h).length() * 0.5)
+                .sum();
+            (4.0 * area / (3f64.sqrt() * n.max(1) as f64)).sqrt()
+        }
+    };
+    if l.is_finite() && l > 0.0 {
+        Ok(l)
+    } else {
+        Err(Error::InvalidOption(format!(
+            "the target edge length must be a positive number, got {l} from {target:?}"
+        )))
+    }
+}
+
+/// Edge and vertex flags of the input: feature edges by dihedral angle, borders (feature
+/// lines, or locked), and the corners where lines end or meet. Crease lines shorter than
+/// `length` in all are dropped: a target edge cannot follow them, and their fixed ends only
+/// pin slivers around them (on horse at 45 degrees, 539 feature edges made 320 corners).
+fn features(he: &HalfEdges, opts: &RemeshOptions, length: f64) -> (Vec<u8>, Vec<u8>) {
+    let cos_max = opts.feature_angle_deg.to_radians().cos();
+    let mut edge_flags: Vec<u8> = (0..he.edge_count() as u32)
+        .map(|e| {
+            let (h, o) = (2 * e, 2 * e + 1);
+            if he.is_border_he(h) || he.is_border_he(o) {
+                return if opts.lock_border {
+                    LOCKED | FEATURE
+                } else {
+                    FEATURE
+                };
+            }
+            let (a, b) = (he.face_normal(h), he.face_normal(o));
+            match (a.try_normalize(), b.try_normalize()) {
+                (Some(a), Some(b)) if a.dot(b) < cos_max => FEATURE,
+                _ => 0,
+            }
+        })
+        .collect();
+    let degree = |flags: &[u8]| -> Vec<u32> {
+        (0..he.pos.len() as u32)
+            .map(|v| {
+                let mut n = 0;
+                he.for_out(v, |g| n += (flags[(g / 2) as usize] & FEATURE != 0) as u32);
+                n
+            })
+            .collect()
+    };
+    let deg = degree(&edge_flags);
+    let mut seen = vec![false; edge_flags.len()];
+    for e in 0..edge_flags.len() {
+        if seen[e] || edge_flags[e] != FEATURE {
+            continue;
+        }
+        let chain = crease_chain(he, &edge_flags, &deg, e as u32);
+        let total: f64 = chain.iter().map(|&c| he.edge_len2(c).sqrt()).sum();
+        for &c in &chain {
+            seen[c as usize] = true;
+        }
+        if total < length && chain.iter().all(|&c| edge_flags[c as usize] == FEATURE) {
+            for &c in &chain {
+                edge_flags[c as usize] = 0;
+            }
+        }
+    }
+    let deg = degree(&edge_flags);
+    let vertex_flags = (0..he.pos.len() as u32)
+        .map(|v| {
+            let mut locked = false;
+            he.for_out(v, |g| locked |= edge_flags[(g / 2) as usize] & LOCKED != 0);
+            match deg[v as usize] {
+                0 => 0,
+                2 if !locked => ON_FEATURE,
+                _ => ON_FEATURE | FIXED,
+            }
+        })
+        .collect();
+    (edge_flags, vertex_flags)
+}
+
+/// The feature edges of the line through edge `e`, up to the vertices where it ends or meets
+/// others (feature degree other than 2), or all round a closed loop.
+fn crease_chain(he: &HalfEdges, flags: &[u8], degree: &[u32], e: u32) -> Vec<u32> {
+    let mut chain = vec![e];
+    for start in [2 * e, 2 * e + 1] {
+        let mut h = start;
+        loop {
+            let v = he.to[h as usize];
+            if degree[v as usize] != 2 {
+                break;
+            }
+            // The other feature edge at v.
+            let mut next = NONE;
+            he.for_out(v, |g| {
+                if g != twin(h) && flags[(g / 2) as usize] & FEATURE != 0 {
+                    next = g;
+                }
+            });
+            if next == NONE || next / 2 == e {
+                break; // a closed loop, back at the start
+            }
+            chain.push(next / 2);
+            h = next;
+        }
+        if chain.len() > 1 && chain.last() == chain.first() {
+            break;
+        }
+    }
+    chain.sort_unstable();
+    chain.dedup();
+    chain
+}
+
+/// The input's feature edges as degenerate faces (a, b, b), for projecting onto the lines.
+fn feature_lines(he: &HalfEdges, edge_flags: &[u8], mesh: &Mesh) -> Mesh {
+    let triangles = (0..he.edge_count() as u32)
+        .filter(|&e| edge_flags[e as usize] & FEATURE != 0)
+        .map(|e| {
+            let h = 2 * e;
+            let (a, b) = (he.from(h), he.to[h as usize]);
+            [a, b, b]
+        })
+        .collect();
+    Mesh::new(mesh.positions.clone(), triangles)
+}
