@@ -191,6 +191,10 @@ impl HalfEdges {
         self.face[h as usize] == NONE
     }
 
+    pub fn is_border_edge(&self, e: u32) -> bool {
+        self.is_border_he(2 * e) || self.is_border_he(2 * e + 1)
+    }
+
     pub fn is_border_vertex(&self, v: u32) -> bool {
         let o = self.out[v as usize];
         o != NONE && self.is_border_he(o)

@@ -184,7 +184,7 @@ impl<'a> Remesher<'a> {
             let (pw, px) = (he.pos[w as usize], he.pos[x as usize]);
             let before = (pw - he.pos[v0 as usize]).cross(px - he.pos[v0 as usize]);
             let after = (pw - p1).cross(px - p1);
-            if before.dot(after) <= 0.0 {
+            if before.dot(after) <= 0.0 || sliver(p1, pw, px) {
                 ok = false;
             }
         });
@@ -222,7 +222,11 @@ impl<'a> Remesher<'a> {
                 let old = (pb - pa).cross(pc - pa) + (pa - pb).cross(pd - pb);
                 let n0 = (pd - pa).cross(pc - pa);
                 let n1 = (pc - pb).cross(pd - pb);
-                if n0.dot(old) <= 0.0 || n1.dot(old) <= 0.0 {
+                if n0.dot(old) <= 0.0
+                    || n1.dot(old) <= 0.0
+                    || sliver(pa, pd, pc)
+                    || sliver(pb, pc, pd)
+                {
                     continue;
                 }
                 self.he.flip(e);
@@ -330,6 +334,18 @@ fn in_tangent_plane(he: &HalfEdges, v: u32) -> Option<DVec3> {
     let n = normal.try_normalize()?;
     let u = c / k - p;
     Some(p + u - n * n.dot(u))
+}
+
+/// Whether the face (a, b, c) is a sliver: twice its area under a twentieth of its longest
+/// edge squared, which is a smallest angle under about 3 degrees. A collapse or flip that
+/// makes one is refused: relaxation could not open it again (three border vertices on a
+/// straight border, say, stay in line).
+fn sliver(a: DVec3, b: DVec3, c: DVec3) -> bool {
+    let longest = a
+        .distance_squared(b)
+        .max(b.distance_squared(c))
+        .max(c.distance_squared(a));
+    (b - a).cross(c - a).length() < 0.05 * longest
 }
 
 /// The midpoint of `v`'s two feature neighbours, moved onto the line through them.

@@ -1,0 +1,188 @@
+//! Isotropic remeshing on generated meshes: what it must keep (manifoldness, Euler
+//! characteristic, borders, sharp edges, orientation) and where its vertices end up.
+
+use meshslim::Mesh;
+use meshslim::mesh::{self, topology};
+use meshslim::metrics::{TriangleBvh, triangle_quality};
+use meshslim::remesh::{EdgeTarget, RemeshOptions, remesh};
+
+fn opts(target: EdgeTarget) -> RemeshOptions {
+    RemeshOptions {
+        target,
+        ..Default::default()
+    }
+}
+
+/// The largest distance from a vertex of `b` to the surface of `a`.
+fn farthest_vertex(a: &Mesh, b: &Mesh) -> f64 {
+    let bvh = TriangleBvh::new(a);
+    b.positions
+        .iter()
+        .map(|p| bvh.closest(p.map(f64::from), None).unwrap().dist2.sqrt())
+        .fold(0.0, f64::max)
+}
+
+/// Manifold, as many borders, the same Euler characteristic and orientation, no degenerate
+/// faces, better triangles than the input's.
+fn assert_kept(input: &Mesh, out: &Mesh) {
+    let (a, b) = (topology(input), topology(out));
+    assert!(b.is_manifold(), "{b:?}");
+    assert_eq!(b.euler_characteristic, a.euler_characteristic);
+    assert_eq!(b.boundary_loops, a.boundary_loops);
+    assert_eq!(b.connected_components, a.connected_components);
+    assert_eq!(b.inconsistently_oriented_edges, 0);
+    assert_eq!((b.degenerate_faces, b.duplicate_faces), (0, 0));
+    assert_eq!(b.signed_volume > 0.0, a.signed_volume > 0.0);
+}
+
+#[test]
+fn closed_surfaces_keep_their_topology_and_stay_on_the_input() {
+    // The noisy sphere's noise is half an edge long: at 45 degrees it makes a net of creases
+    // that the remesher would keep; there it is no feature (180).
+    let cases = [
+        ("torus", mesh::torus(1.0, 0.35, 90, 30), 45.0),
+        ("noisy sphere", mesh::noisy_sphere(4, 0.01, 3), 180.0),
+        ("double torus", mesh::double_torus(2), 45.0),
+    ];
+    for (name, input, feature_angle_deg) in cases {
+        for factor in [0.5, 2.0] {
+            let o = RemeshOptions {
+                feature_angle_deg,
+                ..opts(EdgeTarget::MeanEdgeTimes(factor))
+            };
+            let (out, report) = remesh(&input, &o).unwrap();
+            assert_kept(&input, &out);
+            // Vertices are projected onto the input after every relaxation; a split's
+            // midpoint that a fold check put back may sit off it by a chord's sagitta.
+            let far = farthest_vertex(&input, &out);
+            assert!(
+                far <= 0.05 * report.edge_length,
+                "{name} x{factor}: a vertex {far} from the input (L = {})",
+                report.edge_length
+            );
+            let q = triangle_quality(&out);
+            assert_eq!(q.share_under_10_deg, 0.0, "{name} x{factor}: {q:?}");
+            assert!(q.share_under_30_deg < 0.01, "{name} x{factor}: {q:?}");
+            // The double torus is voxels: its feature lines, one voxel apart, leave room
+            // for right isosceles triangles (45 degrees) only.
+            let mean = if name == "double torus" { 44.9 } else { 50.0 };
+            assert!(q.mean_min_angle_deg > mean, "{name} x{factor}: {q:?}");
+        }
+    }
+}
+
+#[test]
+fn a_cubes_edges_stay_sharp_and_its_corners_stay_put() {
+    let cube = mesh::cube(8);
+    let (out, report) = remesh(&cube, &opts(EdgeTarget::Length(0.2))).unwrap();
+    assert_kept(&cube, &out);
+    assert_eq!((report.feature_edges, report.corners), (12 * 8, 8));
+    let on = |c: f32| c.abs() < 1e-5 || (c - 1.0).abs() < 1e-5;
+    for corner in 0..8 {
+        let want = [corner & 1, (corner >> 1) & 1, corner >> 2].map(|b| b as f32);
+        assert!(out.positions.contains(&want), "corner {want:?} is gone");
+    }
+    // Sharp: no face bends round an edge — the three corners of each share a side of the cube.
+    for t in &out.triangles {
+        let [a, b, c] = t.map(|v| out.positions[v as usize]);
+        let shared = (0..3).any(|k| on(a[k]) && a[k] == b[k] && b[k] == c[k]);
+        assert!(shared, "face {a:?} {b:?} {c:?} cuts a corner of the cube");
+    }
+    // And the remesher did its work: edges near 0.2, not the input's 0.125.
+    let q = triangle_quality(&out);
+    assert!(
+        out.face_count() < cube.face_count() && q.mean_min_angle_deg > 45.0,
+        "{} faces: {q:?}",
+        out.face_count()
+    );
+}
+
+#[test]
+fn a_border_is_kept_and_a_locked_one_is_not_touched() {
+    // A bumpy square patch: its border is a square outline with four corners.
+    let mut patch = mesh::grid(24);
+    for p in &mut patch.positions {
+        p[2] = 0.05 * (p[0] * 9.0).sin() * (p[1] * 7.0).cos();
+    }
+    let on_outline = |p: &[f32; 3]| {
+        let edge = |c: f32| c.abs() < 1e-6 || (c - 1.0).abs() < 1e-6;
+        edge(p[0]) || edge(p[1])
+    };
+    let border_vertices = |m: &Mesh| {
+        let mut count = std::collections::HashMap::new();
+        for t in &m.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        let mut vs: Vec<[f32; 3]> = count
+            .into_iter()
+            .filter(|(_, n)| *n == 1)
+            .flat_map(|((a, b), _)| [a, b])
+            .map(|v| m.positions[v as usize])
+            .collect();
+        vs.sort_by(|x, y| x.partial_cmp(y).unwrap());
+        vs.dedup();
+        vs
+    };
+    let (out, _) = remesh(&patch, &opts(EdgeTarget::MeanEdgeTimes(2.0))).unwrap();
+    assert_kept(&patch, &out);
+    let border = border_vertices(&out);
+    assert!(
+        border.iter().all(on_outline),
+        "a border vertex left the outline"
+    );
+    for corner in [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]] {
+        assert!(
+            border
+                .iter()
+                .any(|p| p[0] == corner[0] && p[1] == corner[1]),
+            "corner {corner:?} is gone"
+        );
+    }
+    assert!(
+        border.len() < border_vertices(&patch).len(),
+        "the border was not coarsened"
+    );
+
+    let locked = RemeshOptions {
+        lock_border: true,
+        ..opts(EdgeTarget::MeanEdgeTimes(2.0))
+    };
+    let (out, _) = remesh(&patch, &locked).unwrap();
+    assert_kept(&patch, &out);
+    assert_eq!(border_vertices(&out), border_vertices(&patch));
+}
+
+#[test]
+fn a_face_count_sets_the_length_and_threads_do_not_change_the_result() {
+    let sphere = mesh::icosphere(5);
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| remesh(&sphere, &opts(EdgeTarget::Faces(3000))).unwrap())
+    };
+    let (one, _) = run(1);
+    let (two, _) = run(2);
+    assert_eq!(one.positions, two.positions);
+    assert_eq!(one.triangles, two.triangles);
+    let n = one.face_count() as f64;
+    assert!((n / 3000.0 - 1.0).abs() < 0.1, "{n} faces for 3000");
+}
+
+#[test]
+fn bad_input_and_options_are_refused_with_a_reason() {
+    let e = remesh(&Mesh::new(vec![], vec![]), &RemeshOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("no faces"), "{e}");
+    let bad_angle = RemeshOptions {
+        feature_angle_deg: 200.0,
+        ..Default::default()
+    };
+    let e = remesh(&mesh::icosphere(1), &bad_angle).unwrap_err();
+    assert!(e.to_string().contains("feature angle"), "{e}");
+    let e = remesh(&mesh::icosphere(1), &opts(EdgeTarget::Length(-1.0))).unwrap_err();
+    assert!(e.to_string().contains("positive"), "{e}");
+}
