@@ -1,6 +1,8 @@
 //! Isotropic remeshing on generated meshes: what it must keep (manifoldness, Euler
 //! characteristic, borders, sharp edges, orientation) and where its vertices end up.
 
+mod common;
+
 use meshslim::Mesh;
 use meshslim::mesh::{self, topology};
 use meshslim::metrics::{TriangleBvh, triangle_quality};
@@ -185,4 +187,85 @@ fn bad_input_and_options_are_refused_with_a_reason() {
     assert!(e.to_string().contains("feature angle"), "{e}");
     let e = remesh(&mesh::icosphere(1), &opts(EdgeTarget::Length(-1.0))).unwrap_err();
     assert!(e.to_string().contains("positive"), "{e}");
+}
+
+#[test]
+fn a_triangle_soup_is_welded_first() {
+    // Every face with its own three vertices: without welding, every edge would be a border.
+    let torus = mesh::torus(1.0, 0.35, 48, 16);
+    let soup = common::triangle_soup(&torus);
+    let (out, _) = remesh(&soup, &opts(EdgeTarget::MeanEdge)).unwrap();
+    assert_kept(&torus, &out);
+    assert_eq!(topology(&out).boundary_loops, 0);
+}
+
+#[test]
+fn the_commands_remesh_and_simplify_then_remesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = common::meshslim(
+        &[
+            "remesh",
+            "builtin:torus",
+            "even.ply",
+            "--edge-factor",
+            "2",
+            "--json",
+        ],
+        dir.path(),
+    );
+    common::expect_code(&o, 0);
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let faces = j["report"]["output_faces"].as_u64().unwrap() as usize;
+    let written = meshslim::io::read(&dir.path().join("even.ply")).unwrap();
+    assert_eq!(written.face_count(), faces);
+    // The generated torus has long thin faces (28% under 30 degrees, mean smallest angle
+    // 35.6); its tube is narrow for this length, which holds the mean near 50.
+    let q = &j["quality"];
+    assert!(q["mean_min_angle_deg"].as_f64().unwrap() > 45.0, "{q}");
+    assert_eq!(q["share_under_30_deg"].as_f64().unwrap(), 0.0, "{q}");
+
+    // Simplify to 2,000 faces, then one remeshing iteration: about as many faces.
+    let o = common::meshslim(
+        &[
+            "simplify",
+            "builtin:torus",
+            "s.ply",
+            "--faces",
+            "2000",
+            "--remesh",
+            "1",
+            "--json",
+        ],
+        dir.path(),
+    );
+    common::expect_code(&o, 0);
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let written = meshslim::io::read(&dir.path().join("s.ply")).unwrap();
+    assert_eq!(
+        j["output_faces"].as_u64().unwrap() as usize,
+        written.face_count()
+    );
+    assert_eq!(j["remesh"]["input_faces"], 2000);
+    let off = written.face_count() as f64 / 2000.0 - 1.0;
+    assert!(off.abs() < 0.05, "{} faces", written.face_count());
+
+    // Usage mistakes exit with 2 and say what is wrong.
+    let o = common::meshslim(
+        &["remesh", "builtin:torus", "x.ply", "--edge-length", "-1"],
+        dir.path(),
+    );
+    common::expect_code(&o, 2);
+    let o = common::meshslim(
+        &[
+            "remesh",
+            "builtin:torus",
+            "x.ply",
+            "--edge-length",
+            "1",
+            "--faces",
+            "10",
+        ],
+        dir.path(),
+    );
+    common::expect_code(&o, 2);
 }

@@ -129,9 +129,9 @@ pub struct SimplifyArgs {
     pub memory: Option<u64>,
 
     /// Then remesh the result with K isotropic remeshing iterations (as 'meshslim remesh',
-    /// features over 45 degrees kept) at the edge length that keeps its face count: well-shaped
-    /// triangles for simulation or printing, at some cost in distance. Normals, UVs and
-    /// colours are not carried through it
+    /// features over 45 degrees kept) at the edge length that keeps its face count (within
+    /// 3%), projecting onto the input: well-shaped triangles for simulation or printing, at
+    /// some cost in distance. Normals, UVs and colours are not carried through it
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub remesh: usize,
 
@@ -323,7 +323,7 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     opts.feature_angle_deg = args.feature_angle;
     opts.removal = args.removal.removal();
 
-    let (simplified, report, load_s, simplify_s, topology, streamed) =
+    let (simplified, report, load_s, simplify_s, topology, streamed, original) =
         if let Some((path, why)) = stream {
             say(format!("streaming {}: {why}", path.display()));
             let t = Instant::now();
@@ -344,6 +344,7 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
                 t.elapsed().as_secs_f64(),
                 None,
                 Some(why),
+                None,
             )
         } else {
             let t = Instant::now();
@@ -381,7 +382,15 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
                 .clustering
                 .is_some()
                 .then(|| super::report::TopologyChange::of(&mesh, &simplified));
-            (simplified, report, load_s, simplify_s, topology, None)
+            (
+                simplified,
+                report,
+                load_s,
+                simplify_s,
+                topology,
+                None,
+                Some(mesh),
+            )
         };
 
     let (simplified, simplify_s, remeshed) = if args.remesh > 0 {
@@ -393,7 +402,8 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
         };
         let (out, r) = progress
             .bar("remeshing", |set| {
-                crate::remesh::remesh_with_progress(&simplified, &opts, set)
+                // Onto the original where it is in memory (not when streamed): nearer it.
+                crate::remesh::remesh_onto(&simplified, original.as_ref(), &opts, set)
             })
             .map_err(lib)
             .context("cannot remesh the simplified mesh")?;
