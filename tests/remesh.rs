@@ -269,3 +269,34 @@ fn the_commands_remesh_and_simplify_then_remesh() {
     );
     common::expect_code(&o, 2);
 }
+
+#[test]
+fn normals_colours_and_seamless_uvs_are_interpolated_on_the_input() {
+    // A flat patch whose normal is +z, colour red and UV its own (x, y): a new vertex at
+    // (x, y) must get exactly those.
+    let mut patch = mesh::grid(16);
+    let n = patch.positions.len();
+    patch.normals = Some(vec![[0.0, 0.0, 1.0]; n]);
+    patch.colors = Some(vec![[1.0, 0.0, 0.0, 1.0]; n]);
+    patch.uvs = Some(patch.positions.iter().map(|p| [p[0], p[1]]).collect());
+    let (out, report) = remesh(&patch, &opts(EdgeTarget::MeanEdgeTimes(1.5))).unwrap();
+    assert!(report.not_carried.is_empty(), "{:?}", report.not_carried);
+    let (normals, colors, uvs) = (
+        out.normals.as_ref().unwrap(),
+        out.colors.as_ref().unwrap(),
+        out.uvs.as_ref().unwrap(),
+    );
+    for (v, p) in out.positions.iter().enumerate() {
+        assert_eq!(normals[v], [0.0, 0.0, 1.0]);
+        assert_eq!(colors[v], [1.0, 0.0, 0.0, 1.0]);
+        assert!((uvs[v][0] - p[0]).abs() < 1e-5 && (uvs[v][1] - p[1]).abs() < 1e-5);
+    }
+    // With a seam (the torus's chart cut open along a meridian) the UVs are left out, and the
+    // report says so.
+    let (out, report) = remesh(&common::seamed_torus(), &RemeshOptions::default()).unwrap();
+    assert!(out.uvs.is_none());
+    assert!(
+        report.not_carried.iter().any(|w| w.contains("UV seams")),
+        "{report:?}"
+    );
+}

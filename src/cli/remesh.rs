@@ -18,8 +18,10 @@ Each iteration splits edges longer than 4/3 L, collapses edges shorter than 4/5 
 towards valence 6 (4 on a border), moves every vertex towards the centroid of its faces within
 its tangent plane and projects it back onto the input. Edges whose faces meet at more than the
 feature angle, and borders, stay where they are: they are split and collapsed only along
-themselves. The input must be manifold and consistently oriented ('meshslim info' tells).
-Only positions and faces are written: normals, UVs, colours and materials are not carried yet.
+themselves. The input must be manifold and consistently oriented ('meshslim info' tells);
+vertices stored twice at one place are welded first. Normals, colours and UVs are
+interpolated on the input at each new vertex; UVs only where the input has no UV seams, and
+materials and groups not at all (the report says what was left out).
 
 The edge length L is, by the first that is given: --edge-length, --edge-factor times the
 input's mean edge length, the length that gives about --faces equilateral faces, or the input's
@@ -128,11 +130,8 @@ pub(super) fn run_remesh(args: RemeshArgs) -> Result<ExitCode> {
     } else if !args.quiet {
         write_report(&mut w, &args, &report)?;
         write_quality(&mut w, &quality, "  ")?;
-        if mesh.normals.is_some() || mesh.uvs.is_some() || mesh.colors.is_some() {
-            writeln!(
-                w,
-                "  note               normals, UVs and colours of the input were not carried"
-            )?;
+        for what in &report.not_carried {
+            writeln!(w, "  not carried        {what}")?;
         }
     }
     w.flush()?;

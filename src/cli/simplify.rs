@@ -131,7 +131,8 @@ pub struct SimplifyArgs {
     /// Then remesh the result with K isotropic remeshing iterations (as 'meshslim remesh',
     /// features over 45 degrees kept) at the edge length that keeps its face count (within
     /// 3%), projecting onto the input: well-shaped triangles for simulation or printing, at
-    /// some cost in distance. Normals, UVs and colours are not carried through it
+    /// some cost in distance. Normals and colours are interpolated on the input; UVs too
+    /// unless it has UV seams
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub remesh: usize,
 

@@ -10,6 +10,7 @@
 //! themselves, and their vertices slide along them and are projected back onto the input's
 //! lines; corners where the lines meet or end stay put.
 
+mod attributes;
 mod halfedge;
 mod steps;
 #[cfg(test)]
@@ -81,6 +82,8 @@ pub struct RemeshReport {
     pub splits: usize,
     pub collapses: usize,
     pub flips: usize,
+    /// What of the input's attributes the result lacks, and why.
+    pub not_carried: Vec<String>,
     pub seconds: RemeshSeconds,
 }
 
@@ -98,8 +101,9 @@ pub struct RemeshSeconds {
 }
 
 /// Remeshes `mesh`; see the module documentation. The input must be a manifold, consistently
-/// oriented triangle mesh. Only positions and faces come out: normals, UVs, colours and
-/// materials are not carried.
+/// oriented triangle mesh (vertices at one position are welded first). Normals, colours and
+/// UVs are interpolated on the input at each new vertex's closest point; UVs only when the
+/// input has no UV seams, and materials and groups not at all (the report's `not_carried`).
 pub fn remesh(mesh: &Mesh, opts: &RemeshOptions) -> Result<(Mesh, RemeshReport)> {
     remesh_with_progress(mesh, opts, &|_| {})
 }
@@ -117,7 +121,7 @@ pub fn remesh_with_progress(
 /// itself: a simplification remeshed onto its original comes back nearer the original
 /// (feature lines are still `mesh`'s own).
 pub fn remesh_onto(
-    mesh: &Mesh,
+    input: &Mesh,
     onto: Option<&Mesh>,
     opts: &RemeshOptions,
     progress: &dyn Fn(f32),
@@ -132,7 +136,7 @@ pub fn remesh_onto(
     // Vertices stored twice at one place (UV seams, a triangle soup) are one point of the
     // surface; the attributes that split them are not carried anyway.
     let welded =
-        crate::mesh::weld_positions(&Mesh::new(mesh.positions.clone(), mesh.triangles.clone()))
+        crate::mesh::weld_positions(&Mesh::new(input.positions.clone(), input.triangles.clone()))
             .mesh;
     let mesh = &welded;
     let he = HalfEdges::from_mesh(mesh)?;
@@ -192,7 +196,9 @@ pub fn remesh_onto(
         progress((i + 1) as f32 / opts.iterations.max(1) as f32);
     }
     report.edge_length = length;
-    let out = r.he.to_mesh();
+    let mut out = r.he.to_mesh();
+    // Welding kept the faces in order, so the surface's face ids are the input's too.
+    report.not_carried = attributes::carry(onto.unwrap_or(input), &surface, &mut out);
     report.output_faces = out.face_count();
     report.seconds.total = start.elapsed().as_secs_f64();
     Ok((out, report))
