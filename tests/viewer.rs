@@ -396,3 +396,30 @@ fn clustering_results_are_drawn_too() {
         assert!(covered > 160 * 120 / 10, "{method:?}: the sphere is drawn");
     }
 }
+
+#[test]
+fn the_quality_mode_shows_slivers_red_and_even_faces_blue() {
+    if gpu_context().is_none() {
+        return;
+    }
+    // The share of drawn pixels whose red channel beats the blue one.
+    let reddish = |m: meshslim::Mesh| {
+        let model = Model::from_mesh("m".into(), m).unwrap();
+        let style = Style {
+            mode: Mode::Quality,
+            ..Style::default()
+        };
+        let frame = screenshot(&model, 1.0, style, (160, 120)).unwrap();
+        let img = Pixmap::decode_png(&frame.png).unwrap();
+        let drawn: Vec<&[u8]> = img.data().chunks(4).filter(|p| !is_background(p)).collect();
+        drawn.iter().filter(|p| p[0] > p[2]).count() as f64 / drawn.len() as f64
+    };
+    // An icosphere's faces are near equilateral (smallest angles 54-60 degrees): blue.
+    assert!(reddish(meshslim::mesh::icosphere(3)) < 0.05);
+    // The same sphere stretched ten times along x: thin faces, red.
+    let mut flat = meshslim::mesh::icosphere(3);
+    for p in &mut flat.positions {
+        p[0] *= 10.0;
+    }
+    assert!(reddish(flat) > 0.5);
+}

@@ -3,7 +3,8 @@
 // vertex can show each side's texture coordinate), plus extras the viewer keeps beside them:
 // per vertex the distance to the original surface (heatmap) and a smooth normal, per corner a
 // texture coordinate. Flat normals come from screen-space derivatives, so the flat modes need
-// none of the extras.
+// none of the extras; the triangle-quality mode reads each face's three corners in the vertex
+// shader (corner / 3 is the face), so it needs none either.
 // Relies on: the per-vertex extras hold one entry per vertex of the GpuMesh drawn with them and
 // the UVs one per corner (SceneMesh sizes them so), as the indirect draw may reach any corner
 // and vertex the rounds kept.
@@ -15,7 +16,7 @@ struct View {
     view_proj: mat4x4<f32>,
     // The camera in the mesh's frame, for the headlight.
     eye: vec4<f32>,
-    // x: mode (0 shaded, 1 normals, 2 heatmap, 3 texture), y: error at the top of the colour
+    // x: mode (0 shaded, 1 normals, 2 heatmap, 3 texture, 4 quality), y: error at the top of the colour
     // ramp, z: 1 for smooth shading, w: unused.
     mode: vec4<f32>,
 }
@@ -35,6 +36,27 @@ struct VOut {
     @location(1) error: f32,
     @location(2) normal: vec3<f32>,
     @location(3) uv: vec2<f32>,
+    // The face's smallest angle in degrees, the same at its three corners.
+    @location(4) @interpolate(flat) min_angle: f32,
+}
+
+// The smallest angle (degrees) of the triangle (a, b, c); 0 for a degenerate one. The frame
+// is the mesh's scaled uniformly, so its angles are the mesh's.
+fn smallest_angle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
+    let ab = b - a;
+    let bc = c - b;
+    let ca = a - c;
+    let la = length(ab);
+    let lb = length(bc);
+    let lc = length(ca);
+    if (la * lb * lc <= 0.0) {
+        return 0.0;
+    }
+    // The angle at each corner, between its two edges leaving it.
+    let at_a = acos(clamp(dot(ab, -ca) / (la * lc), -1.0, 1.0));
+    let at_b = acos(clamp(dot(bc, -ab) / (lb * la), -1.0, 1.0));
+    let at_c = 3.14159265 - at_a - at_b;
+    return degrees(min(at_a, min(at_b, at_c)));
 }
 
 @vertex
@@ -47,6 +69,12 @@ fn vs_main(@builtin(vertex_index) corner: u32) -> VOut {
     o.error = errors[v];
     o.normal = vec3<f32>(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);
     o.uv = uvs[corner];
+    let first = corner - corner % 3u;
+    o.min_angle = smallest_angle(
+        positions[indices[first]].xyz,
+        positions[indices[first + 1u]].xyz,
+        positions[indices[first + 2u]].xyz,
+    );
     return o;
 }
 
@@ -76,6 +104,10 @@ fn fs_main(v: VOut) -> @location(0) vec4<f32> {
         // OBJ texture coordinates start at the bottom row.
         let t = textureSample(albedo, albedo_sampler, vec2<f32>(v.uv.x, 1.0 - v.uv.y));
         return vec4<f32>(t.rgb * light, 1.0);
+    }
+    if (mode == 4u) {
+        // Red for a sliver, blue for an equilateral face (its smallest angle is 60).
+        return vec4<f32>(ramp(1.0 - v.min_angle / 60.0) * light, 1.0);
     }
     return vec4<f32>(vec3<f32>(0.82, 0.78, 0.70) * light, 1.0);
 }

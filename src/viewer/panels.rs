@@ -70,7 +70,7 @@ impl ViewerApp {
         if pressed(Key::Enter) {
             self.simplify();
         }
-        for (k, mode) in [Key::Num1, Key::Num2, Key::Num3, Key::Num4]
+        for (k, mode) in [Key::Num1, Key::Num2, Key::Num3, Key::Num4, Key::Num5]
             .into_iter()
             .zip(Mode::ALL)
         {
@@ -487,7 +487,10 @@ pub const HELP: &[(&str, &str)] = &[
     ("G", "fly mode on/off; W A S D move, Q E down/up"),
     ("F", "frame the mesh"),
     ("R", "reset the view"),
-    ("1 2 3 4", "shaded, normals, error heatmap, texture"),
+    (
+        "1 2 3 4 5",
+        "shaded, normals, error heatmap, texture, triangle quality",
+    ),
     ("M", "smooth / flat shading"),
     ("X", "wireframe overlay"),
     ("B", "side by side: original | simplified"),

@@ -21,16 +21,26 @@ pub enum Mode {
     Heatmap,
     /// The mesh's texture through its UVs (OBJ with a material's map_Kd).
     Texture,
+    /// Each face's smallest angle, red (0 degrees) to blue (60, equilateral): where a mesh
+    /// has slivers, before and after remeshing.
+    Quality,
 }
 
 impl Mode {
-    pub const ALL: [Mode; 4] = [Mode::Shaded, Mode::Normals, Mode::Heatmap, Mode::Texture];
+    pub const ALL: [Mode; 5] = [
+        Mode::Shaded,
+        Mode::Normals,
+        Mode::Heatmap,
+        Mode::Texture,
+        Mode::Quality,
+    ];
     pub fn label(self) -> &'static str {
         match self {
             Mode::Shaded => "shaded",
             Mode::Normals => "normals",
             Mode::Heatmap => "error heatmap",
             Mode::Texture => "texture",
+            Mode::Quality => "triangle quality",
         }
     }
 }

@@ -218,7 +218,11 @@ impl ViewerApp {
             label(rect.left_top() + egui::vec2(8.0, 6.0), top_left, &text);
         }
         if self.style.mode == Mode::Heatmap {
-            heatmap_legend(&painter, rect, self.style.error_scale);
+            let top = format!("{:.2e}", self.style.error_scale);
+            legend(&painter, rect, [&top, "0"], "vertex distance / diagonal");
+        }
+        if self.style.mode == Mode::Quality {
+            legend(&painter, rect, ["0°", "60°"], "smallest angle of each face");
         }
         if self.fly {
             label(
@@ -323,8 +327,8 @@ impl ViewerApp {
     }
 }
 
-/// The heatmap's colour legend: the shader's ramp from 0 to the largest error.
-fn heatmap_legend(painter: &egui::Painter, rect: egui::Rect, top: f32) {
+/// A colour legend: the shader's ramp, its top (red) and bottom (blue) labelled.
+fn legend(painter: &egui::Painter, rect: egui::Rect, ends: [&str; 2], caption: &str) {
     let w = 18.0;
     let h = (rect.height() * 0.4).min(220.0);
     let bar = egui::Rect::from_min_size(
@@ -335,26 +339,24 @@ fn heatmap_legend(painter: &egui::Painter, rect: egui::Rect, top: f32) {
     for s in 0..steps {
         let t0 = s as f32 / steps as f32;
         let t1 = (s + 1) as f32 / steps as f32;
-        // Top of the bar is the largest error.
+        // The top of the bar is the ramp's red end.
         let r = egui::Rect::from_min_max(
             egui::pos2(bar.left(), bar.bottom() - t1 * h),
             egui::pos2(bar.right(), bar.bottom() - t0 * h),
         );
         painter.rect_filled(r, 0.0, ramp_color((t0 + t1) * 0.5));
     }
-    let top = format!("{top:.2e}");
     let at = |p: egui::Pos2, align, text: &str| overlay_text(painter, p, align, text, 12.0);
     at(
         bar.right_top() + egui::vec2(4.0, 0.0),
         egui::Align2::LEFT_TOP,
-        &top,
+        ends[0],
     );
     at(
         bar.right_bottom() + egui::vec2(4.0, 0.0),
         egui::Align2::LEFT_BOTTOM,
-        "0",
+        ends[1],
     );
-    let caption = "vertex distance / diagonal";
     at(
         bar.center_bottom() + egui::vec2(0.0, 4.0),
         egui::Align2::CENTER_TOP,
