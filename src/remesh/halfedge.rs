@@ -59,11 +59,12 @@ impl HalfEdges {
         directed.sort_unstable();
         let mut he_of_slot = vec![NONE; faces.len() * 3];
         let mut to = Vec::with_capacity(directed.len() + directed.len() / 8);
-        let mut edges = 0u32;
-        for run in directed.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        for (e, run) in directed
+            .chunk_by(|x, y| (x.0, x.1) == (y.0, y.1))
+            .enumerate()
+        {
             let (lo, hi) = (run[0].0, run[0].1);
-            let e = edges;
-            edges += 1;
+            let e = e as u32;
             // The half-edge of each face goes from one end to the other; its twin the other way.
             let end = |forward: bool| if forward { (hi, lo) } else { (lo, hi) };
             match run {
@@ -134,9 +135,9 @@ impl HalfEdges {
                 he.out[from] = h;
             }
         }
-        for v in 0..nv {
-            if border_out[v] != NONE {
-                he.out[v] = border_out[v];
+        for (out, &b) in he.out.iter_mut().zip(&border_out) {
+            if b != NONE {
+                *out = b;
             }
         }
         // Border loops: the border half-edge into v is followed by the one out of v.
@@ -152,8 +153,8 @@ impl HalfEdges {
         for h in 0..nh {
             outgoing[he.to[twin(h as u32) as usize] as usize] += 1;
         }
-        for v in 0..nv {
-            if he.out[v] != NONE && he.valence(v as u32) != outgoing[v] {
+        for (v, &n) in outgoing.iter().enumerate() {
+            if he.out[v] != NONE && he.valence(v as u32) != n {
                 return Err(non_manifold_vertex(v));
             }
         }
