@@ -6,7 +6,7 @@ mod common;
 use meshslim::Mesh;
 use meshslim::mesh::{self, topology};
 use meshslim::metrics::{TriangleBvh, triangle_quality};
-use meshslim::remesh::{EdgeTarget, RemeshOptions, remesh};
+use meshslim::remesh::{Adaptive, EdgeTarget, RemeshOptions, remesh};
 
 fn opts(target: EdgeTarget) -> RemeshOptions {
     RemeshOptions {
@@ -187,6 +187,12 @@ fn bad_input_and_options_are_refused_with_a_reason() {
     assert!(e.to_string().contains("feature angle"), "{e}");
     let e = remesh(&mesh::icosphere(1), &opts(EdgeTarget::Length(-1.0))).unwrap_err();
     assert!(e.to_string().contains("positive"), "{e}");
+    // A length that would need billions of faces is refused before any work.
+    let e = remesh(&mesh::icosphere(1), &opts(EdgeTarget::Length(1e-5))).unwrap_err();
+    assert!(e.to_string().contains("remeshing allows"), "{e}");
+    let broken = Mesh::new(vec![[0.0; 3]; 3], vec![[0, 1, 7]]);
+    let e = remesh(&broken, &RemeshOptions::default()).unwrap_err();
+    assert!(e.to_string().contains('7'), "{e}");
 }
 
 #[test]
@@ -197,77 +203,6 @@ fn a_triangle_soup_is_welded_first() {
     let (out, _) = remesh(&soup, &opts(EdgeTarget::MeanEdge)).unwrap();
     assert_kept(&torus, &out);
     assert_eq!(topology(&out).boundary_loops, 0);
-}
-
-#[test]
-fn the_commands_remesh_and_simplify_then_remesh() {
-    let dir = tempfile::tempdir().unwrap();
-    let o = common::meshslim(
-        &[
-            "remesh",
-            "builtin:torus",
-            "even.ply",
-            "--edge-factor",
-            "2",
-            "--json",
-        ],
-        dir.path(),
-    );
-    common::expect_code(&o, 0);
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let faces = j["report"]["output_faces"].as_u64().unwrap() as usize;
-    let written = meshslim::io::read(&dir.path().join("even.ply")).unwrap();
-    assert_eq!(written.face_count(), faces);
-    // The generated torus has long thin faces (28% under 30 degrees, mean smallest angle
-    // 35.6); its tube is narrow for this length, which holds the mean near 50.
-    let q = &j["quality"];
-    assert!(q["mean_min_angle_deg"].as_f64().unwrap() > 45.0, "{q}");
-    assert_eq!(q["share_under_30_deg"].as_f64().unwrap(), 0.0, "{q}");
-
-    // Simplify to 2,000 faces, then one remeshing iteration: about as many faces.
-    let o = common::meshslim(
-        &[
-            "simplify",
-            "builtin:torus",
-            "s.ply",
-            "--faces",
-            "2000",
-            "--remesh",
-            "1",
-            "--json",
-        ],
-        dir.path(),
-    );
-    common::expect_code(&o, 0);
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let written = meshslim::io::read(&dir.path().join("s.ply")).unwrap();
-    assert_eq!(
-        j["output_faces"].as_u64().unwrap() as usize,
-        written.face_count()
-    );
-    assert_eq!(j["remesh"]["input_faces"], 2000);
-    let off = written.face_count() as f64 / 2000.0 - 1.0;
-    assert!(off.abs() < 0.05, "{} faces", written.face_count());
-
-    // Usage mistakes exit with 2 and say what is wrong.
-    let o = common::meshslim(
-        &["remesh", "builtin:torus", "x.ply", "--edge-length", "-1"],
-        dir.path(),
-    );
-    common::expect_code(&o, 2);
-    let o = common::meshslim(
-        &[
-            "remesh",
-            "builtin:torus",
-            "x.ply",
-            "--edge-length",
-            "1",
-            "--faces",
-            "10",
-        ],
-        dir.path(),
-    );
-    common::expect_code(&o, 2);
 }
 
 #[test]
@@ -299,4 +234,52 @@ fn normals_colours_and_seamless_uvs_are_interpolated_on_the_input() {
         report.not_carried.iter().any(|w| w.contains("UV seams")),
         "{report:?}"
     );
+}
+
+#[test]
+fn adaptive_sizing_makes_short_edges_where_the_surface_bends() {
+    // A flat square with a narrow bump in its middle.
+    let mut patch = mesh::grid(60);
+    for p in &mut patch.positions {
+        let r2 = (p[0] - 0.5).powi(2) + (p[1] - 0.5).powi(2);
+        p[2] = 0.15 * (-r2 / (2.0 * 0.06f32.powi(2))).exp();
+    }
+    let o = RemeshOptions {
+        adaptive: Some(Adaptive::default()),
+        feature_angle_deg: 180.0,
+        ..opts(EdgeTarget::Length(0.08))
+    };
+    let (out, _) = remesh(&patch, &o).unwrap();
+    assert_kept(&patch, &out);
+    // Mean edge length near the bump's top and far out on the flat part.
+    let (mut near, mut far) = ((0.0, 0), (0.0, 0));
+    for t in &out.triangles {
+        for k in 0..3 {
+            let [a, b] = [t[k], t[(k + 1) % 3]].map(|v| out.positions[v as usize]);
+            let len = (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f32>().sqrt() as f64;
+            let r =
+                (((a[0] + b[0]) / 2.0 - 0.5).powi(2) + ((a[1] + b[1]) / 2.0 - 0.5).powi(2)).sqrt();
+            if r < 0.06 {
+                near = (near.0 + len, near.1 + 1);
+            } else if r > 0.3 {
+                far = (far.0 + len, far.1 + 1);
+            }
+        }
+    }
+    let (near, far) = (near.0 / near.1 as f64, far.0 / far.1 as f64);
+    assert!(near < 0.6 * far, "near the bump {near}, on the flat {far}");
+    assert!(
+        (far / 0.08 - 1.0).abs() < 0.25,
+        "flat edges {far} for L = 0.08"
+    );
+    // Without it the same length everywhere (within the 4/5..4/3 band).
+    let (out, _) = remesh(
+        &patch,
+        &RemeshOptions {
+            adaptive: None,
+            ..o
+        },
+    )
+    .unwrap();
+    assert!(farthest_vertex(&patch, &out) < 0.08);
 }

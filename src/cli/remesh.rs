@@ -15,13 +15,16 @@ use crate::remesh::{EdgeTarget, RemeshOptions, RemeshReport, remesh_with_progres
 
 pub(super) const REMESH_AFTER_HELP: &str = "\
 Each iteration splits edges longer than 4/3 L, collapses edges shorter than 4/5 L, flips edges
-towards valence 6 (4 on a border), moves every vertex towards the centroid of its faces within
-its tangent plane and projects it back onto the input. Edges whose faces meet at more than the
+towards valence 6 (4 on a border), moves every vertex towards the centroid of its neighbours
+within its tangent plane and projects it back onto the input. Edges whose faces meet at more than the
 feature angle, and borders, stay where they are: they are split and collapsed only along
 themselves. The input must be manifold and consistently oriented ('meshslim info' tells);
 vertices stored twice at one place are welded first. Normals, colours and UVs are
 interpolated on the input at each new vertex; UVs only where the input has no UV seams, and
 materials and groups not at all (the report says what was left out).
+
+With --adaptive, L is the longest edge: edges shrink where the surface bends, down to
+--shortest × L, so that each chord stays within --tolerance × L of the surface.
 
 The edge length L is, by the first that is given: --edge-length, --edge-factor times the
 input's mean edge length, the length that gives about --faces equilateral faces, or the input's
@@ -31,7 +34,8 @@ Examples:
   meshslim remesh scan.ply scan-remeshed.ply
   meshslim remesh scan.ply coarse.ply --edge-factor 2
   meshslim remesh part.obj part-20k.obj --faces 20000 --feature-angle 30
-  meshslim remesh patch.ply patch-even.ply --lock-border --iterations 10";
+  meshslim remesh patch.ply patch-even.ply --lock-border --iterations 10
+  meshslim remesh scan.ply adaptive.ply --edge-factor 4 --adaptive --shortest 0.25";
 
 #[derive(Debug, Args)]
 pub struct RemeshArgs {
@@ -71,6 +75,19 @@ pub struct RemeshArgs {
     #[arg(long)]
     pub lock_border: bool,
 
+    /// Shorter edges where the surface bends (Dunyach et al. 2013): each edge as long as keeps
+    /// its chord within --tolerance of the surface, from --shortest up to L
+    #[arg(long)]
+    pub adaptive: bool,
+
+    /// --adaptive: the shortest edge, as a share of L
+    #[arg(long, value_name = "S", default_value_t = 0.1, requires = "adaptive")]
+    pub shortest: f64,
+
+    /// --adaptive: how far a chord may stray from the surface, as a share of L
+    #[arg(long, value_name = "T", default_value_t = 0.05, requires = "adaptive")]
+    pub tolerance: f64,
+
     /// Print the report as one JSON object on stdout
     #[arg(long)]
     pub json: bool,
@@ -106,6 +123,10 @@ pub(super) fn run_remesh(args: RemeshArgs) -> Result<ExitCode> {
         relax_steps: args.relax_steps,
         feature_angle_deg: args.feature_angle,
         lock_border: args.lock_border,
+        adaptive: args.adaptive.then_some(crate::remesh::Adaptive {
+            shortest: args.shortest,
+            tolerance: args.tolerance,
+        }),
     };
     let (out, report) = progress
         .bar("remeshing", |set| remesh_with_progress(&mesh, &opts, set))

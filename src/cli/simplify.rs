@@ -129,10 +129,11 @@ pub struct SimplifyArgs {
     pub memory: Option<u64>,
 
     /// Then remesh the result with K isotropic remeshing iterations (as 'meshslim remesh',
-    /// features over 45 degrees kept) at the edge length that keeps its face count (within
+    /// features over 45 degrees kept) at the edge length that keeps its face count (aiming at
     /// 3%), projecting onto the input: well-shaped triangles for simulation or printing, at
     /// some cost in distance. Normals and colours are interpolated on the input; UVs too
-    /// unless it has UV seams
+    /// unless it has UV seams. A result remeshing refuses (clustering's may be non-manifold)
+    /// is written as simplified, with a warning
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub remesh: usize,
 
@@ -401,15 +402,23 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
             lock_border: args.lock_border,
             ..Default::default()
         };
-        let (out, r) = progress
-            .bar("remeshing", |set| {
-                // Onto the original where it is in memory (not when streamed): nearer it.
-                crate::remesh::remesh_onto(&simplified, original.as_ref(), &opts, set)
-            })
-            .map_err(lib)
-            .context("cannot remesh the simplified mesh")?;
-        let total = simplify_s + r.seconds.total;
-        (out, total, Some(r))
+        let remeshed = progress.bar("remeshing", |set| {
+            // Onto the original where it is in memory (not when streamed): nearer it.
+            crate::remesh::remesh_onto(&simplified, original.as_ref(), &opts, set)
+        });
+        match remeshed {
+            Ok((out, r)) => {
+                let total = simplify_s + r.seconds.total;
+                (out, total, Some(r))
+            }
+            // The simplification is done and good: keep it rather than lose it.
+            Err(e) => {
+                eprintln!(
+                    "warning: cannot remesh the simplified mesh ({e}); writing it as simplified"
+                );
+                (simplified, simplify_s, None)
+            }
+        }
     } else {
         (simplified, simplify_s, None)
     };

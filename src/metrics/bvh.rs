@@ -96,9 +96,6 @@ impl TriangleBvh {
         self.tris.is_empty()
     }
 
-    /// The face closest to `p` and its squared distance; `None` for an index without faces.
-    /// `hint`, a face likely to be near (the previous query's answer), only speeds the search:
-    /// the distance returned is the minimum over all faces either way.
     /// The closest point of the surface to `p`, and the face it is on (see [`Self::closest`]).
     /// The remesher projects its vertices with it.
     pub fn closest_point(&self, p: DVec3, hint: Option<u32>) -> Option<(DVec3, Hit)> {
@@ -108,6 +105,9 @@ impl TriangleBvh {
         Some((closest_on_triangle(p, t[0], t[1], t[2]), hit))
     }
 
+    /// The face closest to `p` and its squared distance; `None` for an index without faces.
+    /// `hint`, a face likely to be near (the previous query's answer), only speeds the search:
+    /// the distance returned is the minimum over all faces either way.
     pub fn closest(&self, p: [f64; 3], hint: Option<u32>) -> Option<Hit> {
         if self.nodes.is_empty() {
             return None;

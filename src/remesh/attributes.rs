@@ -29,9 +29,10 @@ pub(super) fn carry(source: &Mesh, surface: &TriangleBvh, out: &mut Mesh) -> Vec
         .par_iter()
         .map(|p| {
             let p = DVec3::from_array(p.map(f64::from));
+            // The remesher refused a surface without faces, so there is always a closest one.
             let (q, hit) = surface
                 .closest_point(p, None)
-                .expect("the surface has faces: the remesher refused an empty input");
+                .expect("the surface has faces");
             let t = source.triangles[hit.face as usize];
             let [a, b, c] =
                 t.map(|v| DVec3::from_array(source.positions[v as usize].map(f64::from)));

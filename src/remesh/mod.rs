@@ -4,14 +4,16 @@
 //!
 //! Each iteration splits edges longer than 4/3 L, collapses those shorter than 4/5 L (never
 //! making one longer than 4/3 L), flips edges where that brings valences nearer 6 (4 on a
-//! border), relaxes every vertex tangentially towards the area-weighted centroid of its faces
-//! and projects it back onto the input through the metrics' BVH. Feature edges (a dihedral
-//! angle over the threshold) and borders are kept: they are only split or collapsed along
+//! border), relaxes every vertex tangentially towards the centroid of its neighbours and
+//! projects it back onto the input through the metrics' BVH. Feature edges (a dihedral angle
+//! over the threshold) and borders are kept: they are only split or collapsed along
 //! themselves, and their vertices slide along them and are projected back onto the input's
-//! lines; corners where the lines meet or end stay put.
+//! lines; corners where lines meet or turn sharply stay put. With adaptive sizing
+//! ([`Adaptive`]) L varies over the surface with its curvature.
 
 mod attributes;
 mod halfedge;
+mod sizing;
 mod steps;
 #[cfg(test)]
 mod tests;
@@ -26,6 +28,10 @@ use crate::metrics::TriangleBvh;
 use crate::{Error, Mesh, Result};
 use halfedge::{HalfEdges, NONE, twin};
 use steps::{FEATURE, FIXED, LOCKED, ON_FEATURE, Remesher};
+
+/// The most faces a remeshing may aim at: about 10 GB of half-edges and BVH, and far inside
+/// the u32 indices.
+pub const MAX_FACES: usize = 100_000_000;
 
 /// The length the remesher aims every edge at.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,6 +62,29 @@ pub struct RemeshOptions {
     /// Leave borders exactly as they are: their vertices neither move nor go, their edges are
     /// neither split nor collapsed. Otherwise borders are feature lines.
     pub lock_border: bool,
+    /// Shorter edges where the input bends (Dunyach et al. 2013); the target length is then
+    /// the longest edge.
+    pub adaptive: Option<Adaptive>,
+}
+
+/// Adaptive sizing's bounds, as shares of the target length L: edges from `shortest` × L (in
+/// the sharpest bends) to L (where the surface is flat enough), each as long as keeps its
+/// chord within `tolerance` × L of the input.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Adaptive {
+    pub shortest: f64,
+    pub tolerance: f64,
+}
+
+impl Default for Adaptive {
+    /// Edges from L/10 to L, chords within L/20: a sphere gets L-long edges from a radius of
+    /// about 3.3 L up.
+    fn default() -> Self {
+        Adaptive {
+            shortest: 0.1,
+            tolerance: 0.05,
+        }
+    }
 }
 
 impl Default for RemeshOptions {
@@ -66,6 +95,7 @@ impl Default for RemeshOptions {
             relax_steps: 3,
             feature_angle_deg: 45.0,
             lock_border: false,
+            adaptive: None,
         }
     }
 }
@@ -133,6 +163,15 @@ pub fn remesh_onto(
             opts.feature_angle_deg
         )));
     }
+    input.validate()?;
+    if let Some(onto) = onto {
+        onto.validate()?;
+        if onto.triangles.is_empty() {
+            return Err(Error::InvalidMesh(
+                "the surface to project onto has no faces".into(),
+            ));
+        }
+    }
     // Vertices stored twice at one place (UV seams, a triangle soup) are one point of the
     // surface; the attributes that split them are not carried anyway.
     let welded =
@@ -144,6 +183,21 @@ pub fn remesh_onto(
         return Err(Error::InvalidMesh("the mesh has no faces to remesh".into()));
     }
     let length = edge_length(&he, opts.target)?;
+    // Equilateral faces of side L cover the area with about this many; splitting towards a
+    // tiny L would otherwise fill the memory (and overflow the u32 indices).
+    let area: f64 = he
+        .fhe
+        .iter()
+        .map(|&h| he.face_normal(h).length() * 0.5)
+        .sum();
+    let shortest = length * opts.adaptive.map_or(1.0, |a| a.shortest);
+    let estimate = 4.0 * area / (3f64.sqrt() * shortest * shortest);
+    if estimate > MAX_FACES as f64 {
+        return Err(Error::InvalidOption(format!(
+            "an edge length of {shortest:.3e} would make about {estimate:.3e} faces, over the \
+             {MAX_FACES} remeshing allows; choose a longer edge or fewer faces"
+        )));
+    }
     let (edge_flags, vertex_flags) = features(&he, opts, length);
     let mut report = RemeshReport {
         edge_length: length,
@@ -155,7 +209,19 @@ pub fn remesh_onto(
     };
     let surface = TriangleBvh::new(onto.unwrap_or(mesh));
     let lines = TriangleBvh::new(&feature_lines(&he, &edge_flags, mesh));
-    let mut r = Remesher::new(he, edge_flags, vertex_flags, &surface, &lines, length);
+    let size = match opts.adaptive {
+        None => None,
+        Some(a) if a.shortest > 0.0 && a.shortest <= 1.0 && a.tolerance > 0.0 => Some(
+            sizing::vertex_sizes(&he, a.shortest * length, length, a.tolerance * length),
+        ),
+        Some(a) => {
+            return Err(Error::InvalidOption(format!(
+                "adaptive sizing needs a shortest share in (0, 1] and a positive tolerance, \
+                 got {a:?}"
+            )));
+        }
+    };
+    let mut r = Remesher::new(he, edge_flags, vertex_flags, &surface, &lines, length, size);
     report.seconds.setup = start.elapsed().as_secs_f64();
     let mut length = length;
     // Seconds since the last lap, and a new lap.
@@ -169,8 +235,8 @@ pub fn remesh_onto(
         // Edges between 4/5 L and 4/3 L are left alone, so the face count for a length can be
         // off by that band (an icosphere of 20,480 faces aimed at 3,000 stopped at 3,548, a
         // torus simplified to 2,000 faces and remeshed once came to 2,426). For a face count,
-        // splits and collapses run again with the length corrected by what they missed, until
-        // within 3% (flips and relaxation keep the count).
+        // splits and collapses run again with the length corrected by what they missed, up to
+        // four times, aiming at 3% (flips and relaxation keep the count).
         for _attempt in 0..4 {
             let (low, high) = (length * 4.0 / 5.0, length * 4.0 / 3.0);
             report.splits += r.split_long(high);

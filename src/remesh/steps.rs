@@ -36,6 +36,9 @@ pub(super) struct Remesher<'a> {
     pub lines: &'a TriangleBvh,
     /// Twice the area below which a relaxed face counts as flattened.
     pub min_double_area: f64,
+    /// With adaptive sizing, each vertex's target length as a share of the longest (0..=1];
+    /// an edge aims at the mean of its ends'. `None`: every edge aims at the one length.
+    pub size: Option<Vec<f64>>,
     /// Scratch for the link condition.
     mark: Vec<u32>,
     stamp: u32,
@@ -49,6 +52,7 @@ impl<'a> Remesher<'a> {
         surface: &'a TriangleBvh,
         lines: &'a TriangleBvh,
         length: f64,
+        size: Option<Vec<f64>>,
     ) -> Self {
         let hint = vec![NONE; he.pos.len()];
         Remesher {
@@ -61,6 +65,7 @@ impl<'a> Remesher<'a> {
             // A face with edges of about `length` has twice its area near length²; a
             // millionth of that is flat for any purpose.
             min_double_area: length * length * 1e-6,
+            size,
             mark: Vec::new(),
             stamp: 0,
         }
@@ -75,11 +80,19 @@ impl<'a> Remesher<'a> {
         while (e as usize) < self.he.edge_count() {
             if !self.he.dead_edge[e as usize]
                 && self.edge_flags[e as usize] & LOCKED == 0
-                && self.he.edge_len2(e) > high2
+                && self.he.edge_len2(e) > high2 * self.factor2(e)
             {
                 let h = 2 * e;
                 let (a, b) = (self.he.from(h), self.he.to[h as usize]);
                 let mid = (self.he.pos[a as usize] + self.he.pos[b as usize]) * 0.5;
+                // An edge a rounding step long has no midpoint of its own: leave it.
+                if mid == self.he.pos[a as usize] || mid == self.he.pos[b as usize] {
+                    e += 1;
+                    continue;
+                }
+                if let Some(size) = &mut self.size {
+                    size.push(0.5 * (size[a as usize] + size[b as usize]));
+                }
                 let first_new_edge = self.he.edge_count();
                 let (v, cont) = self.he.split(e, mid);
                 let flags = self.edge_flags[e as usize];
@@ -88,7 +101,11 @@ impl<'a> Remesher<'a> {
                 debug_assert_eq!(cont as usize, first_new_edge);
                 let on_line = if flags & FEATURE != 0 { ON_FEATURE } else { 0 };
                 self.vertex_flags.push(on_line);
-                self.hint.push(self.hint[a as usize]);
+                // Hints are faces of the surface or of the lines, by the vertex's flag: a's
+                // is good only if it projects onto the same.
+                let same = self.vertex_flags[a as usize] & ON_FEATURE == on_line;
+                self.hint
+                    .push(if same { self.hint[a as usize] } else { NONE });
                 debug_assert_eq!(self.vertex_flags.len(), v as usize + 1);
                 splits += 1;
                 continue; // the shortened edge may still be too long
@@ -108,7 +125,7 @@ impl<'a> Remesher<'a> {
             for e in 0..self.he.edge_count() as u32 {
                 if self.he.dead_edge[e as usize]
                     || self.edge_flags[e as usize] & LOCKED != 0
-                    || self.he.edge_len2(e) >= low2
+                    || self.he.edge_len2(e) >= low2 * self.factor2(e)
                 {
                     continue;
                 }
@@ -141,6 +158,17 @@ impl<'a> Remesher<'a> {
         collapses
     }
 
+    /// The square of edge `e`'s target as a share of the longest: 1 without adaptive sizing.
+    fn factor2(&self, e: u32) -> f64 {
+        match &self.size {
+            None => 1.0,
+            Some(s) => {
+                let (a, b) = (self.he.from(2 * e), self.he.to[2 * e as usize]);
+                (0.5 * (s[a as usize] + s[b as usize])).powi(2)
+            }
+        }
+    }
+
     /// Whether `from(h)` may be removed into `to(h)`.
     fn collapse_ok(&mut self, h: u32, high2: f64) -> bool {
         let (v0, v1) = (self.he.from(h), self.he.to[h as usize]);
@@ -168,7 +196,11 @@ impl<'a> Remesher<'a> {
                 return;
             }
             let w = he.to[g as usize];
-            if w != v1 && he.pos[w as usize].distance_squared(p1) > high2 {
+            let f2 = match &self.size {
+                None => 1.0,
+                Some(s) => (0.5 * (s[v1 as usize] + s[w as usize])).powi(2),
+            };
+            if w != v1 && he.pos[w as usize].distance_squared(p1) > high2 * f2 {
                 ok = false;
                 return;
             }

@@ -21,7 +21,7 @@ fn with_remesher<T>(m: &Mesh, length: f64, f: impl FnOnce(&mut Remesher) -> T) -
     let (ef, vf) = features(&he, &RemeshOptions::default(), length);
     let surface = TriangleBvh::new(m);
     let lines = TriangleBvh::new(&super::feature_lines(&he, &ef, m));
-    let mut r = Remesher::new(he, ef, vf, &surface, &lines, length);
+    let mut r = Remesher::new(he, ef, vf, &surface, &lines, length, None);
     f(&mut r)
 }
 
