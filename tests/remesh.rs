@@ -226,14 +226,38 @@ fn normals_colours_and_seamless_uvs_are_interpolated_on_the_input() {
         assert_eq!(colors[v], [1.0, 0.0, 0.0, 1.0]);
         assert!((uvs[v][0] - p[0]).abs() < 1e-5 && (uvs[v][1] - p[1]).abs() < 1e-5);
     }
-    // With a seam (the torus's chart cut open along a meridian) the UVs are left out, and the
-    // report says so.
-    let (out, report) = remesh(&common::seamed_torus(), &RemeshOptions::default()).unwrap();
-    assert!(out.uvs.is_none());
+    // With a seam (the torus's chart cut open along a meridian, u = 0 on one side and 1 on
+    // the other): the seam stays a line, its vertices are stored once per side, and no face
+    // spreads across the atlas. The torus's u is its angle round the z axis over 2π.
+    let seamed = common::seamed_torus();
+    let (out, report) = remesh(&seamed, &RemeshOptions::default()).unwrap();
+    assert!(report.not_carried.is_empty(), "{report:?}");
+    let uv = out.uvs.as_ref().expect("UVs carried");
+    let t = topology(&out);
+    assert_eq!((t.euler_characteristic, t.boundary_loops), (0, 0), "{t:?}");
     assert!(
-        report.not_carried.iter().any(|w| w.contains("UV seams")),
-        "{report:?}"
+        out.vertex_count() > t.welded_vertices,
+        "the seam's vertices are not split"
     );
+    for tri in &out.triangles {
+        let us = tri.map(|v| uv[v as usize][0]);
+        let spread =
+            us.iter().fold(0f32, |m, &a| m.max(a)) - us.iter().fold(1f32, |m, &a| m.min(a));
+        assert!(
+            spread < 0.1,
+            "a face spreads over {spread} of the atlas: {us:?}"
+        );
+        for v in *tri {
+            let p = out.positions[v as usize];
+            let angle = (p[1].atan2(p[0]) / std::f32::consts::TAU).rem_euclid(1.0);
+            let u = uv[v as usize][0];
+            let off = (u - angle)
+                .abs()
+                .min((u - angle - 1.0).abs())
+                .min((u - angle + 1.0).abs());
+            assert!(off < 0.01, "u {u} at angle {angle}");
+        }
+    }
 }
 
 #[test]

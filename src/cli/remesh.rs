@@ -20,8 +20,9 @@ within its tangent plane and projects it back onto the input. Edges whose faces 
 feature angle, and borders, stay where they are: they are split and collapsed only along
 themselves. The input must be manifold and consistently oriented ('meshslim info' tells);
 vertices stored twice at one place are welded first. Normals, colours and UVs are
-interpolated on the input at each new vertex; UVs only where the input has no UV seams, and
-materials and groups not at all (the report says what was left out).
+interpolated on the input at each new vertex; UV seams are kept as lines, like creases, with
+their vertices stored once per side. Materials and groups are not carried (the report says
+what was left out).
 
 With --adaptive, L is the longest edge: edges shrink where the surface bends, down to
 --shortest × L, so that each chord stays within --tolerance × L of the surface.

@@ -131,8 +131,8 @@ pub struct SimplifyArgs {
     /// Then remesh the result with K isotropic remeshing iterations (as 'meshslim remesh',
     /// features over 45 degrees kept) at the edge length that keeps its face count (aiming at
     /// 3%), projecting onto the input: well-shaped triangles for simulation or printing, at
-    /// some cost in distance. Normals and colours are interpolated on the input; UVs too
-    /// unless it has UV seams. A result remeshing refuses (clustering's may be non-manifold)
+    /// some cost in distance. Normals, colours and UVs are interpolated on the input (UV
+    /// seams kept). A result remeshing refuses (clustering's may be non-manifold)
     /// is written as simplified, with a warning
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub remesh: usize,

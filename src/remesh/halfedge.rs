@@ -28,6 +28,9 @@ pub(crate) struct HalfEdges {
     pub fhe: Vec<u32>,
     /// Per edge: deleted by a collapse.
     pub dead_edge: Vec<bool>,
+    /// For each face built from the mesh, its index there (faces that repeat a vertex are
+    /// left out, so the two can differ).
+    pub origin: Vec<u32>,
 }
 
 #[inline]
@@ -42,12 +45,13 @@ impl HalfEdges {
     /// faces form more than one fan are refused, with the vertex indices in the message.
     pub fn from_mesh(m: &Mesh) -> Result<HalfEdges> {
         let nv = m.positions.len();
-        let faces: Vec<[u32; 3]> = m
+        let (origin, faces): (Vec<u32>, Vec<[u32; 3]>) = m
             .triangles
             .iter()
-            .copied()
-            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
-            .collect();
+            .enumerate()
+            .filter(|(_, t)| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
+            .map(|(f, t)| (f as u32, *t))
+            .unzip();
         // (low, high, corner slot 3f + k, forward = the face goes low → high).
         let mut directed: Vec<(u32, u32, u32, bool)> = Vec::with_capacity(faces.len() * 3);
         for (f, t) in faces.iter().enumerate() {
@@ -108,6 +112,7 @@ impl HalfEdges {
             prev: vec![NONE; nh],
             face: vec![NONE; nh],
             fhe: vec![NONE; faces.len()],
+            origin,
             dead_edge: vec![false; nh / 2],
         };
         for f in 0..faces.len() {

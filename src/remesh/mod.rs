@@ -27,7 +27,7 @@ use glam::DVec3;
 use crate::metrics::TriangleBvh;
 use crate::{Error, Mesh, Result};
 use halfedge::{HalfEdges, NONE, twin};
-use steps::{FEATURE, FIXED, LOCKED, ON_FEATURE, Remesher};
+use steps::{FEATURE, FIXED, LOCKED, ON_FEATURE, Remesher, SEAM};
 
 /// The most faces a remeshing may aim at: about 10 GB of half-edges and BVH, and far inside
 /// the u32 indices.
@@ -132,8 +132,9 @@ pub struct RemeshSeconds {
 
 /// Remeshes `mesh`; see the module documentation. The input must be a manifold, consistently
 /// oriented triangle mesh (vertices at one position are welded first). Normals, colours and
-/// UVs are interpolated on the input at each new vertex's closest point; UVs only when the
-/// input has no UV seams, and materials and groups not at all (the report's `not_carried`).
+/// UVs are interpolated on the input at each new vertex's closest point; UV seams are feature
+/// lines, their vertices stored once per side. Materials and groups are not carried (the
+/// report's `not_carried`).
 pub fn remesh(mesh: &Mesh, opts: &RemeshOptions) -> Result<(Mesh, RemeshReport)> {
     remesh_with_progress(mesh, opts, &|_| {})
 }
@@ -173,10 +174,10 @@ pub fn remesh_onto(
         }
     }
     // Vertices stored twice at one place (UV seams, a triangle soup) are one point of the
-    // surface; the attributes that split them are not carried anyway.
-    let welded =
-        crate::mesh::weld_positions(&Mesh::new(input.positions.clone(), input.triangles.clone()))
-            .mesh;
+    // surface; where their UVs differ the edges become seam lines below.
+    let weld =
+        crate::mesh::weld_positions(&Mesh::new(input.positions.clone(), input.triangles.clone()));
+    let welded = weld.mesh;
     let mesh = &welded;
     let he = HalfEdges::from_mesh(mesh)?;
     if he.fhe.is_empty() {
@@ -198,7 +199,8 @@ pub fn remesh_onto(
              {MAX_FACES} remeshing allows; choose a longer edge or fewer faces"
         )));
     }
-    let (edge_flags, vertex_flags) = features(&he, opts, length);
+    let seams = seam_edges(&he, input, &weld.remap);
+    let (edge_flags, vertex_flags) = features(&he, opts, length, &seams);
     let mut report = RemeshReport {
         edge_length: length,
         iterations: opts.iterations,
@@ -298,15 +300,50 @@ fn edge_length(he: &HalfEdges, target: EdgeTarget) -> Result<f64> {
     }
 }
 
+/// Per edge of `he` (built from `input` welded by `remap`), whether its two faces give one of
+/// its ends different UVs: a seam of the UV atlas. Empty without UVs.
+fn seam_edges(he: &HalfEdges, input: &Mesh, remap: &[u32]) -> Vec<bool> {
+    let Some(uvs) = &input.uvs else {
+        return Vec::new();
+    };
+    // The UV that input face `f` gives welded vertex `v`.
+    let uv_at = |f: u32, v: u32| {
+        let t = input.triangles[he.origin[f as usize] as usize];
+        t.iter()
+            .find(|&&c| remap[c as usize] == v)
+            .map(|&c| uvs[c as usize])
+    };
+    (0..he.edge_count() as u32)
+        .map(|e| {
+            let (h, o) = (2 * e, 2 * e + 1);
+            let (f0, f1) = (he.face[h as usize], he.face[o as usize]);
+            if f0 == NONE || f1 == NONE {
+                return false;
+            }
+            [he.from(h), he.to[h as usize]]
+                .iter()
+                .any(|&v| uv_at(f0, v) != uv_at(f1, v))
+        })
+        .collect()
+}
+
 /// Edge and vertex flags of the input: feature edges by dihedral angle, borders (feature
 /// lines, or locked), and the corners where lines end or meet. Crease lines shorter than
 /// `length` in all are dropped: a target edge cannot follow them, and their fixed ends only
 /// pin slivers around them (on horse at 45 degrees, 539 feature edges made 320 corners).
-fn features(he: &HalfEdges, opts: &RemeshOptions, length: f64) -> (Vec<u8>, Vec<u8>) {
+fn features(
+    he: &HalfEdges,
+    opts: &RemeshOptions,
+    length: f64,
+    seams: &[bool],
+) -> (Vec<u8>, Vec<u8>) {
     let cos_max = opts.feature_angle_deg.to_radians().cos();
     let mut edge_flags: Vec<u8> = (0..he.edge_count() as u32)
         .map(|e| {
             let (h, o) = (2 * e, 2 * e + 1);
+            if seams.get(e as usize) == Some(&true) {
+                return FEATURE | SEAM;
+            }
             if he.is_border_he(h) || he.is_border_he(o) {
                 return if opts.lock_border {
                     LOCKED | FEATURE

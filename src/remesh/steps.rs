@@ -14,6 +14,8 @@ use crate::metrics::TriangleBvh;
 pub(super) const FEATURE: u8 = 1;
 /// A border under `--lock-border`: never split, collapsed, flipped or moved.
 pub(super) const LOCKED: u8 = 2;
+/// A UV seam (with `FEATURE`): the UV chart is cut there, so the line stays.
+pub(super) const SEAM: u8 = 4;
 /// Vertex flags: on a feature line (or a border), moving only along it.
 pub(super) const ON_FEATURE: u8 = 1;
 /// A corner of the feature lines (one, or three or more feature edges), or a locked border

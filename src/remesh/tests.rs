@@ -18,7 +18,7 @@ fn flat(positions: &[[f32; 2]], triangles: Vec<[u32; 3]>) -> Mesh {
 /// Runs `f` on a remesher of `m` with the flags of the default options at `length`.
 fn with_remesher<T>(m: &Mesh, length: f64, f: impl FnOnce(&mut Remesher) -> T) -> T {
     let he = HalfEdges::from_mesh(m).unwrap();
-    let (ef, vf) = features(&he, &RemeshOptions::default(), length);
+    let (ef, vf) = features(&he, &RemeshOptions::default(), length, &[]);
     let surface = TriangleBvh::new(m);
     let lines = TriangleBvh::new(&super::feature_lines(&he, &ef, m));
     let mut r = Remesher::new(he, ef, vf, &surface, &lines, length, None);
