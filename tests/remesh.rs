@@ -241,8 +241,7 @@ fn normals_colours_and_seamless_uvs_are_interpolated_on_the_input() {
     );
     for tri in &out.triangles {
         let us = tri.map(|v| uv[v as usize][0]);
-        let spread =
-            us.iter().fold(0f32, |m, &a| m.max(a)) - us.iter().fold(1f32, |m, &a| m.min(a));
+        let spread = common::u_spread(us);
         assert!(
             spread < 0.1,
             "a face spreads over {spread} of the atlas: {us:?}"

@@ -100,6 +100,8 @@ impl GpuSimplifier {
 /// The mesh on the GPU as a renderer draws it: positions (vec4, normalized frame) and u32
 /// indices, usable as STORAGE, VERTEX and INDEX buffers, and indexed indirect draw arguments the
 /// rounds keep current. Positions are in the unit-diagonal frame: world = p / scale + center.
+/// A clone shares the buffers (wgpu handles).
+#[derive(Clone)]
 pub struct GpuMesh {
     pub positions: wgpu::Buffer,
     pub indices: wgpu::Buffer,

@@ -24,57 +24,28 @@ pub(super) fn carry(source: &Mesh, surface: &TriangleBvh, out: &mut Mesh) -> Vec
         .par_iter()
         .map(|p| {
             let p = DVec3::from_array(p.map(f64::from));
-            // The remesher refused a surface without faces, so there is always a closest one.
-            let (q, hit) = surface
-                .closest_point(p, None)
-                .expect("the surface has faces");
-            let t = source.triangles[hit.face as usize];
-            let [a, b, c] =
-                t.map(|v| DVec3::from_array(source.positions[v as usize].map(f64::from)));
-            (hit.face, barycentric(q, a, b, c))
+            weights_at(source, surface, p, None)
         })
         .collect();
-    let mix = |f: u32, w: [f64; 3], get: &dyn Fn(u32) -> Vec<f32>| -> Vec<f32> {
-        let t = source.triangles[f as usize];
-        let mut acc = vec![0.0f64; get(t[0]).len()];
-        for k in 0..3 {
-            for (a, x) in acc.iter_mut().zip(get(t[k])) {
-                *a += w[k] * x as f64;
-            }
-        }
-        acc.into_iter().map(|x| x as f32).collect()
-    };
     if let Some(n) = &source.normals {
         out.normals = Some(
             weights
                 .iter()
                 .map(|&(f, w)| {
-                    let v = mix(f, w, &|i| n[i as usize].to_vec());
-                    let v = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
+                    let v = DVec3::from_array(mix(source, f, w, n).map(f64::from));
                     v.try_normalize().unwrap_or(DVec3::Z).as_vec3().to_array()
                 })
                 .collect(),
         );
     }
     if let Some(c) = &source.colors {
-        out.colors = Some(
-            weights
-                .iter()
-                .map(|&(f, w)| {
-                    let v = mix(f, w, &|i| c[i as usize].to_vec());
-                    [v[0], v[1], v[2], v[3]]
-                })
-                .collect(),
-        );
+        out.colors = Some(weights.iter().map(|&(f, w)| mix(source, f, w, c)).collect());
     }
     if let Some(uv) = uvs {
         out.uvs = Some(
             weights
                 .iter()
-                .map(|&(f, w)| {
-                    let v = mix(f, w, &|i| uv[i as usize].to_vec());
-                    [v[0], v[1]]
-                })
+                .map(|&(f, w)| mix(source, f, w, uv))
                 .collect(),
         );
         out.uv_origin = source.uv_origin;
@@ -101,21 +72,8 @@ fn corner_uvs(source: &Mesh, surface: &TriangleBvh, uv: &[[f32; 2]], out: &mut M
             let centre = (pos(t[0]) + pos(t[1]) + pos(t[2])) / 3.0;
             t.map(|v| {
                 let p = pos(v);
-                let inside = p + (centre - p) * 1e-3;
-                let (_, hit) = surface
-                    .closest_point(inside, None)
-                    .expect("the surface has faces");
-                let f = source.triangles[hit.face as usize];
-                let [a, b, c] =
-                    f.map(|i| DVec3::from_array(source.positions[i as usize].map(f64::from)));
-                let w = barycentric(p, a, b, c);
-                let mut r = [0.0f64; 2];
-                for k in 0..3 {
-                    for (x, &y) in r.iter_mut().zip(&uv[f[k] as usize]) {
-                        *x += w[k] * y as f64;
-                    }
-                }
-                [r[0] as f32, r[1] as f32]
+                let (f, w) = weights_at(source, surface, p + (centre - p) * 1e-3, Some(p));
+                mix(source, f, w, uv)
             })
         })
         .collect();
@@ -154,6 +112,35 @@ fn corner_uvs(source: &Mesh, surface: &TriangleBvh, uv: &[[f32; 2]], out: &mut M
         out.colors = Some(from.iter().map(|&v| c[v as usize]).collect());
     }
     out.uvs = Some(uvs);
+}
+
+/// The input face nearest `query` and the barycentric weights in it of `at`, or of the
+/// closest point itself without one.
+fn weights_at(
+    source: &Mesh,
+    surface: &TriangleBvh,
+    query: DVec3,
+    at: Option<DVec3>,
+) -> (u32, [f64; 3]) {
+    // The remesher refused a surface without faces, so there is always a closest one.
+    let (q, hit) = surface
+        .closest_point(query, None)
+        .expect("the surface has faces");
+    let t = source.triangles[hit.face as usize];
+    let [a, b, c] = t.map(|v| DVec3::from_array(source.positions[v as usize].map(f64::from)));
+    (hit.face, barycentric(at.unwrap_or(q), a, b, c))
+}
+
+/// The mix of input face `f`'s corner values by the weights `w`, summed in f64.
+fn mix<const N: usize>(source: &Mesh, f: u32, w: [f64; 3], values: &[[f32; N]]) -> [f32; N] {
+    let t = source.triangles[f as usize];
+    let mut acc = [0.0f64; N];
+    for k in 0..3 {
+        for (a, &x) in acc.iter_mut().zip(&values[t[k] as usize]) {
+            *a += w[k] * x as f64;
+        }
+    }
+    acc.map(|x| x as f32)
 }
 
 /// Whether two vertices at one position have different UVs.

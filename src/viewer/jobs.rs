@@ -81,7 +81,8 @@ impl ViewerApp {
                     &mesh,
                     crate::options::StopReason::TargetReached,
                 );
-                let mut s = scene::show(&device, &model, (*mesh).clone(), report, &cancel, phase)?;
+                let mesh = Arc::unwrap_or_clone(mesh);
+                let mut s = scene::show(&device, &model, mesh, report, &cancel, phase)?;
                 s.made_by = Some(format!(
                     "member {} of the Pareto front: error {:.3e} by its search",
                     k + 1,
@@ -112,10 +113,15 @@ impl ViewerApp {
         members.sort_by_key(|m| std::cmp::Reverse(m.faces));
         let device = self.gpu.device.clone();
         self.lod_source = format!("{} members of the Pareto front", members.len());
+        // The original on the GPU already, shared rather than uploaded again.
+        let original = self.original.as_deref().cloned();
         self.spawn(
             "making the LOD scene from the front".into(),
             move |cancel, progress, _| {
-                let mut levels = vec![model.original(&device)?];
+                let mut levels = vec![match original {
+                    Some(o) => o,
+                    None => model.original(&device)?,
+                }];
                 for (i, m) in members.iter().enumerate() {
                     cancel.check()?;
                     let mesh = m.mesh.load()?;

@@ -69,7 +69,9 @@ impl Default for Style {
 }
 
 /// A drawable mesh: the [`GpuMesh`] as the simplifier left it, and extras beside it: one entry
-/// per vertex of the GpuMesh, in its order, or per corner for the UVs.
+/// per vertex of the GpuMesh, in its order, or per corner for the UVs. A clone shares the
+/// GPU buffers (wgpu handles): it uploads and copies nothing.
+#[derive(Clone)]
 pub struct SceneMesh {
     pub gpu: GpuMesh,
     /// f32 per vertex: distance to the original surface, relative to its diagonal.

@@ -94,7 +94,8 @@ pub fn open(
             let model = model_of(&m.input, m.input_from_manifest.as_deref(), given)?;
             if model.faces() != m.faces {
                 return Err(Error::InvalidOption(format!(
-                    "{}: made from a mesh of {} faces, but {} has {}: the levels are of                      another mesh",
+                    "{}: made from a mesh of {} faces, but {} has {}: the levels are of \
+                     another mesh",
                     path.display(),
                     m.faces,
                     model.name,
@@ -107,13 +108,14 @@ pub fn open(
                     path.display()
                 )));
             }
-            let mut levels = vec![model.original(device)?];
+            // Uploaded once: the scene's finest level is the original itself.
+            let original = model.original(device)?;
+            let mut levels = vec![original.clone()];
             for (k, e) in m.levels.iter().enumerate() {
                 let mesh = crate::io::read(&manifest::resolve(path, &e.file)?)?;
                 levels.push(model.level(device, &mesh)?);
                 progress((k + 1) as f32 / m.levels.len() as f32);
             }
-            let original = model.original(device)?;
             Ok(Loaded {
                 model,
                 original,

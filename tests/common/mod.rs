@@ -57,6 +57,12 @@ pub fn seamed_torus() -> Mesh {
     m
 }
 
+/// How far apart a face's u coordinates are: near 1 for a face across the [`seamed_torus`]'s
+/// seam.
+pub fn u_spread(us: [f32; 3]) -> f32 {
+    us.iter().fold(0f32, |m, &a| m.max(a)) - us.iter().fold(1f32, |m, &a| m.min(a))
+}
+
 /// A simplified [`seamed_torus`]: the invariants, the target reached (the seam may not pin it
 /// away), UVs on every vertex, no face mixing the two sides of the seam (u near 0 with u near
 /// 1), and the seam still there but thinned out (seam vertices slide along it).
@@ -71,8 +77,7 @@ pub fn check_seamed_torus(label: &str, input: &Mesh, out: &Mesh, report: &Simpli
     assert_eq!(uv.len(), out.positions.len(), "{label}");
     for t in &out.triangles {
         let us = t.map(|v| uv[v as usize][0]);
-        let spread =
-            us.iter().fold(0f32, |m, &a| m.max(a)) - us.iter().fold(1f32, |m, &a| m.min(a));
+        let spread = u_spread(us);
         assert!(
             spread < 0.5,
             "{label}: a face straddles the seam, u = {us:?}"
