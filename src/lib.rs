@@ -36,6 +36,9 @@ pub mod cli;
 // Vertex clustering; public (hidden) for the tests of its stages.
 #[doc(hidden)]
 pub mod cluster;
+// The GPU layer every family shares: schedules' vocabulary, pipeline cache, error capture.
+#[doc(hidden)]
+pub mod compute;
 // The CPU twin and the round driver: internals, public (and hidden from the docs) only so that
 // the integration tests can diff the GPU's buffers stage by stage.
 #[doc(hidden)]

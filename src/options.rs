@@ -473,4 +473,10 @@ pub struct RoundsReport {
     pub pipeline_seconds: f64,
     /// Upload and download between host and device (gpu backend).
     pub transfer_seconds: f64,
+    /// Preparing the upload on the host before the rounds: weld, position classes, Morton
+    /// order, normalization (gpu backend, `qem`; `hybrid`'s hand-over is in its clustering).
+    pub prepare_seconds: f64,
+    /// The rounds' waits, from each round's submission to its counters read back: the GPU's
+    /// work and the driver's (gpu backend).
+    pub wait_seconds: f64,
 }

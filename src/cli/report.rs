@@ -214,6 +214,12 @@ fn write_rounds(out: &mut impl Write, rr: &crate::parallel::RoundsReport) -> std
              stage times); upload + download {:.3} s",
             rr.pipeline_seconds, rr.transfer_seconds
         )?;
+        writeln!(
+            out,
+            "host                {:.3} s preparing the upload; {:.3} s from the rounds' \
+             submissions to their counters",
+            rr.prepare_seconds, rr.wait_seconds
+        )?;
     }
     let removed = &rr.faces_removed_per_round;
     writeln!(out, "rounds              {}", rr.rounds)?;

@@ -7,9 +7,10 @@
 
 use super::floating::hash_grid;
 use super::floating_twins::{RANK_PASSES, ROUND_SLOTS, cluster_passes, float_params};
-use super::gpu::{GpuClusterMesh, Part, check};
+use super::gpu::{GpuClusterMesh, Part};
 use super::gpu_schedule::{self as sched, CBuf};
 use super::twins::{self, ClusterBuild};
+use crate::compute::gpu::ErrorScope;
 use crate::cpu::common::V3;
 use crate::error::{Error, Result};
 use crate::gpu::context::checked_buffer;
@@ -108,15 +109,12 @@ impl GpuClusterMesh<'_> {
     /// Runs one floating part alone and waits for it.
     pub fn run_fc_part(&mut self, part: FcPart) -> Result<()> {
         self.floating_buffers()?;
-        let scope = self
-            .sim
-            .device
-            .push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = ErrorScope::push(&self.sim.device);
         let mut enc = self.sim.device.create_command_encoder(&Default::default());
         self.record_fc(&mut enc, part);
         self.sim.queue.submit([enc.finish()]);
         self.wait()?;
-        check(scope, "running a floating-cell stage")
+        scope.check("running a floating-cell stage")
     }
 
     /// The ranks and the rank order, once per mesh.
@@ -138,7 +136,7 @@ impl GpuClusterMesh<'_> {
     /// is a device fault and an error.
     pub fn build_floating(&mut self, lo: V3, hi: V3, r: f32) -> Result<(ClusterBuild, usize)> {
         let dev = self.sim.device.clone();
-        let scope = dev.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = ErrorScope::push(&dev);
         self.set_radius(lo, hi, r)?;
         let encoder = || {
             dev.create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -183,7 +181,7 @@ impl GpuClusterMesh<'_> {
         self.record_part(&mut enc, Part::Faces);
         self.sim.queue.submit([enc.finish()]);
         let b = self.read_build()?;
-        check(scope, "floating cells on the GPU")?;
+        scope.check("floating cells on the GPU")?;
         Ok((b, rounds))
     }
 }

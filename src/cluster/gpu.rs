@@ -8,13 +8,13 @@
 use crate::cluster::gpu_schedule::{self as sched, CBuf, CCount, CGrid, CStage, CStep};
 use crate::cluster::grid::Grid;
 use crate::cluster::twins::{self, ClusterBuild};
+use crate::compute::gpu::{ErrorScope, Groups, Pipelines};
+use crate::compute::schedule::Step as S;
 use crate::error::{Error, Result};
 use crate::gpu::GpuMesh;
 use crate::gpu::context::{checked_buffer, checked_buffer_init};
-use crate::gpu::shaders::{source, stage_source};
 use crate::gpu::simplifier::{DRAW_ARGS_USAGE, MESH_USAGE};
 use crate::gpu::types::*;
-use crate::parallel::schedule::Access;
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -36,29 +36,14 @@ pub struct GpuClusterer {
     pub pipeline_seconds: f64,
 }
 
-/// Waits for an error scope and turns what it caught into an error.
-pub(super) fn check(scope: wgpu::ErrorScopeGuard, doing: &str) -> Result<()> {
-    match pollster::block_on(scope.pop()) {
-        Some(e) => Err(Error::Gpu(format!("{doing}: {e}"))),
-        None => Ok(()),
-    }
-}
-
 impl GpuClusterer {
     /// Compiles every stage of [`sched::STAGES`] on `device` (borrowed: a viewer or the rounds
-    /// may share it). Errors are caught by error scopes, not the device's handler, which the
-    /// rounds' simplifier owns.
+    /// may share it; the stages they share come from the device's [`Pipelines`]).
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<GpuClusterer> {
-        let t = Instant::now();
         let limits = device.limits();
         let most = sched::STAGES
             .iter()
-            .map(|s| {
-                s.bindings
-                    .iter()
-                    .filter(|b| b.access != Access::Uniform)
-                    .count()
-            })
+            .map(|s| s.storage_buffers())
             .max()
             .unwrap_or(0) as u32;
         if limits.max_storage_buffers_per_shader_stage < most {
@@ -67,36 +52,13 @@ impl GpuClusterer {
                 limits.max_storage_buffers_per_shader_stage
             )));
         }
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let mut modules = HashMap::new();
-        let mut pipelines = HashMap::new();
-        for stage in sched::STAGES {
-            let module = modules.entry(stage.shader).or_insert_with(|| {
-                device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some(stage.shader),
-                    source: wgpu::ShaderSource::Wgsl(
-                        source(stage_source(stage.shader).unwrap_or_default()).into(),
-                    ),
-                })
-            });
-            let label = format!("meshslim.{}", stage.entry);
-            let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(&label),
-                layout: None,
-                module,
-                entry_point: Some(stage.entry),
-                compilation_options: Default::default(),
-                cache: None,
-            });
-            pipelines.insert(stage.entry, p);
-        }
-        check(scope, "creating the clustering pipelines")?;
+        let (pipelines, pipeline_seconds) = Pipelines::of(device).get(sched::STAGES)?;
         Ok(GpuClusterer {
             device: device.clone(),
             queue: queue.clone(),
             pipelines,
             max_workgroups: limits.max_compute_workgroups_per_dimension,
-            pipeline_seconds: t.elapsed().as_secs_f64(),
+            pipeline_seconds,
         })
     }
 }
@@ -181,7 +143,7 @@ impl<'a> GpuClusterMesh<'a> {
         assert_eq!(positions.len(), locked.len(), "a locked flag per vertex");
         let t = Instant::now();
         let dev = &sim.device;
-        let scope = dev.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = ErrorScope::push(dev);
         let (nv, nf) = (positions.len(), faces.len());
         let (v, f) = (nv as u64, nf as u64);
         let blocks = (nv as u32).div_ceil(SORT_BLOCK) as u64;
@@ -296,9 +258,10 @@ impl<'a> GpuClusterMesh<'a> {
             setup_seconds: 0.0,
         };
         let mut enc = dev.create_command_encoder(&Default::default());
-        m.record(&mut enc, sched::MESH);
+        m.record(&mut enc, sched::ADJACENCY);
+        m.record(&mut enc, sched::PLANES);
         q.submit([enc.finish()]);
-        check(scope, "uploading the mesh for clustering")?;
+        scope.check("uploading the mesh for clustering")?;
         m.setup_seconds = t.elapsed().as_secs_f64();
         Ok(m)
     }
@@ -340,29 +303,23 @@ impl<'a> GpuClusterMesh<'a> {
 
     /// Runs one part alone and waits for it (after [`Self::set_grid`]).
     pub fn run_part(&mut self, part: Part) -> Result<()> {
-        let scope = self
-            .sim
-            .device
-            .push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = ErrorScope::push(&self.sim.device);
         let mut enc = self.sim.device.create_command_encoder(&Default::default());
         self.record_part(&mut enc, part);
         self.sim.queue.submit([enc.finish()]);
         self.wait()?;
-        check(scope, "running a clustering stage")
+        scope.check("running a clustering stage")
     }
 
     /// Runs `steps` alone and waits for them (after [`Self::set_grid`] and the parts they
     /// read): what examples/cluster_gpu_stages.rs times stage by stage.
     pub fn run_steps(&mut self, steps: &[CStep]) -> Result<()> {
-        let scope = self
-            .sim
-            .device
-            .push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = ErrorScope::push(&self.sim.device);
         let mut enc = self.sim.device.create_command_encoder(&Default::default());
         self.record(&mut enc, steps);
         self.sim.queue.submit([enc.finish()]);
         self.wait()?;
-        check(scope, "running clustering steps")
+        scope.check("running clustering steps")
     }
 
     pub(super) fn wait(&self) -> Result<()> {
@@ -375,10 +332,7 @@ impl<'a> GpuClusterMesh<'a> {
 
     /// One clustering at `grid`: every pass in one command buffer, then the result read back.
     pub fn build(&mut self, grid: &Grid) -> Result<ClusterBuild> {
-        let scope = self
-            .sim
-            .device
-            .push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = ErrorScope::push(&self.sim.device);
         self.set_grid(grid);
         let mut enc = self
             .sim
@@ -396,7 +350,7 @@ impl<'a> GpuClusterMesh<'a> {
         self.sim.queue.submit([enc.finish()]);
         let b = self.read_build()?;
         self.grid = Some(*grid);
-        check(scope, "clustering on the GPU")?;
+        scope.check("clustering on the GPU")?;
         Ok(b)
     }
 
@@ -440,10 +394,7 @@ impl<'a> GpuClusterMesh<'a> {
         let (_, kept) = self
             .built
             .ok_or_else(|| Error::Internal("a drawable clustering before any build".into()))?;
-        let scope = self
-            .sim
-            .device
-            .push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = ErrorScope::push(&self.sim.device);
         let mut enc = self.sim.device.create_command_encoder(&Default::default());
         self.record(&mut enc, sched::DRAWABLE);
         self.sim.queue.submit([enc.finish()]);
@@ -459,7 +410,7 @@ impl<'a> GpuClusterMesh<'a> {
             std::mem::size_of::<DrawArgs>(),
             DRAW_ARGS_USAGE,
         )?;
-        check(scope, "making the clustering drawable")?;
+        scope.check("making the clustering drawable")?;
         Ok(GpuMesh {
             positions: self.bufs[&CBuf::MeshPositions].clone(),
             indices: self.bufs[&CBuf::ClusterFaces].clone(),
@@ -494,21 +445,18 @@ impl<'a> GpuClusterMesh<'a> {
     pub(super) fn record(&mut self, enc: &mut wgpu::CommandEncoder, steps: &[CStep]) {
         for step in steps {
             match *step {
-                CStep::Clear(buf) => enc.clear_buffer(self.buffer(buf, None), 0, None),
-                CStep::CopyBuffer(from, to) => {
+                S::Clear(buf) => enc.clear_buffer(self.buffer(buf, None), 0, None),
+                S::CopyBuffer(from, to) => {
                     let (from, to) = (self.buffer(from, None), self.buffer(to, None));
                     enc.copy_buffer_to_buffer(from, 0, to, 0, from.size().min(to.size()));
                 }
-                CStep::Run(stage) => self.dispatch(enc, stage, None),
-                CStep::PrefixSum { count, data } => {
-                    for stage in [
-                        &sched::PREFIX_SUM_REDUCE,
-                        &sched::PREFIX_SUM_SPINE,
-                        &sched::PREFIX_SUM_APPLY,
-                    ] {
+                S::Run(stage) => self.dispatch(enc, stage, None),
+                S::PrefixSum { count, data } => {
+                    for stage in sched::PREFIX_SUM {
                         self.dispatch(enc, stage, Some((count, data)));
                     }
                 }
+                S::Own(never) => match never {},
             }
         }
     }
@@ -521,52 +469,35 @@ impl<'a> GpuClusterMesh<'a> {
         }
     }
 
-    /// One compute pass of `stage` over its grid (split over y beyond the per-dimension limit).
+    /// One compute pass of `stage` over its grid.
     fn dispatch(
         &self,
         enc: &mut wgpu::CommandEncoder,
         stage: &'static CStage,
         scan: Option<(CCount, CBuf)>,
     ) {
-        let pipeline = &self.sim.pipelines[stage.entry];
-        let layout = pipeline.get_bind_group_layout(0);
-        let entries: Vec<wgpu::BindGroupEntry> = stage
-            .bindings
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: self.buffer(b.buf, scan).as_entire_binding(),
-            })
-            .collect();
-        let bg = self
-            .sim
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(stage.entry),
-                layout: &layout,
-                entries: &entries,
-            });
         let groups = match stage.grid {
             CGrid::Each(c) => self.count(c).div_ceil(WG),
             CGrid::SortBlocks => (self.nv as u32).div_ceil(SORT_BLOCK),
             CGrid::ScanBlocks => scan.map_or(0, |s| self.count(s.0)).div_ceil(SCAN_BLOCK),
             CGrid::One => 1,
-        }
-        .max(1);
-        let max_x = self.sim.max_workgroups;
-        let (x, y) = if groups <= max_x {
-            (groups, 1)
-        } else {
-            (max_x, groups.div_ceil(max_x))
         };
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(stage.entry),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &bg, &[]);
-        pass.dispatch_workgroups(x, y, 1);
+        let buffers: Vec<&wgpu::Buffer> = stage
+            .bindings
+            .iter()
+            .map(|b| self.buffer(b.buf, scan))
+            .collect();
+        crate::compute::gpu::pass(
+            &self.sim.device,
+            enc,
+            stage.entry,
+            &self.sim.pipelines[stage.entry],
+            &buffers,
+            Groups::Direct(groups),
+            self.sim.max_workgroups,
+            None,
+            None,
+        );
     }
 
     /// The first `bytes` of a working buffer as the schedule names it (the sort's names as the

@@ -2,16 +2,14 @@
 //! `crate::parallel::schedule`: every stage's entry point, its bindings by WGSL variable name in
 //! binding order, the buffer each takes and the grid it runs over; and the parts of a build in
 //! order. The runner (`gpu.rs`) binds and dispatches from these, the CPU twins (`twins.rs`) are
-//! named after them, and a test checks every description against its WGSL through naga. The
-//! rounds' `Buf` has no room for the sort's halves and the clusters' buffers, hence this
-//! schedule of its own, with the prefix sum and adjacency stages described again on its buffers.
+//! named after them, and `compute::tests` checks every description against its WGSL through
+//! naga. It is written in the compute core's vocabulary ([`crate::compute::schedule`]) on its
+//! own buffers; the prefix sum, adjacency and face-plane stages are the core's, expanded here.
 //!
 //! The floating cells (`fc_*`, Low & Tan 1997) reuse the build's parts: the radix sort orders
 //! the vertices by rank once per mesh, then per build into the cells of a hash grid (by cell,
 //! then rank) and, after the rounds, by cluster; the cells part finds the ranges each time, and
 //! the faces part is the uniform grid's.
-
-use crate::parallel::schedule::Access;
 
 /// A buffer of the build. The sort's keys and values come in two halves: the plain names are
 /// the half a pass reads (and, after the sort, the sorted result), the `*Out` ones the half it
@@ -70,13 +68,6 @@ pub enum CBuf {
     FcLive,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct CBinding {
-    pub var: &'static str,
-    pub access: Access,
-    pub buf: CBuf,
-}
-
 /// A count a stage or a prefix sum runs over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CCount {
@@ -97,47 +88,19 @@ pub enum CGrid {
     One,
 }
 
-/// A compute stage: entry point `entry` in `shaders/<shader>.wgsl`.
-#[derive(Debug, PartialEq, Eq)]
-pub struct CStage {
-    pub entry: &'static str,
-    pub shader: &'static str,
-    pub bindings: &'static [CBinding],
-    pub grid: CGrid,
-}
+/// A stage of the clustering build: entry point `entry` in `shaders/<shader>.wgsl`.
+pub type CStage = crate::compute::schedule::Stage<CBuf, CGrid>;
 
-/// `stage!(entry in "shader" over grid; var: access Buf, ...)`, as the rounds' schedule writes it.
+/// `stage!(entry in "shader" over grid; var: access Buf, ...)`: a stage of the build.
 macro_rules! stage {
-    ($entry:ident in $shader:literal over $grid:expr; $($var:ident: $access:ident $buf:ident),* $(,)?) => {
-        CStage {
-            entry: stringify!($entry),
-            shader: $shader,
-            bindings: &[$(CBinding { var: stringify!($var), access: Access::$access, buf: CBuf::$buf }),*],
-            grid: $grid,
-        }
-    };
+    ($($t:tt)*) => { crate::compute::schedule::stage!(CBuf; $($t)*) };
 }
 
 use CCount::{Faces, Vertices};
-use CGrid::{Each, One, ScanBlocks, SortBlocks};
+use CGrid::{Each, SortBlocks};
 
-pub const PREFIX_SUM_REDUCE: CStage = stage!(prefix_sum_reduce in "prefix_sum" over ScanBlocks;
-    scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
-pub const PREFIX_SUM_SPINE: CStage = stage!(prefix_sum_spine in "prefix_sum" over One;
-    scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
-pub const PREFIX_SUM_APPLY: CStage = stage!(prefix_sum_apply in "prefix_sum" over ScanBlocks;
-    scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
-
-pub const ADJACENCY_COUNT: CStage = stage!(adjacency_count in "adjacency_count" over Each(Faces);
-    params: Uniform Params, indices: Read Indices, counts: ReadWrite Offsets);
-pub const ADJACENCY_FILL: CStage = stage!(adjacency_fill in "adjacency_fill" over Each(Faces);
-    params: Uniform Params, indices: Read Indices, offsets: Read Offsets,
-    cursor: ReadWrite Cursor, vertex_faces: ReadWrite VertexFaces);
-pub const ADJACENCY_SORT: CStage = stage!(adjacency_sort in "adjacency_sort" over Each(Vertices);
-    params: Uniform Params, offsets: Read Offsets, vertex_faces: ReadWrite VertexFaces);
-pub const FACE_PLANES: CStage = stage!(face_planes in "face_planes" over Each(Faces);
-    params: Uniform Params, positions: Read Positions, indices: Read Indices,
-    face_normals: ReadWrite FaceNormals);
+// The prefix sum, the vertex→face lists and the face planes: the core's, on these buffers.
+crate::compute::schedule::shared_stages!(CStage, CStep, CBuf, CGrid, CCount);
 
 pub const CELL_KEYS: CStage = stage!(cell_keys in "cell_keys" over Each(Vertices);
     cluster: Uniform Cluster, positions: Read Positions, locked: Read Locked,
@@ -240,34 +203,14 @@ pub const STAGES: &[&CStage] = &[
     &FC_QUADRICS,
 ];
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CStep {
-    Clear(CBuf),
-    Run(&'static CStage),
-    /// Exclusive prefix sum of `data` over `count` values, the total at index `count`.
-    PrefixSum {
-        count: CCount,
-        data: CBuf,
-    },
-    /// The whole of one buffer into another of the same size.
-    CopyBuffer(CBuf, CBuf),
-}
+/// One step of a build; the clustering has no steps of its own.
+pub type CStep = crate::compute::schedule::Step<CBuf, CGrid, CCount, std::convert::Infallible>;
 
-use CStep::{Clear, CopyBuffer, PrefixSum, Run};
+use crate::compute::schedule::Step::{Clear, CopyBuffer, PrefixSum, Run};
 
-/// Once per mesh (the grid does not change them): the vertex→face lists and face planes.
-pub const MESH: &[CStep] = &[
-    Clear(CBuf::Offsets),
-    Clear(CBuf::Cursor),
-    Run(&ADJACENCY_COUNT),
-    PrefixSum {
-        count: Vertices,
-        data: CBuf::Offsets,
-    },
-    Run(&ADJACENCY_FILL),
-    Run(&ADJACENCY_SORT),
-    Run(&FACE_PLANES),
-];
+/// Once per mesh (the grid does not change them): the vertex→face lists ([`ADJACENCY`]), then
+/// the face planes.
+pub const PLANES: &[CStep] = &[Run(&FACE_PLANES)];
 /// Per build: each vertex's cell key.
 pub const KEYS: &[CStep] = &[Run(&CELL_KEYS)];
 /// One radix pass (as many as the largest key needs); the halves swap after it.
@@ -335,104 +278,47 @@ pub const FLOATING_CLUSTERS: &[CStep] = &[
 /// One vertex per floating cell.
 pub const FLOATING_QUADRICS: &[CStep] = &[Run(&FC_QUADRICS)];
 
+/// Every part of a build, for the schedule's test.
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::parallel::schedule::check::{in_house_order, snake_case};
+const PARTS: &[&[CStep]] = &[
+    ADJACENCY,
+    PLANES,
+    KEYS,
+    SORT_PASS,
+    CELLS,
+    QUADRICS,
+    FACES,
+    DRAWABLE,
+    FLOATING_RANKS,
+    FLOATING_ORDER,
+    FLOATING_KEYS,
+    FLOATING_BATCH,
+    FLOATING_ROUND,
+    FLOATING_CLUSTERS,
+    FLOATING_QUADRICS,
+];
 
-    const PARTS: &[&[CStep]] = &[
-        MESH,
-        KEYS,
-        SORT_PASS,
-        CELLS,
-        QUADRICS,
-        FACES,
-        DRAWABLE,
-        FLOATING_RANKS,
-        FLOATING_ORDER,
-        FLOATING_KEYS,
-        FLOATING_BATCH,
-        FLOATING_ROUND,
-        FLOATING_CLUSTERS,
-        FLOATING_QUADRICS,
+/// The build's schedule against its WGSL, with the checks every family passes
+/// (`compute::tests`); a binding's variable names its buffer but for the roles listed here.
+#[cfg(test)]
+pub(crate) fn check_schedule() {
+    const ROLES: &[(&str, CBuf)] = &[
+        ("counts", CBuf::Offsets),
+        ("bucket_counts", CBuf::BucketOffsets),
+        ("keys", CBuf::SortKeys),
+        ("vals", CBuf::SortVals),
+        ("keys_out", CBuf::SortKeysOut),
+        ("vals_out", CBuf::SortValsOut),
+        ("scan", CBuf::ScanCount),
+        ("data", CBuf::ScanData),
     ];
-
-    /// Every stage's described bindings against its shader as naga reads it (names, order,
-    /// access), in the house order: uniforms, then read-only, then read_write.
-    #[test]
-    fn every_cluster_stage_binds_what_its_shader_declares() {
-        for stage in STAGES {
-            let declared = crate::gpu::shaders::shader_bindings(stage.shader)
-                .unwrap_or_else(|e| panic!("{}: {e}", stage.entry));
-            let described: Vec<(String, Access)> = stage
-                .bindings
-                .iter()
-                .map(|b| (b.var.to_string(), b.access))
-                .collect();
-            assert_eq!(
-                described, declared,
-                "{}: the cluster schedule's bindings against shaders/{}.wgsl",
-                stage.entry, stage.shader
-            );
-            assert!(
-                in_house_order(&described),
-                "{}: bindings out of the house order: {described:?}",
-                stage.entry
-            );
-        }
-    }
-
-    /// A binding's variable names its buffer, but for the roles listed here.
-    #[test]
-    fn every_cluster_binding_names_its_buffer() {
-        const ROLES: &[(&str, CBuf)] = &[
-            ("counts", CBuf::Offsets),
-            ("bucket_counts", CBuf::BucketOffsets),
-            ("keys", CBuf::SortKeys),
-            ("vals", CBuf::SortVals),
-            ("keys_out", CBuf::SortKeysOut),
-            ("vals_out", CBuf::SortValsOut),
-            ("scan", CBuf::ScanCount),
-            ("data", CBuf::ScanData),
-        ];
-
-        for s in STAGES {
-            for b in s.bindings {
-                assert!(
-                    b.var == snake_case(b.buf) || ROLES.contains(&(b.var, b.buf)),
-                    "{}: binding `{}` takes {:?}",
-                    s.entry,
-                    b.var,
-                    b.buf
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn every_cluster_stage_is_listed_once_runs_and_binds_each_buffer_once() {
-        for (i, s) in STAGES.iter().enumerate() {
-            assert!(
-                STAGES[..i].iter().all(|t| t.entry != s.entry),
-                "{} listed twice",
-                s.entry
-            );
-            let runs = PARTS.iter().any(|steps| {
-                steps.iter().any(|step| match step {
-                    Run(t) => t.entry == s.entry,
-                    PrefixSum { .. } => s.shader == "prefix_sum",
-                    Clear(_) | CopyBuffer(..) => false,
-                })
-            });
-            assert!(runs, "{} never runs", s.entry);
-            for (j, b) in s.bindings.iter().enumerate() {
-                assert!(
-                    s.bindings[..j].iter().all(|c| c.buf != b.buf),
-                    "{} binds {:?} twice",
-                    s.entry,
-                    b.buf
-                );
-            }
-        }
-    }
+    crate::compute::schedule::check::family("clustering", STAGES, ROLES, |s| {
+        PARTS.iter().any(|steps| {
+            steps.iter().any(|step| match step {
+                Run(t) => t.entry == s.entry,
+                PrefixSum { .. } => PREFIX_SUM.iter().any(|p| p.entry == s.entry),
+                _ => false,
+            })
+        })
+    });
 }

@@ -25,10 +25,11 @@ pub mod validate;
 pub mod vertex_flags;
 pub mod vertex_quadrics;
 
+use crate::compute::schedule::Step as S;
 use crate::error::{Error, Result};
 use crate::gpu::types::*;
 use crate::options::{Blocked, SimplifyOptions};
-use crate::parallel::schedule::{self, Buf, Stage, Step, When};
+use crate::parallel::schedule::{self, Buf, RoundStep, Stage, Step, When};
 use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
 use edge_costs::CounterField;
 use rayon::prelude::*;
@@ -245,10 +246,12 @@ impl CpuRounds {
     pub fn run_steps(&mut self, p: &Params, steps: &[Step]) -> Result<()> {
         for step in steps {
             match *step {
-                Step::Clear(buf) => self.clear(p, buf)?,
-                Step::ClearTentative => self.counters[CounterField::Tentative as usize] = 0,
-                Step::Run(stage) => self.time(stage.entry, |s| s.run_stage(p, stage))?,
-                Step::PrefixSum { count, data } => {
+                S::Clear(buf) => self.clear(p, buf)?,
+                S::Own(RoundStep::ClearTentative) => {
+                    self.counters[CounterField::Tentative as usize] = 0
+                }
+                S::Run(stage) => self.time(stage.entry, |s| s.run_stage(p, stage))?,
+                S::PrefixSum { count, data } => {
                     let n = count.of(p);
                     let data = match data {
                         Buf::Offsets => &mut self.offsets,
@@ -262,7 +265,8 @@ impl CpuRounds {
                     prefix_sum::prefix_sum(n, data, &mut self.block_sums);
                     self.times.add("prefix_sum", t.elapsed().as_secs_f64());
                 }
-                Step::CheckWinners => self.check_winners(p)?,
+                S::Own(RoundStep::CheckWinners) => self.check_winners(p)?,
+                S::CopyBuffer(from, _) => return Err(no_twin("copying", from)),
             }
         }
         Ok(())
@@ -659,14 +663,11 @@ impl RoundRunner for CpuRounds {
         reset(&mut self.counters, std::mem::size_of::<Counters>() / 4);
         for &(when, steps) in schedule::ROUND {
             match when {
-                When::Always => self.run_steps(p, steps)?,
-                When::FirstRound if first => self.run_steps(p, steps)?,
-                When::FirstRoundQuadrics if first && !self.carried_quadrics => {
+                When::EachSelectionPass => self.passes(p, steps, selection)?,
+                w if w.runs_once(first, self.carried_quadrics, p.trim != 0) => {
                     self.run_steps(p, steps)?
                 }
-                When::Trimming if p.trim != 0 => self.run_steps(p, steps)?,
-                When::FirstRound | When::FirstRoundQuadrics | When::Trimming => {}
-                When::EachSelectionPass => self.passes(p, steps, selection)?,
+                _ => {}
             }
         }
         self.swap_halves();

@@ -2,7 +2,6 @@
 //! million-triangle meshes fit, and every buffer checked against them before it is allocated.
 
 use crate::error::{Error, Result};
-use std::sync::{Arc, Mutex};
 
 /// A device and queue the simplifier (and a viewer) use.
 pub struct GpuContext {
@@ -125,31 +124,6 @@ pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'sta
             & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::POLYGON_MODE_LINE),
         required_limits: adapter.limits(),
         ..Default::default()
-    }
-}
-
-/// Errors the device reports asynchronously (validation, out of memory, device lost), kept until
-/// the host checks after a submission, instead of wgpu's default panic.
-#[derive(Clone, Default)]
-pub struct ErrorSink(Arc<Mutex<Option<String>>>);
-
-impl ErrorSink {
-    pub fn install(device: &wgpu::Device) -> ErrorSink {
-        let sink = ErrorSink::default();
-        let s = sink.0.clone();
-        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
-            let mut slot = s.lock().unwrap_or_else(|p| p.into_inner());
-            slot.get_or_insert_with(|| e.to_string());
-        }));
-        sink
-    }
-
-    pub fn check(&self, doing: &str) -> Result<()> {
-        let slot = self.0.lock().unwrap_or_else(|p| p.into_inner()).take();
-        match slot {
-            Some(e) => Err(Error::Gpu(format!("{doing}: {e}"))),
-            None => Ok(()),
-        }
     }
 }
 

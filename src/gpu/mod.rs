@@ -58,14 +58,14 @@ pub fn simplify_with(
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
-    simplify_upload(
-        ctx,
-        sim,
-        &Upload::pinned(mesh, &opts.pin),
-        mesh,
-        opts,
-        progress,
-    )
+    let t = std::time::Instant::now();
+    let up = Upload::pinned(mesh, &opts.pin);
+    let prepare = t.elapsed().as_secs_f64();
+    let (out, mut rep) = simplify_upload(ctx, sim, &up, mesh, opts, progress)?;
+    if let Some(r) = rep.rounds.as_mut() {
+        r.prepare_seconds = prepare;
+    }
+    Ok((out, rep))
 }
 
 /// The rounds on a prepared upload (`hybrid` carries its clusters' quadrics in it); `mesh` is
@@ -88,6 +88,7 @@ pub fn simplify_upload(
     let (out, mut rep) = simplify_rounds(&mut rounds, up, mesh, opts, progress, report)?;
     if let Some(r) = rep.rounds.as_mut() {
         r.transfer_seconds = rounds.transfer_seconds;
+        r.wait_seconds = rounds.wait_seconds;
     }
     Ok((out, rep))
 }

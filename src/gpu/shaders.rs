@@ -193,22 +193,13 @@ pub fn source(stage_source: &str) -> String {
     format!("{src}\n{stage_source}")
 }
 
-/// The bindings `shaders/<stage.shader>.wgsl` declares, by binding number: each variable's
-/// name and access. What the schedule's test compares with the stage's description.
-#[cfg(test)]
-pub(crate) fn declared_bindings(
-    stage: &crate::parallel::schedule::Stage,
-) -> std::result::Result<Vec<(String, crate::parallel::schedule::Access)>, String> {
-    shader_bindings(stage.shader)
-}
-
 /// The bindings `shaders/<shader>.wgsl` declares, by binding number: each variable's name and
-/// access. Shared by the rounds' schedule test and the clustering schedule's.
+/// access: what every family's schedule test compares with the stages' descriptions.
 #[cfg(test)]
 pub(crate) fn shader_bindings(
     shader: &str,
-) -> std::result::Result<Vec<(String, crate::parallel::schedule::Access)>, String> {
-    use crate::parallel::schedule::Access;
+) -> std::result::Result<Vec<(String, crate::compute::schedule::Access)>, String> {
+    use crate::compute::schedule::Access;
     let src = stage_source(shader).ok_or("no such shader file")?;
     let module = naga::front::wgsl::parse_str(&source(src)).map_err(|e| e.message().to_string())?;
     let mut vars: Vec<(u32, String, Access)> = Vec::new();

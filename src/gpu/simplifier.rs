@@ -2,11 +2,13 @@
 //! per mesh ([`GpuMesh`] plus the working buffers), and one command buffer per round whose only
 //! read-back is the 64-byte counters block (and the stage timestamps when the device has them).
 
-use super::context::{ErrorSink, checked_buffer, checked_buffer_init};
-use super::shaders::{MAX_STORAGE_BUFFERS, source, stage_source};
+use super::context::{checked_buffer, checked_buffer_init};
+use super::shaders::MAX_STORAGE_BUFFERS;
 use super::types::*;
+use crate::compute::gpu::{ErrorScope, Groups, Pipelines};
+use crate::compute::schedule::Step as S;
 use crate::error::{Error, Result};
-use crate::parallel::schedule::{self, Buf, Count, Stage, Step, When};
+use crate::parallel::schedule::{self, Buf, Count, RoundStep, Stage, Step, When};
 use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
 use std::collections::HashMap;
 use std::time::Instant;
@@ -35,16 +37,14 @@ pub struct GpuSimplifier {
     /// Seconds spent compiling shaders and creating pipelines.
     pub pipeline_seconds: f64,
     timestamps: bool,
-    errors: ErrorSink,
     /// The device's `max_compute_workgroups_per_dimension`, read once.
     max_workgroups: u32,
 }
 
 impl GpuSimplifier {
-    /// Compiles every stage on `device`. Borrows the device: a viewer can share it.
+    /// Compiles every stage on `device` (those another family already made there are taken
+    /// from the device's [`Pipelines`]). Borrows the device: a viewer can share it.
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<GpuSimplifier> {
-        let t = Instant::now();
-        let errors = ErrorSink::install(device);
         let limits = device.limits();
         if limits.max_storage_buffers_per_shader_stage < MAX_STORAGE_BUFFERS {
             return Err(Error::Gpu(format!(
@@ -53,47 +53,19 @@ impl GpuSimplifier {
                 limits.max_storage_buffers_per_shader_stage
             )));
         }
-        let mut modules = HashMap::new();
-        let mut pipelines = HashMap::new();
-        for stage in schedule::STAGES {
-            let module = modules.entry(stage.shader).or_insert_with(|| {
-                let src = stage_source(stage.shader).unwrap_or_default();
-                device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some(stage.shader),
-                    source: wgpu::ShaderSource::Wgsl(source(src).into()),
-                })
-            });
-            let label = format!("meshslim.{}", stage.entry);
-            let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(&label),
-                layout: None,
-                module,
-                entry_point: Some(stage.entry),
-                compilation_options: Default::default(),
-                cache: None,
-            });
-            pipelines.insert(stage.entry, p);
-        }
-        errors.check("creating the compute pipelines")?;
+        let (pipelines, pipeline_seconds) = Pipelines::of(device).get(schedule::STAGES)?;
         Ok(GpuSimplifier {
             device: device.clone(),
             queue: queue.clone(),
             pipelines,
-            pipeline_seconds: t.elapsed().as_secs_f64(),
+            pipeline_seconds,
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
-            errors,
             max_workgroups: limits.max_compute_workgroups_per_dimension,
         })
     }
 
     pub fn has_timestamps(&self) -> bool {
         self.timestamps
-    }
-
-    /// An error the device reported since the last check (it holds the device's one error
-    /// handler, so a renderer on the same device checks its own work here too).
-    pub fn check_errors(&self, doing: &str) -> Result<()> {
-        self.errors.check(doing)
     }
 }
 
@@ -217,23 +189,12 @@ pub struct GpuRounds<'a> {
     carried_quadrics: bool,
     /// Upload and download seconds.
     pub transfer_seconds: f64,
+    /// Seconds from each round's submission to its counters read back.
+    pub wait_seconds: f64,
     /// Submit each pass on its own and wait for it: set when the device also draws a window,
     /// whose frames then come between passes (a round on a 1M-face mesh keeps lavapipe busy
     /// for over a second, which would otherwise be one frame's wait). Off for the command line.
     pub share_queue: bool,
-}
-
-/// How many workgroups a pass runs.
-#[derive(Clone, Copy)]
-enum Groups {
-    Direct(u32),
-    /// From the `dispatch` buffer at this byte offset, written by `dispatch_args`.
-    Indirect(u64),
-}
-
-/// Workgroups for `n` invocations.
-fn wg(n: u32) -> Groups {
-    Groups::Direct(n.div_ceil(WG).max(1))
 }
 
 impl<'a> GpuRounds<'a> {
@@ -245,6 +206,7 @@ impl<'a> GpuRounds<'a> {
     ) -> Result<GpuRounds<'a>> {
         let t = Instant::now();
         let dev = &sim.device;
+        let scope = ErrorScope::push(dev);
         let nv = up.positions.len().max(1) as u64;
         let nf = up.face_count().max(1) as u64;
         let cap = 3 * nf;
@@ -349,6 +311,7 @@ impl<'a> GpuRounds<'a> {
             selection_passes,
             carried_quadrics: up.quadrics.is_some(),
             transfer_seconds: 0.0,
+            wait_seconds: 0.0,
             share_queue: false,
         };
         // Draw arguments for the mesh as uploaded: a renderer can draw it before any round.
@@ -359,7 +322,7 @@ impl<'a> GpuRounds<'a> {
         };
         sim.queue
             .write_buffer(&r.draw_args, 0, bytemuck::bytes_of(&args));
-        sim.errors.check("uploading the mesh")?;
+        scope.check("uploading the mesh")?;
         let mut r = r;
         r.transfer_seconds += t.elapsed().as_secs_f64();
         Ok(r)
@@ -424,27 +387,28 @@ impl<'a> GpuRounds<'a> {
     fn record(&mut self, enc: &mut wgpu::CommandEncoder, p: &Params, steps: &[Step]) {
         for step in steps {
             match *step {
-                Step::Clear(buf) => enc.clear_buffer(self.buffer(buf, None), 0, None),
-                Step::ClearTentative => enc.clear_buffer(&self.counters, TENTATIVE_OFFSET, Some(4)),
-                Step::Run(stage) => self.pass(enc, stage, p, None),
-                Step::PrefixSum { count, data } => {
-                    for stage in [
-                        &schedule::PREFIX_SUM_REDUCE,
-                        &schedule::PREFIX_SUM_SPINE,
-                        &schedule::PREFIX_SUM_APPLY,
-                    ] {
+                S::Clear(buf) => enc.clear_buffer(self.buffer(buf, None), 0, None),
+                S::CopyBuffer(from, to) => {
+                    let (from, to) = (self.buffer(from, None), self.buffer(to, None));
+                    enc.copy_buffer_to_buffer(from, 0, to, 0, from.size().min(to.size()));
+                }
+                S::Own(RoundStep::ClearTentative) => {
+                    enc.clear_buffer(&self.counters, TENTATIVE_OFFSET, Some(4))
+                }
+                S::Run(stage) => self.pass(enc, stage, p, None),
+                S::PrefixSum { count, data } => {
+                    for stage in schedule::PREFIX_SUM {
                         self.pass(enc, stage, p, Some((count, data)));
                     }
                 }
                 // The GPU's winners are checked by the tests against the CPU twin; nothing on
                 // the device writes through unchecked host memory.
-                Step::CheckWinners => {}
+                S::Own(RoundStep::CheckWinners) => {}
             }
         }
     }
 
-    /// One compute pass: `stage` with its bindings in the shader's order, over its grid (split
-    /// over y beyond the per-dimension limit).
+    /// One compute pass of `stage` with its bindings in the shader's order, over its grid.
     fn pass(
         &mut self,
         enc: &mut wgpu::CommandEncoder,
@@ -452,48 +416,21 @@ impl<'a> GpuRounds<'a> {
         p: &Params,
         scan: Option<(Count, Buf)>,
     ) {
-        let entry = stage.entry;
-        let pipeline = &self.sim.pipelines[entry];
-        let layout = pipeline.get_bind_group_layout(0);
-        let entries: Vec<wgpu::BindGroupEntry> = stage
-            .bindings
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: self.buffer(b.buf, scan).as_entire_binding(),
-            })
-            .collect();
-        let bg = self
-            .sim
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(entry),
-                layout: &layout,
-                entries: &entries,
-            });
+        let wg = |n: u32| Groups::Direct(n.div_ceil(WG));
         let groups = match stage.grid {
             schedule::Grid::Each(count) => wg(count.of(p)),
             schedule::Grid::VerticesOrFaces => wg(p.vertex_count.max(p.face_count)),
             schedule::Grid::ScanBlocks => {
                 let n = scan.map_or(p.vertex_count, |(count, _)| count.of(p));
-                Groups::Direct(n.div_ceil(SCAN_BLOCK).max(1))
+                Groups::Direct(n.div_ceil(SCAN_BLOCK))
             }
             schedule::Grid::One => Groups::Direct(1),
             indirect => Groups::Indirect(indirect.indirect_offset().unwrap_or(0)),
         };
-        let max_x = self.sim.max_workgroups;
-        let split = |groups: u32| {
-            if groups <= max_x {
-                (groups, 1)
-            } else {
-                (max_x, groups.div_ceil(max_x))
-            }
-        };
         let qi = self.query_stages.len() as u32 * 2;
-        let timestamp_writes = match &self.queries {
+        let timestamps = match &self.queries {
             Some((set, _)) if qi + 2 <= QUERY_CAP => {
-                self.query_stages.push(entry);
+                self.query_stages.push(stage.entry);
                 Some(wgpu::ComputePassTimestampWrites {
                     query_set: set,
                     beginning_of_pass_write_index: Some(qi),
@@ -502,20 +439,22 @@ impl<'a> GpuRounds<'a> {
             }
             _ => None,
         };
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(entry),
-            timestamp_writes,
-        });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &bg, &[]);
-        match groups {
-            Groups::Direct(groups) => {
-                let (x, y) = split(groups);
-                pass.dispatch_workgroups(x, y, 1);
-            }
-            Groups::Indirect(offset) => pass.dispatch_workgroups_indirect(&self.dispatch, offset),
-        }
-        drop(pass);
+        let buffers: Vec<&wgpu::Buffer> = stage
+            .bindings
+            .iter()
+            .map(|b| self.buffer(b.buf, scan))
+            .collect();
+        crate::compute::gpu::pass(
+            &self.sim.device,
+            enc,
+            stage.entry,
+            &self.sim.pipelines[stage.entry],
+            &buffers,
+            groups,
+            self.sim.max_workgroups,
+            Some(&self.dispatch),
+            timestamps,
+        );
         if self.share_queue {
             // Submit this pass alone and wait for it, so that work others put on the queue
             // meanwhile (the viewer's frames) runs between passes instead of after the round.
@@ -538,6 +477,7 @@ impl<'a> GpuRounds<'a> {
 
     /// The mesh as it stands (after the last round), for a renderer.
     pub fn into_mesh(self, up: &Upload) -> Result<GpuMesh> {
+        let scope = ErrorScope::push(&self.sim.device);
         let h = &self.half[self.cur];
         let (positions, indices) = if self.cur == 0 {
             (h.positions.clone(), h.indices.clone())
@@ -562,6 +502,7 @@ impl<'a> GpuRounds<'a> {
             self.sim.queue.submit([enc.finish()]);
             (h0.positions.clone(), h0.indices.clone())
         };
+        scope.check("keeping the result on the device")?;
         Ok(GpuMesh {
             positions,
             indices,
@@ -576,6 +517,7 @@ impl<'a> GpuRounds<'a> {
     /// round ([`crate::parallel::Driver`] knows them).
     pub fn snapshot(&self, up: &Upload, vertices: usize, faces: usize) -> Result<GpuMesh> {
         let dev = &self.sim.device;
+        let scope = ErrorScope::push(dev);
         let h = &self.half[self.cur];
         let mk = |label: &str, size: u64, usage| checked_buffer(dev, label, size, usage);
         let (pb, ib) = (vertices as u64 * 16, faces as u64 * 12);
@@ -601,7 +543,7 @@ impl<'a> GpuRounds<'a> {
             std::mem::size_of::<DrawArgs>() as u64,
         );
         self.sim.queue.submit([enc.finish()]);
-        self.sim.errors.check("copying a level of detail")?;
+        scope.check("copying a level of detail")?;
         Ok(mesh)
     }
 
@@ -617,6 +559,7 @@ impl<'a> GpuRounds<'a> {
             return Ok(Vec::new());
         }
         let dev = &self.sim.device;
+        let scope = ErrorScope::push(dev);
         let size = bytes.max(4).next_multiple_of(4);
         let staging = dev.create_buffer(&wgpu::BufferDescriptor {
             label: Some("meshslim.download"),
@@ -633,6 +576,7 @@ impl<'a> GpuRounds<'a> {
             .map_err(|e| Error::Gpu(format!("reading back: {e}")))?[..bytes as usize]
             .to_vec();
         staging.unmap();
+        scope.check("reading back")?;
         Ok(data)
     }
 }
@@ -654,6 +598,7 @@ impl RoundRunner for GpuRounds<'_> {
     fn round(&mut self, p: &Params, first: bool, selection: Selection) -> Result<Counters> {
         let sim = self.sim;
         let (q, dev) = (&sim.queue, &sim.device);
+        let scope = ErrorScope::push(dev);
         q.write_buffer(&self.params, 0, bytemuck::bytes_of(p));
         let sp = |n: u32| ScanParams { n, _pad: [0; 3] };
         q.write_buffer(&self.scan_v, 0, bytemuck::bytes_of(&sp(p.vertex_count)));
@@ -666,13 +611,6 @@ impl RoundRunner for GpuRounds<'_> {
         enc.clear_buffer(&self.counters, 0, None);
         for &(when, steps) in schedule::ROUND {
             match when {
-                When::Always => self.record(&mut enc, p, steps),
-                When::FirstRound if first => self.record(&mut enc, p, steps),
-                When::FirstRoundQuadrics if first && !self.carried_quadrics => {
-                    self.record(&mut enc, p, steps)
-                }
-                When::Trimming if p.trim != 0 => self.record(&mut enc, p, steps),
-                When::FirstRound | When::FirstRoundQuadrics | When::Trimming => {}
                 When::EachSelectionPass => {
                     for pass in 0u32.. {
                         match selection {
@@ -700,6 +638,10 @@ impl RoundRunner for GpuRounds<'_> {
                         self.record(&mut enc, p, steps);
                     }
                 }
+                w if w.runs_once(first, self.carried_quadrics, p.trim != 0) => {
+                    self.record(&mut enc, p, steps)
+                }
+                _ => {}
             }
         }
         let (o, counters) = (1 - self.cur, self.counters.clone());
@@ -715,6 +657,7 @@ impl RoundRunner for GpuRounds<'_> {
         q.submit([enc.finish()]);
         map_wait(dev, &self.readback)?;
         let wall = t.elapsed().as_secs_f64();
+        self.wait_seconds += wall;
         let (counters_out, stamps) = {
             let view = self
                 .readback
@@ -727,7 +670,7 @@ impl RoundRunner for GpuRounds<'_> {
             (c, stamps)
         };
         self.readback.unmap();
-        sim.errors.check("running a round")?;
+        scope.check("running a round")?;
         if self.queries.is_some() && !stamps.is_empty() {
             let period = q.get_timestamp_period() as f64 * 1e-9;
             for (i, stage) in self.query_stages.iter().enumerate() {

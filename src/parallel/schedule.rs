@@ -58,22 +58,6 @@ pub enum Buf {
     DrawArgs,
 }
 
-/// How a shader declares a binding.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Access {
-    Uniform,
-    Read,
-    ReadWrite,
-}
-
-/// One binding: the WGSL variable, how it is declared, and the buffer bound to it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Binding {
-    pub var: &'static str,
-    pub access: Access,
-    pub buf: Buf,
-}
-
 /// A count a prefix sum runs over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Count {
@@ -124,51 +108,22 @@ impl Grid {
     }
 }
 
-/// A compute stage: a WGSL entry point in `shaders/<shader>.wgsl`, the twin of the CPU function
-/// of the same name in `src/cpu/`.
-#[derive(Debug, PartialEq, Eq)]
-pub struct Stage {
-    pub entry: &'static str,
-    /// File stem in `shaders/`.
-    pub shader: &'static str,
-    pub bindings: &'static [Binding],
-    pub grid: Grid,
-}
+/// A stage of the rounds: a WGSL entry point in `shaders/<shader>.wgsl`, the twin of the CPU
+/// function of the same name in `src/cpu/`.
+pub type Stage = crate::compute::schedule::Stage<Buf, Grid>;
+pub use crate::compute::schedule::{Access, Binding};
 
-/// `stage!(entry in "shader" over grid; var: access Buf, ...)`: a stage with its bindings in
-/// binding order. A binding's name is the WGSL variable's, its buffer the one the runners bind.
+/// `stage!(entry in "shader" over grid; var: access Buf, ...)`: a stage of the rounds.
 macro_rules! stage {
-    ($entry:ident in $shader:literal over $grid:expr; $($var:ident: $access:ident $buf:ident),* $(,)?) => {
-        Stage {
-            entry: stringify!($entry),
-            shader: $shader,
-            bindings: &[$(Binding { var: stringify!($var), access: Access::$access, buf: Buf::$buf }),*],
-            grid: $grid,
-        }
-    };
+    ($($t:tt)*) => { crate::compute::schedule::stage!(Buf; $($t)*) };
 }
 
 use Count::{EdgeSlots, Faces, Vertices};
-use Grid::{Each, One, PerEdge, PerLive, PerTentative, ScanBlocks, VerticesOrFaces};
+use Grid::{Each, One, PerEdge, PerLive, PerTentative, VerticesOrFaces};
 
-pub const PREFIX_SUM_REDUCE: Stage = stage!(prefix_sum_reduce in "prefix_sum" over ScanBlocks;
-    scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
-pub const PREFIX_SUM_SPINE: Stage = stage!(prefix_sum_spine in "prefix_sum" over One;
-    scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
-pub const PREFIX_SUM_APPLY: Stage = stage!(prefix_sum_apply in "prefix_sum" over ScanBlocks;
-    scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
+// The prefix sum, the vertex→face lists and the face planes: written once for every family.
+crate::compute::schedule::shared_stages!(Stage, Step, Buf, Grid, Count);
 
-pub const ADJACENCY_COUNT: Stage = stage!(adjacency_count in "adjacency_count" over Each(Faces);
-    params: Uniform Params, indices: Read Indices, counts: ReadWrite Offsets);
-pub const ADJACENCY_FILL: Stage = stage!(adjacency_fill in "adjacency_fill" over Each(Faces);
-    params: Uniform Params, indices: Read Indices, offsets: Read Offsets,
-    cursor: ReadWrite Cursor, vertex_faces: ReadWrite VertexFaces);
-pub const ADJACENCY_SORT: Stage = stage!(adjacency_sort in "adjacency_sort" over Each(Vertices);
-    params: Uniform Params, offsets: Read Offsets, vertex_faces: ReadWrite VertexFaces);
-
-pub const FACE_PLANES: Stage = stage!(face_planes in "face_planes" over Each(Faces);
-    params: Uniform Params, positions: Read Positions, indices: Read Indices,
-    face_normals: ReadWrite FaceNormals);
 pub const VERTEX_FLAGS: Stage = stage!(vertex_flags in "vertex_flags" over Each(Vertices);
     params: Uniform Params, indices: Read Indices, offsets: Read Offsets,
     vertex_faces: Read VertexFaces, flags: ReadWrite Flags);
@@ -292,24 +247,18 @@ pub const STAGES: &[&Stage] = &[
     &DRAW_ARGS,
 ];
 
-/// One step of a round.
+/// The rounds' own steps, beside the core's ([`crate::compute::schedule::Step`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Step {
-    /// Zero a buffer (the CPU also sizes it for the round).
-    Clear(Buf),
+pub enum RoundStep {
     /// Zero `Counters::tentative`: the list `select_win` fills is per selection pass.
     ClearTentative,
-    Run(&'static Stage),
-    /// Exclusive prefix sum of `data` over `count` values, the total at index `count`: the three
-    /// `prefix_sum_*` stages with [`Buf::ScanCount`] and [`Buf::ScanData`] bound to these.
-    PrefixSum {
-        count: Count,
-        data: Buf,
-    },
     /// The CPU twin's check that no two winners reach one face, before `collapse` writes through
     /// unsynchronised slices on that promise (`cpu::select::shared_face`); nothing on the GPU.
     CheckWinners,
 }
+
+/// One step of a round.
+pub type Step = crate::compute::schedule::Step<Buf, Grid, Count, RoundStep>;
 
 /// When a part of the round runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -326,20 +275,8 @@ pub enum When {
     Trimming,
 }
 
-use Step::{Clear, PrefixSum, Run};
+use crate::compute::schedule::Step::{Clear, Own, PrefixSum, Run};
 
-/// Vertex→face lists of the current faces (CSR: counts, prefix sum, fill, sort).
-pub const ADJACENCY: &[Step] = &[
-    Clear(Buf::Offsets),
-    Clear(Buf::Cursor),
-    Run(&ADJACENCY_COUNT),
-    PrefixSum {
-        count: Vertices,
-        data: Buf::Offsets,
-    },
-    Run(&ADJACENCY_FILL),
-    Run(&ADJACENCY_SORT),
-];
 /// The first round's set-up.
 pub const SETUP: &[Step] = &[Run(&FACE_PLANES), Run(&VERTEX_FLAGS)];
 /// The input's vertex quadrics.
@@ -366,14 +303,14 @@ pub const UNLOCK: &[Step] = &[Clear(Buf::VertexLock)];
 pub const SELECTION_PASS: &[Step] = &[
     Clear(Buf::FaceBest),
     Clear(Buf::FaceId),
-    Step::ClearTentative,
+    Own(RoundStep::ClearTentative),
     Run(&SELECT_COST),
     Run(&SELECT_ID),
     Run(&SELECT_WIN),
     Run(&DISPATCH_ARGS),
     Run(&VALIDATE),
 ];
-pub const CHECK: &[Step] = &[Step::CheckWinners];
+pub const CHECK: &[Step] = &[Own(RoundStep::CheckWinners)];
 /// Winners beyond the round's budget lose, so the round lands on its target.
 pub const TRIM: &[Step] = &[
     Clear(Buf::TrimHistogram),
@@ -403,6 +340,20 @@ pub const APPLY: &[Step] = &[
     Run(&DRAW_ARGS),
 ];
 
+impl When {
+    /// Whether a part runs once in this round: `first` round, quadrics `carried` in, the round
+    /// `trimming`. [`When::EachSelectionPass`] is the runner's to repeat, and says no here.
+    pub fn runs_once(self, first: bool, carried: bool, trimming: bool) -> bool {
+        match self {
+            When::Always => true,
+            When::FirstRound => first,
+            When::FirstRoundQuadrics => first && !carried,
+            When::Trimming => trimming,
+            When::EachSelectionPass => false,
+        }
+    }
+}
+
 /// A round, in order (after the counters are zeroed); the halves swap after it.
 pub const ROUND: &[(When, &[Step])] = &[
     (When::Always, ADJACENCY),
@@ -419,127 +370,27 @@ pub const ROUND: &[(When, &[Step])] = &[
     (When::Always, APPLY),
 ];
 
-/// Test helpers both schedules' binding tests share (the rounds' here, the clustering's in
-/// `cluster::gpu_schedule`).
+/// The rounds' schedule against its WGSL, with the checks every family passes
+/// (`compute::tests`); a binding's variable names its buffer (`Buf::EdgeState` is `edge_state`)
+/// but for the few a stage calls by its own role, listed here.
 #[cfg(test)]
-pub(crate) mod check {
-    use super::Access;
-
-    /// Whether bindings come in the house order: uniform params, then read-only, then
-    /// read_write.
-    pub fn in_house_order(bindings: &[(String, Access)]) -> bool {
-        let rank = |a: Access| match a {
-            Access::Uniform => 0,
-            Access::Read => 1,
-            Access::ReadWrite => 2,
-        };
-        bindings.windows(2).all(|w| rank(w[0].1) <= rank(w[1].1))
-    }
-
-    /// A buffer enum's variant as the variable that binds it: `EdgeState` is `edge_state`.
-    pub fn snake_case(variant: impl std::fmt::Debug) -> String {
-        let mut out = String::new();
-        for (i, c) in format!("{variant:?}").chars().enumerate() {
-            if c.is_ascii_uppercase() && i > 0 {
-                out.push('_');
-            }
-            out.push(c.to_ascii_lowercase());
-        }
-        out
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::check::{in_house_order, snake_case};
-    use super::*;
-
-    /// Every stage's declared bindings against its shader, as naga reads it: the same variables
-    /// in the same binding order with the same access; and in the house order (uniform params,
-    /// then read-only, then read_write), so a reader finds a stage's outputs at its end.
-    #[test]
-    fn every_stage_binds_what_its_shader_declares() {
-        for stage in STAGES {
-            let declared = crate::gpu::shaders::declared_bindings(stage)
-                .unwrap_or_else(|e| panic!("{}: {e}", stage.entry));
-            let described: Vec<(String, Access)> = stage
-                .bindings
-                .iter()
-                .map(|b| (b.var.to_string(), b.access))
-                .collect();
-            assert_eq!(
-                described, declared,
-                "{}: the schedule's bindings against shaders/{}.wgsl",
-                stage.entry, stage.shader
-            );
-            assert!(
-                in_house_order(&described),
-                "{}: bindings not in the order params, read-only, read_write: {described:?}",
-                stage.entry
-            );
-        }
-    }
-
-    /// A binding's variable names its buffer (`Buf::EdgeState` is `edge_state`) but for the
-    /// few a stage calls by its own role, listed here: so `edges: Read Live` in a description,
-    /// the right name on the wrong buffer, fails too.
-    #[test]
-    fn every_binding_names_its_buffer() {
-        const ROLES: &[(&str, Buf)] = &[
-            ("counts", Buf::Offsets),
-            ("edge_counts", Buf::EdgeOffsets),
-            ("args", Buf::Dispatch),
-            ("draw", Buf::DrawArgs),
-            ("histogram", Buf::TrimHistogram),
-            ("scan", Buf::ScanCount),
-            ("data", Buf::ScanData),
-        ];
-
-        for s in STAGES {
-            for b in s.bindings {
-                assert!(
-                    b.var == snake_case(b.buf) || ROLES.contains(&(b.var, b.buf)),
-                    "{}: binding `{}` takes {:?}",
-                    s.entry,
-                    b.var,
-                    b.buf
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn every_stage_is_listed_once_and_runs_in_the_round() {
-        for (i, s) in STAGES.iter().enumerate() {
-            assert!(
-                STAGES[..i].iter().all(|t| t.entry != s.entry),
-                "{} listed twice",
-                s.entry
-            );
-            let runs = ROUND.iter().any(|(_, steps)| {
-                steps.iter().any(|step| match step {
-                    Step::Run(t) => t.entry == s.entry,
-                    Step::PrefixSum { .. } => s.shader == "prefix_sum",
-                    _ => false,
-                })
-            });
-            assert!(runs, "{} never runs in ROUND", s.entry);
-        }
-    }
-
-    /// A buffer may go by a stage's own name (`offsets` is `counts` in adjacency_count), but no
-    /// stage binds one buffer twice: WGSL would alias a read_write binding.
-    #[test]
-    fn no_stage_binds_a_buffer_twice() {
-        for s in STAGES {
-            for (i, b) in s.bindings.iter().enumerate() {
-                assert!(
-                    s.bindings[..i].iter().all(|c| c.buf != b.buf),
-                    "{} binds {:?} twice",
-                    s.entry,
-                    b.buf
-                );
-            }
-        }
-    }
+pub(crate) fn check_schedule() {
+    const ROLES: &[(&str, Buf)] = &[
+        ("counts", Buf::Offsets),
+        ("edge_counts", Buf::EdgeOffsets),
+        ("args", Buf::Dispatch),
+        ("draw", Buf::DrawArgs),
+        ("histogram", Buf::TrimHistogram),
+        ("scan", Buf::ScanCount),
+        ("data", Buf::ScanData),
+    ];
+    crate::compute::schedule::check::family("rounds", STAGES, ROLES, |s| {
+        ROUND.iter().any(|(_, steps)| {
+            steps.iter().any(|step| match step {
+                Run(t) => t.entry == s.entry,
+                PrefixSum { .. } => PREFIX_SUM.iter().any(|p| p.entry == s.entry),
+                _ => false,
+            })
+        })
+    });
 }

@@ -115,6 +115,7 @@ pub fn screenshot_with(
     // The normalized frame: centred, bounding-box diagonal 1, so a sphere of radius 0.5 holds it.
     cam.fit(glam::Vec3::ZERO, 0.5, size.0 as f32 / size.1 as f32);
     let items = [(&scene, cam.model)];
+    let scope = crate::compute::gpu::ErrorScope::push(&ctx.device);
     let rgba = render::render_rgba(
         &ctx.device,
         &ctx.queue,
@@ -124,8 +125,7 @@ pub fn screenshot_with(
         &style,
         size,
     )?;
-    // The device's one error handler is the simplifier's: a refused draw shows up there.
-    sim.check_errors("rendering the frame")?;
+    scope.check("rendering the frame")?;
     Ok(Frame {
         adapter: ctx.adapter_name.clone(),
         faces,

@@ -140,6 +140,8 @@ impl ViewerApp {
             vec![main]
         };
         let lod_levels = self.lod.take();
+        // A refused draw becomes the status line, not a panic in wgpu's default handler.
+        let scope = crate::compute::gpu::ErrorScope::push(&self.gpu.device);
         for (k, mesh) in shown.iter().enumerate() {
             let items: Vec<(&SceneMesh, Mat4)> = match (&lod_levels, lod) {
                 (Some(levels), true) => self.lod_items(levels),
@@ -166,9 +168,7 @@ impl ViewerApp {
             self.gpu.queue.submit([enc.finish()]);
         }
         self.lod = lod_levels;
-        if let Some(sim) = &self.gpu.sim
-            && let Err(e) = sim.check_errors("drawing the view")
-        {
+        if let Err(e) = scope.check("drawing the view") {
             self.status = e.to_string();
         }
     }

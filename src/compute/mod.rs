@@ -1,0 +1,23 @@
+//! The compute core every GPU family shares (house rules 1, 2, 4 and 10 of the architecture,
+//! summed up in docs/DESIGN.md): the vocabulary a family's schedule is written in ([`schedule`]: stages
+//! described by their bindings, steps, the stages every family runs written once), and on the
+//! device ([`gpu`]) one pipeline cache per device, one error capture and one pass recorder.
+//!
+//! A family — the QEM rounds (`crate::parallel::schedule`, run by `crate::gpu` and twinned in
+//! `crate::cpu`) and the clustering (`crate::cluster::gpu_schedule`) — owns its buffer, count
+//! and grid enums, its stages and parts, and the runner glue that binds its buffers; the
+//! recorder and the caches here do the rest.
+
+pub mod gpu;
+pub mod schedule;
+
+#[cfg(test)]
+mod tests {
+    /// Every family's schedule against its WGSL through naga, with the same checks: what a
+    /// family adds runs through this one test.
+    #[test]
+    fn every_family_binds_what_its_shaders_declare() {
+        crate::parallel::schedule::check_schedule();
+        crate::cluster::gpu_schedule::check_schedule();
+    }
+}
