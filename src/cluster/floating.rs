@@ -37,7 +37,7 @@ pub fn grades(positions: &[[f32; 4]], faces: &[[u32; 3]], csr: &Csr) -> Vec<f32>
 /// Low & Tan's grade of `v`, whose faces are `list`: `cos(θ/2)` for the widest angle θ between
 /// two edges at the vertex (a flat or straight-through vertex has θ near 180° and grades near
 /// 0, a tip or a crease corner grades high), times the longest edge there (a vertex among large
-/// faces stands for more surface). `dirs` is scratch. The twin of shaders/fc_grades.wgsl, which
+/// faces stands for more surface). `dirs` is scratch. The twin of shaders/cluster/fc_grades.wgsl, which
 /// recomputes each direction per pair instead of keeping the list (the same values; min and
 /// max do not depend on the order).
 pub fn grade(
@@ -94,7 +94,7 @@ pub fn rank(g: f32, v: u32) -> u64 {
 }
 
 /// A vertex no centre has claimed yet (`fc_centre`). Keep in sync with `UNCLAIMED` in
-/// shaders/cluster.wgsl.
+/// shaders/cluster/cluster.inc.wgsl.
 pub const UNCLAIMED: u32 = u32::MAX;
 
 /// Centres' radii spread over ±[`JITTER`]/2 about the nominal radius, by a hash of the centre:

@@ -8,8 +8,7 @@
 use crate::cluster::gpu_schedule::{self as sched, CBuf, CCount, CGrid, CStage, CStep};
 use crate::cluster::grid::Grid;
 use crate::cluster::twins::{self, ClusterBuild};
-use crate::compute::gpu::{ErrorScope, Groups, Pipelines};
-use crate::compute::schedule::Step as S;
+use crate::compute::gpu::{ErrorScope, Groups, Pipelines, Runner};
 use crate::error::{Error, Result};
 use crate::gpu::GpuMesh;
 use crate::gpu::context::{checked_buffer, checked_buffer_init};
@@ -420,45 +419,8 @@ impl<'a> GpuClusterMesh<'a> {
         })
     }
 
-    /// The buffer bound for `buf`; `scan` is the prefix sum's (count, data) when one runs.
-    fn buffer(&self, buf: CBuf, scan: Option<(CCount, CBuf)>) -> &wgpu::Buffer {
-        match buf {
-            CBuf::SortKeys => &self.halves[self.cur][0],
-            CBuf::SortVals => &self.halves[self.cur][1],
-            CBuf::SortKeysOut => &self.halves[1 - self.cur][0],
-            CBuf::SortValsOut => &self.halves[1 - self.cur][1],
-            CBuf::Radix => &self.radix[self.pass],
-            CBuf::Floating => &self.floats[self.slot],
-            CBuf::ScanCount => match scan.map(|s| s.0) {
-                Some(CCount::Faces) => &self.scans[1],
-                Some(CCount::Digits) => &self.scans[2],
-                _ => &self.scans[0],
-            },
-            CBuf::ScanData => {
-                let data = scan.map_or(CBuf::CellHead, |s| s.1);
-                &self.bufs[&data]
-            }
-            other => &self.bufs[&other],
-        }
-    }
-
     pub(super) fn record(&mut self, enc: &mut wgpu::CommandEncoder, steps: &[CStep]) {
-        for step in steps {
-            match *step {
-                S::Clear(buf) => enc.clear_buffer(self.buffer(buf, None), 0, None),
-                S::CopyBuffer(from, to) => {
-                    let (from, to) = (self.buffer(from, None), self.buffer(to, None));
-                    enc.copy_buffer_to_buffer(from, 0, to, 0, from.size().min(to.size()));
-                }
-                S::Run(stage) => self.dispatch(enc, stage, None),
-                S::PrefixSum { count, data } => {
-                    for stage in sched::PREFIX_SUM {
-                        self.dispatch(enc, stage, Some((count, data)));
-                    }
-                }
-                S::Own(never) => match never {},
-            }
-        }
+        crate::compute::gpu::record(self, enc, steps)
     }
 
     fn count(&self, c: CCount) -> u32 {
@@ -467,37 +429,6 @@ impl<'a> GpuClusterMesh<'a> {
             CCount::Faces => self.nf as u32,
             CCount::Digits => 256 * (self.nv as u32).div_ceil(SORT_BLOCK),
         }
-    }
-
-    /// One compute pass of `stage` over its grid.
-    fn dispatch(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        stage: &'static CStage,
-        scan: Option<(CCount, CBuf)>,
-    ) {
-        let groups = match stage.grid {
-            CGrid::Each(c) => self.count(c).div_ceil(WG),
-            CGrid::SortBlocks => (self.nv as u32).div_ceil(SORT_BLOCK),
-            CGrid::ScanBlocks => scan.map_or(0, |s| self.count(s.0)).div_ceil(SCAN_BLOCK),
-            CGrid::One => 1,
-        };
-        let buffers: Vec<&wgpu::Buffer> = stage
-            .bindings
-            .iter()
-            .map(|b| self.buffer(b.buf, scan))
-            .collect();
-        crate::compute::gpu::pass(
-            &self.sim.device,
-            enc,
-            stage.entry,
-            &self.sim.pipelines[stage.entry],
-            &buffers,
-            Groups::Direct(groups),
-            self.sim.max_workgroups,
-            None,
-            None,
-        );
     }
 
     /// The first `bytes` of a working buffer as the schedule names it (the sort's names as the
@@ -546,5 +477,65 @@ impl<'a> GpuClusterMesh<'a> {
         drop(view);
         staging.unmap();
         Ok(out)
+    }
+}
+
+impl crate::compute::gpu::Runner<CBuf, CGrid, CCount, std::convert::Infallible>
+    for GpuClusterMesh<'_>
+{
+    /// The buffer bound for `buf`; `scan` is the prefix sum's (count, data) when one runs.
+    fn buffer(&self, buf: CBuf, scan: Option<(CCount, CBuf)>) -> &wgpu::Buffer {
+        match buf {
+            CBuf::SortKeys => &self.halves[self.cur][0],
+            CBuf::SortVals => &self.halves[self.cur][1],
+            CBuf::SortKeysOut => &self.halves[1 - self.cur][0],
+            CBuf::SortValsOut => &self.halves[1 - self.cur][1],
+            CBuf::Radix => &self.radix[self.pass],
+            CBuf::Floating => &self.floats[self.slot],
+            CBuf::ScanCount => match scan.map(|s| s.0) {
+                Some(CCount::Faces) => &self.scans[1],
+                Some(CCount::Digits) => &self.scans[2],
+                _ => &self.scans[0],
+            },
+            CBuf::ScanData => {
+                let data = scan.map_or(CBuf::CellHead, |s| s.1);
+                &self.bufs[&data]
+            }
+            other => &self.bufs[&other],
+        }
+    }
+
+    /// One compute pass of `stage` over its grid.
+    fn run(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        stage: &'static CStage,
+        scan: Option<(CCount, CBuf)>,
+    ) {
+        let groups = match stage.grid {
+            CGrid::Each(c) => self.count(c).div_ceil(WG),
+            CGrid::SortBlocks => (self.nv as u32).div_ceil(SORT_BLOCK),
+            CGrid::ScanBlocks => scan.map_or(0, |s| self.count(s.0)).div_ceil(SCAN_BLOCK),
+            CGrid::One => 1,
+        };
+        crate::compute::gpu::pass(
+            &self.sim.device,
+            enc,
+            &self.sim.pipelines,
+            stage,
+            |b| self.buffer(b, scan),
+            Groups::Direct(groups),
+            self.sim.max_workgroups,
+            None,
+            None,
+        );
+    }
+
+    fn own(&mut self, _: &mut wgpu::CommandEncoder, step: std::convert::Infallible) {
+        match step {}
+    }
+
+    fn prefix_sum(&self) -> [&'static CStage; 3] {
+        sched::PREFIX_SUM
     }
 }

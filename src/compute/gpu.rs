@@ -3,7 +3,7 @@
 //! recorder of a stage's compute pass (bind group from its description, workgroups split over y
 //! beyond the device's per-dimension limit, timestamps when asked).
 
-use super::schedule::Stage;
+use super::schedule::{Stage, Step};
 use crate::error::{Error, Result};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, Weak};
@@ -56,11 +56,11 @@ impl Pipelines {
             .collect();
         for stage in missing {
             let module = modules.entry(stage.shader).or_insert_with(|| {
-                let src = crate::gpu::shaders::stage_source(stage.shader).unwrap_or_default();
+                let src = super::shaders::stage_source(stage.shader).unwrap_or_default();
                 self.device
                     .create_shader_module(wgpu::ShaderModuleDescriptor {
                         label: Some(stage.shader),
-                        source: wgpu::ShaderSource::Wgsl(crate::gpu::shaders::source(src).into()),
+                        source: wgpu::ShaderSource::Wgsl(src.into()),
                     })
             });
             let label = format!("meshslim.{}", stage.entry);
@@ -126,28 +126,73 @@ pub enum Groups {
     Indirect(u64),
 }
 
-/// One compute pass: `pipeline` with `buffers` bound in binding order, over `groups` (a direct
-/// count beyond `max_x` is split over y; the shader folds y back into its index), with
-/// `timestamps` when given; `indirect` holds the arguments of an indirect grid.
+/// What a family's GPU runner gives the step interpreter ([`record`]): its buffers, its passes
+/// and its own steps.
+pub trait Runner<B: Copy + 'static, G: 'static, C: Copy, X: Copy> {
+    /// The buffer bound for `buf`; `scan` is the prefix sum's (count, data) when one runs.
+    fn buffer(&self, buf: B, scan: Option<(C, B)>) -> &wgpu::Buffer;
+    /// One compute pass of `stage` (`scan` as for [`Runner::buffer`]).
+    fn run(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        stage: &'static Stage<B, G>,
+        scan: Option<(C, B)>,
+    );
+    /// The family's own step.
+    fn own(&mut self, enc: &mut wgpu::CommandEncoder, step: X);
+    /// The three passes of the family's prefix sum (`shared_stages!`'s `PREFIX_SUM`).
+    fn prefix_sum(&self) -> [&'static Stage<B, G>; 3];
+}
+
+/// Records a family's `steps` into `enc`: the one interpreter of the steps on the GPU.
+pub fn record<B: Copy + 'static, G: 'static, C: Copy, X: Copy>(
+    runner: &mut impl Runner<B, G, C, X>,
+    enc: &mut wgpu::CommandEncoder,
+    steps: &[Step<B, G, C, X>],
+) {
+    for step in steps {
+        match *step {
+            Step::Clear(buf) => enc.clear_buffer(runner.buffer(buf, None), 0, None),
+            Step::CopyBuffer(from, to) => {
+                let (from, to) = (runner.buffer(from, None), runner.buffer(to, None));
+                enc.copy_buffer_to_buffer(from, 0, to, 0, from.size().min(to.size()));
+            }
+            Step::Run(stage) => runner.run(enc, stage, None),
+            Step::PrefixSum { count, data } => {
+                for stage in runner.prefix_sum() {
+                    runner.run(enc, stage, Some((count, data)));
+                }
+            }
+            Step::Own(x) => runner.own(enc, x),
+        }
+    }
+}
+
+/// One compute pass of `stage`: its pipeline from `pipelines`, each binding's buffer from
+/// `bind` in binding order, over `groups` (a direct count beyond `max_x` is split over y; the
+/// shader folds y back into its index), with `timestamps` when given; `indirect` holds the
+/// arguments of an indirect grid.
 #[allow(clippy::too_many_arguments)]
-pub fn pass(
+pub fn pass<'b, B: Copy, G>(
     device: &wgpu::Device,
     enc: &mut wgpu::CommandEncoder,
-    label: &str,
-    pipeline: &wgpu::ComputePipeline,
-    buffers: &[&wgpu::Buffer],
+    pipelines: &HashMap<&'static str, wgpu::ComputePipeline>,
+    stage: &Stage<B, G>,
+    bind: impl Fn(B) -> &'b wgpu::Buffer,
     groups: Groups,
     max_x: u32,
     indirect: Option<&wgpu::Buffer>,
     timestamps: Option<wgpu::ComputePassTimestampWrites>,
 ) {
+    let (label, pipeline) = (stage.entry, &pipelines[stage.entry]);
     let layout = pipeline.get_bind_group_layout(0);
-    let entries: Vec<wgpu::BindGroupEntry> = buffers
+    let entries: Vec<wgpu::BindGroupEntry> = stage
+        .bindings
         .iter()
         .enumerate()
         .map(|(i, b)| wgpu::BindGroupEntry {
             binding: i as u32,
-            resource: b.as_entire_binding(),
+            resource: bind(b.buf).as_entire_binding(),
         })
         .collect();
     let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {

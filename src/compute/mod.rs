@@ -10,6 +10,7 @@
 
 pub mod gpu;
 pub mod schedule;
+pub(crate) mod shaders;
 
 #[cfg(test)]
 mod tests {

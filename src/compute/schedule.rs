@@ -104,29 +104,29 @@ pub use crate::stage;
 macro_rules! shared_stages {
     ($stage:ty, $step:ty, $b:ident, $g:ident, $c:ident) => {
         pub const PREFIX_SUM_REDUCE: $stage = $crate::compute::schedule::stage!($b;
-            prefix_sum_reduce in "prefix_sum" over $g::ScanBlocks;
+            prefix_sum_reduce in "core/prefix_sum" over $g::ScanBlocks;
             scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
         pub const PREFIX_SUM_SPINE: $stage = $crate::compute::schedule::stage!($b;
-            prefix_sum_spine in "prefix_sum" over $g::One;
+            prefix_sum_spine in "core/prefix_sum" over $g::One;
             scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
         pub const PREFIX_SUM_APPLY: $stage = $crate::compute::schedule::stage!($b;
-            prefix_sum_apply in "prefix_sum" over $g::ScanBlocks;
+            prefix_sum_apply in "core/prefix_sum" over $g::ScanBlocks;
             scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
         /// The three passes of a prefix sum, in order.
         pub const PREFIX_SUM: [&$stage; 3] = [&PREFIX_SUM_REDUCE, &PREFIX_SUM_SPINE, &PREFIX_SUM_APPLY];
 
         pub const ADJACENCY_COUNT: $stage = $crate::compute::schedule::stage!($b;
-            adjacency_count in "adjacency_count" over $g::Each($c::Faces);
+            adjacency_count in "core/adjacency_count" over $g::Each($c::Faces);
             params: Uniform Params, indices: Read Indices, counts: ReadWrite Offsets);
         pub const ADJACENCY_FILL: $stage = $crate::compute::schedule::stage!($b;
-            adjacency_fill in "adjacency_fill" over $g::Each($c::Faces);
+            adjacency_fill in "core/adjacency_fill" over $g::Each($c::Faces);
             params: Uniform Params, indices: Read Indices, offsets: Read Offsets,
             cursor: ReadWrite Cursor, vertex_faces: ReadWrite VertexFaces);
         pub const ADJACENCY_SORT: $stage = $crate::compute::schedule::stage!($b;
-            adjacency_sort in "adjacency_sort" over $g::Each($c::Vertices);
+            adjacency_sort in "core/adjacency_sort" over $g::Each($c::Vertices);
             params: Uniform Params, offsets: Read Offsets, vertex_faces: ReadWrite VertexFaces);
         pub const FACE_PLANES: $stage = $crate::compute::schedule::stage!($b;
-            face_planes in "face_planes" over $g::Each($c::Faces);
+            face_planes in "core/face_planes" over $g::Each($c::Faces);
             params: Uniform Params, positions: Read Positions, indices: Read Indices,
             face_normals: ReadWrite FaceNormals);
 
@@ -150,7 +150,49 @@ pub use crate::shared_stages;
 /// (`compute::tests`).
 #[cfg(test)]
 pub(crate) mod check {
-    use super::{Access, Stage};
+    use super::{Access, Stage, Step};
+
+    /// The bindings `shaders/<shader>.wgsl` declares, by binding number: each variable's name and
+    /// access: what every family's schedule test compares with the stages' descriptions.
+    pub fn shader_bindings(shader: &str) -> std::result::Result<Vec<(String, Access)>, String> {
+        let src = crate::compute::shaders::stage_source(shader).ok_or("no such shader file")?;
+        let module = naga::front::wgsl::parse_str(&src).map_err(|e| e.message().to_string())?;
+        let mut vars: Vec<(u32, String, Access)> = Vec::new();
+        for (_, v) in module.global_variables.iter() {
+            let Some(binding) = &v.binding else { continue };
+            if binding.group != 0 {
+                return Err(format!(
+                    "binding group {} (the rounds use group 0)",
+                    binding.group
+                ));
+            }
+            let access = match v.space {
+                naga::AddressSpace::Uniform => Access::Uniform,
+                naga::AddressSpace::Storage { access }
+                    if access.contains(naga::StorageAccess::STORE) =>
+                {
+                    Access::ReadWrite
+                }
+                naga::AddressSpace::Storage { .. } => Access::Read,
+                ref other => return Err(format!("a binding in address space {other:?}")),
+            };
+            vars.push((binding.binding, v.name.clone().unwrap_or_default(), access));
+        }
+        vars.sort_by_key(|v| v.0);
+        for (i, v) in vars.iter().enumerate() {
+            if v.0 != i as u32 {
+                return Err(format!(
+                    "bindings not numbered 0..{}: {:?}",
+                    vars.len(),
+                    vars
+                ));
+            }
+        }
+        Ok(vars
+            .into_iter()
+            .map(|(_, name, access)| (name, access))
+            .collect())
+    }
 
     /// Whether bindings come in the house order: uniform params, then read-only, then
     /// read_write.
@@ -179,15 +221,23 @@ pub(crate) mod check {
     /// same binding order with the same access, in the house order); each binding named after
     /// its buffer but for the `roles` a stage calls by a name of its own; each stage listed once
     /// and binding no buffer twice (WGSL would alias a read_write binding); and each running in
-    /// some part (`runs`).
-    pub fn family<B: Copy + PartialEq + std::fmt::Debug, G>(
+    /// one of the family's `parts`.
+    pub fn family<B: Copy + PartialEq + std::fmt::Debug, G, C, X>(
         family: &str,
         stages: &[&Stage<B, G>],
         roles: &[(&str, B)],
-        runs: impl Fn(&Stage<B, G>) -> bool,
+        parts: &[&[Step<B, G, C, X>]],
     ) {
+        // A stage runs when a part names it, or, for the prefix sum's, when a part scans.
+        let runs = |s: &Stage<B, G>| {
+            parts.iter().flat_map(|p| p.iter()).any(|step| match step {
+                Step::Run(t) => t.entry == s.entry,
+                Step::PrefixSum { .. } => s.shader == "core/prefix_sum",
+                _ => false,
+            })
+        };
         for (i, stage) in stages.iter().enumerate() {
-            let declared = crate::gpu::shaders::shader_bindings(stage.shader)
+            let declared = shader_bindings(stage.shader)
                 .unwrap_or_else(|e| panic!("{family}: {}: {e}", stage.entry));
             let described: Vec<(String, Access)> = stage
                 .bindings

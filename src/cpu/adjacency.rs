@@ -1,4 +1,4 @@
-//! Twins of shaders/adjacency_count.wgsl, adjacency_fill.wgsl and adjacency_sort.wgsl: the
+//! Twins of shaders/core/adjacency_count.wgsl, adjacency_fill.wgsl and adjacency_sort.wgsl: the
 //! vertex→face lists (CSR) of the current faces, built by counting, a prefix sum and a scatter.
 //! The scatter's order depends on thread timing, so each list is then sorted: the lists, and
 //! everything gathered from them, are the same on every run and on CPU and GPU.

@@ -1,4 +1,4 @@
-//! Twin of shaders/collapse.wgsl: each winner moves its survivor to the new position, gives it
+//! Twin of shaders/rounds/collapse.wgsl: each winner moves its survivor to the new position, gives it
 //! the sum of both quadrics (re-centred on the new position) and the removed vertex's border
 //! bit, and points the removed vertex at the survivor; when the survivor is a seam vertex, the
 //! removed vertex's corners take their attribute vertices by the seam rule `edge_errors`

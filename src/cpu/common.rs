@@ -1,4 +1,4 @@
-//! Quadric and triangle math in f32, the twin of the functions in shaders/common.wgsl: the same
+//! Quadric and triangle math in f32, the twin of the functions in shaders/common.inc.wgsl: the same
 //! operations in the same order, so CPU and GPU floats agree to rounding (the GPU may fuse
 //! multiply-adds).
 

@@ -1,4 +1,4 @@
-//! Twins of shaders/compact_mark.wgsl, compact_vertices.wgsl, compact_faces.wgsl and
+//! Twins of shaders/rounds/compact_mark.wgsl, compact_vertices.wgsl, compact_faces.wgsl and
 //! draw_args.wgsl: removed vertices and faces that lost a corner are dropped by prefix-sum
 //! compaction, the faces renumbered to the surviving vertices' new ids, and the indirect draw
 //! arguments and counts written for the next round and for a renderer.

@@ -1,4 +1,4 @@
-//! Twin of shaders/cost_ceiling.wgsl (one invocation): the ceiling below which candidates
+//! Twin of shaders/rounds/cost_ceiling.wgsl (one invocation): the ceiling below which candidates
 //! compete this round, the smallest histogram bin boundary under which at least
 //! `ceiling_wanted` candidates lie. Keeps each round's collapses among the cheapest edges, so
 //! the order stays close to the greedy one.

@@ -1,4 +1,4 @@
-//! Twin of shaders/dispatch_args.wgsl: the indirect dispatch sizes of the per-edge stages, of
+//! Twin of shaders/rounds/dispatch_args.wgsl: the indirect dispatch sizes of the per-edge stages, of
 //! `validate` and of the per-candidate stages. The CPU runs loops of the exact length; this twin exists so tests can diff the GPU
 //! stage.
 

@@ -1,4 +1,4 @@
-//! Twin of shaders/edge_costs.wgsl: for the candidates whose error (`edge_errors`) is under the
+//! Twin of shaders/rounds/edge_costs.wgsl: for the candidates whose error (`edge_errors`) is under the
 //! round's cost ceiling, the faces that move: no normal may turn past the angle limit (against
 //! the current and the input normal), no needle may appear, and the worst new quality scales
 //! the error up to the priority the selection ranks by (MeshLab-style). The ceiling picks the

@@ -1,4 +1,4 @@
-//! Twin of shaders/edge_errors.wgsl: per edge, where the collapse would put the survivor and
+//! Twin of shaders/rounds/edge_errors.wgsl: per edge, where the collapse would put the survivor and
 //! its quadric error, and the histogram of errors `cost_ceiling` picks the round's ceiling
 //! from. The error is the cheap half of an edge's evaluation (a quadric solve on the two
 //! endpoints); the faces that move are the costly half, and `edge_costs` checks them only for

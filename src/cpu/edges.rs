@@ -1,4 +1,4 @@
-//! Twins of shaders/edges_count.wgsl and edges_fill.wgsl: the unique edges (a, b), a < b, of
+//! Twins of shaders/rounds/edges_count.wgsl and edges_fill.wgsl: the unique edges (a, b), a < b, of
 //! the current faces. Each vertex lists its higher-id neighbours in the order of its sorted face
 //! list (first occurrence), so edge ids are the same on every run and on CPU and GPU.
 //! `edges_count` enumerates them once into two slots per corner of the vertex's list (a face adds

@@ -1,4 +1,4 @@
-//! Twin of shaders/face_planes.wgsl: each face's unit normal and area (first round only). The
+//! Twin of shaders/core/face_planes.wgsl: each face's unit normal and area (first round only). The
 //! normal stays with the face as its reference for the flip test; the area weights its quadric.
 
 use super::common::{cross, length, scale, sub, xyz};

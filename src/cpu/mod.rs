@@ -75,7 +75,7 @@ pub fn face_of(indices: &[u32], f: u32) -> [u32; 3] {
     [indices[i], indices[i + 1], indices[i + 2]]
 }
 
-/// Which corner of face `f` is on vertex `v` (the last when none), as shaders/seams.wgsl's
+/// Which corner of face `f` is on vertex `v` (the last when none), as shaders/rounds/seams.inc.wgsl's
 /// `corner_attr` picks it.
 #[inline]
 pub fn corner_on(indices: &[u32], f: u32, v: u32) -> usize {
@@ -85,7 +85,7 @@ pub fn corner_on(indices: &[u32], f: u32, v: u32) -> usize {
         .unwrap_or(2)
 }
 
-/// Twin of shaders/seams.wgsl's `corner_attr`: the attribute vertex face `f` uses at its corner
+/// Twin of shaders/rounds/seams.inc.wgsl's `corner_attr`: the attribute vertex face `f` uses at its corner
 /// on vertex `v`.
 #[inline]
 pub fn corner_attr(indices: &[u32], face_extra: &[FaceExtra], f: u32, v: u32) -> u32 {

@@ -1,4 +1,4 @@
-//! Twin of shaders/prefix_sum.wgsl: exclusive prefix sum of `n` u32 values in place, the total
+//! Twin of shaders/core/prefix_sum.wgsl: exclusive prefix sum of `n` u32 values in place, the total
 //! written at index `n`, in three stages — per-block sums, a scan of the block sums, and each
 //! block's local scan plus its offset. Integer results equal the GPU's exactly.
 

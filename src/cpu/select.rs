@@ -1,4 +1,4 @@
-//! Twins of shaders/select_cost.wgsl, select_id.wgsl and select_win.wgsl: one pass of the
+//! Twins of shaders/rounds/select_cost.wgsl, select_id.wgsl and select_win.wgsl: one pass of the
 //! independent-set selection, one invocation per candidate on the live list. An edge wins when its key (cost bits, then edge id) is the
 //! smallest over every candidate touching any face around either endpoint: 32-bit atomicMax of
 //! inverted keys per face, first on the cost, then on a hash of the id among equal costs (64-bit atomics

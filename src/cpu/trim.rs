@@ -1,4 +1,4 @@
-//! Twins of shaders/trim_histogram.wgsl, trim_ceiling.wgsl, trim_mark.wgsl and trim_apply.wgsl:
+//! Twins of shaders/rounds/trim_histogram.wgsl, trim_ceiling.wgsl, trim_mark.wgsl and trim_apply.wgsl:
 //! in a round that would overshoot the target, the winners are cut back cheapest first so the
 //! face count lands on the target or one below it (a collapse removes one or two faces: the last
 //! winner kept may take two where one was left), never above, as the greedy reference does. Bins

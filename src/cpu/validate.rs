@@ -1,4 +1,4 @@
-//! Twin of shaders/validate.wgsl: the edges a selection pass picked (TENTATIVE) get the
+//! Twin of shaders/rounds/validate.wgsl: the edges a selection pass picked (TENTATIVE) get the
 //! topological checks of the greedy reference — link condition, no border pinch, no lone
 //! triangle, no tetrahedral fold. Those that fail drop out; the rest win and lock every vertex of
 //! the faces around them (see `select`). Tentative winners share no face, so their checks cannot interfere. Checking only

@@ -1,4 +1,4 @@
-//! Twin of shaders/vertex_flags.wgsl (first round): which vertices lie on a border and which
+//! Twin of shaders/rounds/vertex_flags.wgsl (first round): which vertices lie on a border and which
 //! must stay pinned — a non-manifold edge (more than two faces), more than one fan of faces (a
 //! bow-tie), or a border under `lock_border`. Collapses keep a manifold manifold and carry the
 //! border bit to the survivor, so these flags stay true without being recomputed each round.

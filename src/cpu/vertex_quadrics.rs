@@ -1,4 +1,4 @@
-//! Twin of shaders/vertex_quadrics.wgsl (first round): each vertex gathers the area-weighted plane
+//! Twin of shaders/rounds/vertex_quadrics.wgsl (first round): each vertex gathers the area-weighted plane
 //! quadrics of its faces and, for each border edge at it, Hoppe's constraint plane through the
 //! edge perpendicular to its face, weighted by the squared edge length; likewise for each
 //! attribute-seam edge (its two faces use different attribute vertices at an end), perpendicular

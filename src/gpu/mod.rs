@@ -2,7 +2,6 @@
 //! stage; src/cpu/ holds their twins).
 
 pub mod context;
-pub(crate) mod shaders;
 pub mod simplifier;
 // The GPU structs and constants with their Rust twins: public for the stage-by-stage tests.
 #[doc(hidden)]

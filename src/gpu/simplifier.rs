@@ -3,10 +3,9 @@
 //! read-back is the 64-byte counters block (and the stage timestamps when the device has them).
 
 use super::context::{checked_buffer, checked_buffer_init};
-use super::shaders::MAX_STORAGE_BUFFERS;
 use super::types::*;
-use crate::compute::gpu::{ErrorScope, Groups, Pipelines};
-use crate::compute::schedule::Step as S;
+use crate::compute::gpu::{ErrorScope, Groups, Pipelines, Runner};
+use crate::compute::shaders::MAX_STORAGE_BUFFERS;
 use crate::error::{Error, Result};
 use crate::parallel::schedule::{self, Buf, Count, RoundStep, Stage, Step, When};
 use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
@@ -191,6 +190,8 @@ pub struct GpuRounds<'a> {
     pub transfer_seconds: f64,
     /// Seconds from each round's submission to its counters read back.
     pub wait_seconds: f64,
+    /// The round being recorded's parameters (the grids are counted from them).
+    round_params: Params,
     /// Submit each pass on its own and wait for it: set when the device also draws a window,
     /// whose frames then come between passes (a round on a 1M-face mesh keeps lavapipe busy
     /// for over a second, which would otherwise be one frame's wait). Off for the command line.
@@ -312,6 +313,7 @@ impl<'a> GpuRounds<'a> {
             carried_quadrics: up.quadrics.is_some(),
             transfer_seconds: 0.0,
             wait_seconds: 0.0,
+            round_params: Params::default(),
             share_queue: false,
         };
         // Draw arguments for the mesh as uploaded: a renderer can draw it before any round.
@@ -328,151 +330,10 @@ impl<'a> GpuRounds<'a> {
         Ok(r)
     }
 
-    /// The buffer bound for `buf`; `scan` is the prefix sum's (count, data) when one runs.
-    fn buffer(&self, buf: Buf, scan: Option<(Count, Buf)>) -> &wgpu::Buffer {
-        let (h, o) = (&self.half[self.cur], &self.half[1 - self.cur]);
-        match buf {
-            Buf::Params => &self.params,
-            Buf::ScanCount => match scan.map(|s| s.0) {
-                Some(Count::Faces) => &self.scan_f,
-                Some(Count::EdgeSlots) => &self.scan_e,
-                // A prefix sum always names its count; vertices otherwise.
-                Some(Count::Vertices) | None => &self.scan_v,
-            },
-            Buf::ScanData => match scan {
-                Some((_, data)) if data != Buf::ScanData => self.buffer(data, None),
-                _ => &self.offsets,
-            },
-            Buf::BlockSums => &self.block_sums,
-            Buf::Positions => &h.positions,
-            Buf::Quadrics => &h.quadrics,
-            Buf::Flags => &h.flags,
-            Buf::VertexAttr => &h.vertex_attr,
-            Buf::Indices => &h.indices,
-            Buf::FaceNormals => &h.face_normals,
-            Buf::FaceExtra => &h.face_extra,
-            Buf::PositionsOut => &o.positions,
-            Buf::QuadricsOut => &o.quadrics,
-            Buf::FlagsOut => &o.flags,
-            Buf::VertexAttrOut => &o.vertex_attr,
-            Buf::IndicesOut => &o.indices,
-            Buf::FaceNormalsOut => &o.face_normals,
-            Buf::FaceExtraOut => &o.face_extra,
-            Buf::Offsets => &self.offsets,
-            Buf::Cursor => &self.cursor,
-            Buf::VertexFaces => &self.vertex_faces,
-            Buf::EdgeOffsets => &self.edge_offsets,
-            Buf::Neighbours => &self.neighbours,
-            Buf::Remap => &self.remap,
-            Buf::Edges => &self.edges,
-            Buf::Candidates => &self.candidates,
-            Buf::EdgeState => &self.edge_state,
-            Buf::Histogram => &self.histogram,
-            Buf::Live => &self.live,
-            Buf::VertexLock => &self.vertex_lock,
-            Buf::FaceBest => &self.face_best,
-            Buf::FaceId => &self.face_id,
-            Buf::Tentative => &self.tentative,
-            Buf::TrimHistogram => &self.trim_histogram,
-            Buf::Marks => &self.marks,
-            Buf::VertexKeep => &self.vertex_keep,
-            Buf::FaceKeep => &self.face_keep,
-            Buf::Counters => &self.counters,
-            Buf::Dispatch => &self.dispatch,
-            Buf::DrawArgs => &self.draw_args,
-        }
-    }
-
-    /// Records the steps in `steps`.
+    /// Records the steps in `steps` with the round's parameters `p`.
     fn record(&mut self, enc: &mut wgpu::CommandEncoder, p: &Params, steps: &[Step]) {
-        for step in steps {
-            match *step {
-                S::Clear(buf) => enc.clear_buffer(self.buffer(buf, None), 0, None),
-                S::CopyBuffer(from, to) => {
-                    let (from, to) = (self.buffer(from, None), self.buffer(to, None));
-                    enc.copy_buffer_to_buffer(from, 0, to, 0, from.size().min(to.size()));
-                }
-                S::Own(RoundStep::ClearTentative) => {
-                    enc.clear_buffer(&self.counters, TENTATIVE_OFFSET, Some(4))
-                }
-                S::Run(stage) => self.pass(enc, stage, p, None),
-                S::PrefixSum { count, data } => {
-                    for stage in schedule::PREFIX_SUM {
-                        self.pass(enc, stage, p, Some((count, data)));
-                    }
-                }
-                // The GPU's winners are checked by the tests against the CPU twin; nothing on
-                // the device writes through unchecked host memory.
-                S::Own(RoundStep::CheckWinners) => {}
-            }
-        }
-    }
-
-    /// One compute pass of `stage` with its bindings in the shader's order, over its grid.
-    fn pass(
-        &mut self,
-        enc: &mut wgpu::CommandEncoder,
-        stage: &'static Stage,
-        p: &Params,
-        scan: Option<(Count, Buf)>,
-    ) {
-        let wg = |n: u32| Groups::Direct(n.div_ceil(WG));
-        let groups = match stage.grid {
-            schedule::Grid::Each(count) => wg(count.of(p)),
-            schedule::Grid::VerticesOrFaces => wg(p.vertex_count.max(p.face_count)),
-            schedule::Grid::ScanBlocks => {
-                let n = scan.map_or(p.vertex_count, |(count, _)| count.of(p));
-                Groups::Direct(n.div_ceil(SCAN_BLOCK))
-            }
-            schedule::Grid::One => Groups::Direct(1),
-            indirect => Groups::Indirect(indirect.indirect_offset().unwrap_or(0)),
-        };
-        let qi = self.query_stages.len() as u32 * 2;
-        let timestamps = match &self.queries {
-            Some((set, _)) if qi + 2 <= QUERY_CAP => {
-                self.query_stages.push(stage.entry);
-                Some(wgpu::ComputePassTimestampWrites {
-                    query_set: set,
-                    beginning_of_pass_write_index: Some(qi),
-                    end_of_pass_write_index: Some(qi + 1),
-                })
-            }
-            _ => None,
-        };
-        let buffers: Vec<&wgpu::Buffer> = stage
-            .bindings
-            .iter()
-            .map(|b| self.buffer(b.buf, scan))
-            .collect();
-        crate::compute::gpu::pass(
-            &self.sim.device,
-            enc,
-            stage.entry,
-            &self.sim.pipelines[stage.entry],
-            &buffers,
-            groups,
-            self.sim.max_workgroups,
-            Some(&self.dispatch),
-            timestamps,
-        );
-        if self.share_queue {
-            // Submit this pass alone and wait for it, so that work others put on the queue
-            // meanwhile (the viewer's frames) runs between passes instead of after the round.
-            let done = std::mem::replace(
-                enc,
-                self.sim
-                    .device
-                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                        label: Some("meshslim.round"),
-                    }),
-            );
-            let index = self.sim.queue.submit([done.finish()]);
-            // A failed wait shows up at the round's own wait, which reports it.
-            let _ = self.sim.device.poll(wgpu::PollType::Wait {
-                submission_index: Some(index),
-                timeout: None,
-            });
-        }
+        self.round_params = *p;
+        crate::compute::gpu::record(self, enc, steps)
     }
 
     /// The mesh as it stands (after the last round), for a renderer.
@@ -702,5 +563,139 @@ impl RoundRunner for GpuRounds<'_> {
 
     fn stage_times(&self) -> &StageTimes {
         &self.times
+    }
+}
+
+impl Runner<Buf, schedule::Grid, Count, RoundStep> for GpuRounds<'_> {
+    /// The buffer bound for `buf`; `scan` is the prefix sum's (count, data) when one runs.
+    fn buffer(&self, buf: Buf, scan: Option<(Count, Buf)>) -> &wgpu::Buffer {
+        let (h, o) = (&self.half[self.cur], &self.half[1 - self.cur]);
+        match buf {
+            Buf::Params => &self.params,
+            Buf::ScanCount => match scan.map(|s| s.0) {
+                Some(Count::Faces) => &self.scan_f,
+                Some(Count::EdgeSlots) => &self.scan_e,
+                // A prefix sum always names its count; vertices otherwise.
+                Some(Count::Vertices) | None => &self.scan_v,
+            },
+            Buf::ScanData => match scan {
+                Some((_, data)) if data != Buf::ScanData => self.buffer(data, None),
+                _ => &self.offsets,
+            },
+            Buf::BlockSums => &self.block_sums,
+            Buf::Positions => &h.positions,
+            Buf::Quadrics => &h.quadrics,
+            Buf::Flags => &h.flags,
+            Buf::VertexAttr => &h.vertex_attr,
+            Buf::Indices => &h.indices,
+            Buf::FaceNormals => &h.face_normals,
+            Buf::FaceExtra => &h.face_extra,
+            Buf::PositionsOut => &o.positions,
+            Buf::QuadricsOut => &o.quadrics,
+            Buf::FlagsOut => &o.flags,
+            Buf::VertexAttrOut => &o.vertex_attr,
+            Buf::IndicesOut => &o.indices,
+            Buf::FaceNormalsOut => &o.face_normals,
+            Buf::FaceExtraOut => &o.face_extra,
+            Buf::Offsets => &self.offsets,
+            Buf::Cursor => &self.cursor,
+            Buf::VertexFaces => &self.vertex_faces,
+            Buf::EdgeOffsets => &self.edge_offsets,
+            Buf::Neighbours => &self.neighbours,
+            Buf::Remap => &self.remap,
+            Buf::Edges => &self.edges,
+            Buf::Candidates => &self.candidates,
+            Buf::EdgeState => &self.edge_state,
+            Buf::Histogram => &self.histogram,
+            Buf::Live => &self.live,
+            Buf::VertexLock => &self.vertex_lock,
+            Buf::FaceBest => &self.face_best,
+            Buf::FaceId => &self.face_id,
+            Buf::Tentative => &self.tentative,
+            Buf::TrimHistogram => &self.trim_histogram,
+            Buf::Marks => &self.marks,
+            Buf::VertexKeep => &self.vertex_keep,
+            Buf::FaceKeep => &self.face_keep,
+            Buf::Counters => &self.counters,
+            Buf::Dispatch => &self.dispatch,
+            Buf::DrawArgs => &self.draw_args,
+        }
+    }
+
+    /// One compute pass of `stage` with its bindings in the shader's order, over its grid.
+    fn run(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        stage: &'static Stage,
+        scan: Option<(Count, Buf)>,
+    ) {
+        let p = &self.round_params;
+        let wg = |n: u32| Groups::Direct(n.div_ceil(WG));
+        let groups = match stage.grid {
+            schedule::Grid::Each(count) => wg(count.of(p)),
+            schedule::Grid::VerticesOrFaces => wg(p.vertex_count.max(p.face_count)),
+            schedule::Grid::ScanBlocks => {
+                let n = scan.map_or(p.vertex_count, |(count, _)| count.of(p));
+                Groups::Direct(n.div_ceil(SCAN_BLOCK))
+            }
+            schedule::Grid::One => Groups::Direct(1),
+            indirect => Groups::Indirect(indirect.indirect_offset().unwrap_or(0)),
+        };
+        let qi = self.query_stages.len() as u32 * 2;
+        let timestamps = match &self.queries {
+            Some((set, _)) if qi + 2 <= QUERY_CAP => {
+                self.query_stages.push(stage.entry);
+                Some(wgpu::ComputePassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(qi),
+                    end_of_pass_write_index: Some(qi + 1),
+                })
+            }
+            _ => None,
+        };
+        crate::compute::gpu::pass(
+            &self.sim.device,
+            enc,
+            &self.sim.pipelines,
+            stage,
+            |b| self.buffer(b, scan),
+            groups,
+            self.sim.max_workgroups,
+            Some(&self.dispatch),
+            timestamps,
+        );
+        if self.share_queue {
+            // Submit this pass alone and wait for it, so that work others put on the queue
+            // meanwhile (the viewer's frames) runs between passes instead of after the round.
+            let done = std::mem::replace(
+                enc,
+                self.sim
+                    .device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                        label: Some("meshslim.round"),
+                    }),
+            );
+            let index = self.sim.queue.submit([done.finish()]);
+            // A failed wait shows up at the round's own wait, which reports it.
+            let _ = self.sim.device.poll(wgpu::PollType::Wait {
+                submission_index: Some(index),
+                timeout: None,
+            });
+        }
+    }
+
+    fn own(&mut self, enc: &mut wgpu::CommandEncoder, step: RoundStep) {
+        match step {
+            RoundStep::ClearTentative => {
+                enc.clear_buffer(&self.counters, TENTATIVE_OFFSET, Some(4))
+            }
+            // The GPU's winners are checked by the tests against the CPU twin; nothing on the
+            // device writes through unchecked host memory.
+            RoundStep::CheckWinners => {}
+        }
+    }
+
+    fn prefix_sum(&self) -> [&'static Stage; 3] {
+        schedule::PREFIX_SUM
     }
 }

@@ -1,15 +1,15 @@
 //! Structs shared by the WGSL stages and their CPU twins. Keep in sync with
-//! shaders/common.wgsl: every struct here has a WGSL twin of the same name and layout, and
+//! shaders/common.inc.wgsl: every struct here has a WGSL twin of the same name and layout, and
 //! `tests` in `src/gpu/shaders.rs` compare naga's sizes with `size_of`.
 //! No `vec3` members: storage structs are packed into `vec4`s so the layouts need no padding
 //! rules beyond 16-byte alignment.
 
 use bytemuck::{Pod, Zeroable};
 
-/// Threads per workgroup of every 1-D stage. Keep in sync with `WG` in shaders/common.wgsl.
+/// Threads per workgroup of every 1-D stage. Keep in sync with `WG` in shaders/common.inc.wgsl.
 pub const WG: u32 = 256;
 /// Elements one workgroup of the prefix sum scans (4 per thread). Keep in sync with
-/// `SCAN_BLOCK` in shaders/common.wgsl.
+/// `SCAN_BLOCK` in shaders/common.inc.wgsl.
 pub const SCAN_BLOCK: u32 = WG * 4;
 /// Bins of the cost histogram: the top 12 bits of a non-negative f32 (sign, 8 exponent bits,
 /// 3 mantissa bits), the resolution meshoptimizer ranks with. Keep in sync with `HIST_BINS`.
@@ -19,7 +19,7 @@ pub const HIST_SHIFT: u32 = 20;
 /// Cost bits of an edge that may not collapse (a NaN pattern: above every real cost).
 pub const INVALID_COST: u32 = 0xffff_ffff;
 
-/// Vertex flag bits (`flags` buffers). Keep in sync with shaders/common.wgsl.
+/// Vertex flag bits (`flags` buffers). Keep in sync with shaders/common.inc.wgsl.
 pub mod flag {
     /// The vertex lies on an open border.
     pub const BORDER: u32 = 1;
@@ -37,7 +37,7 @@ pub mod flag {
     pub const MOVED: u32 = 8;
 }
 
-/// Per-edge selection state (`edge_state` buffer). Keep in sync with shaders/common.wgsl.
+/// Per-edge selection state (`edge_state` buffer). Keep in sync with shaders/common.inc.wgsl.
 pub mod state {
     /// Invalid or already out of this round.
     pub const OUT: u32 = 0;
@@ -52,7 +52,7 @@ pub mod state {
     pub const POSTED: u32 = 4;
 }
 
-/// Per-round constants, a uniform. Keep in sync with `Params` in shaders/common.wgsl.
+/// Per-round constants, a uniform. Keep in sync with `Params` in shaders/common.inc.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct Params {
@@ -79,7 +79,7 @@ pub struct Params {
     pub _pad: [u32; 3],
 }
 
-/// Prefix-sum size, a uniform (one buffer per scan site). Keep in sync with shaders/common.wgsl.
+/// Prefix-sum size, a uniform (one buffer per scan site). Keep in sync with shaders/common.inc.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct ScanParams {
@@ -88,7 +88,7 @@ pub struct ScanParams {
     pub _pad: [u32; 3],
 }
 
-/// Round counters, atomics on the GPU. Keep in sync with `Counters` in shaders/common.wgsl.
+/// Round counters, atomics on the GPU. Keep in sync with `Counters` in shaders/common.inc.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct Counters {
@@ -124,14 +124,14 @@ pub struct Counters {
 /// with `y = x - position`. Keeping the origin at the vertex keeps `c` and `b` small, so f32
 /// does not lose the tiny errors of a million-triangle scan to cancellation.
 /// Layout `[a00 a01 a02 a11] [a12 a22 b0 b1] [b2 c weight 0]`.
-/// Keep in sync with `Quadric` in shaders/common.wgsl.
+/// Keep in sync with `Quadric` in shaders/common.inc.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct Quadric {
     pub q: [[f32; 4]; 3],
 }
 
-/// The best collapse of one edge. Keep in sync with `EdgeCandidate` in shaders/common.wgsl.
+/// The best collapse of one edge. Keep in sync with `EdgeCandidate` in shaders/common.inc.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct EdgeCandidate {
@@ -168,7 +168,7 @@ pub const NO_ATTR: u32 = u32::MAX;
 
 /// Per-face data carried through compaction alongside the indices: the attribute vertex of
 /// each corner (for seam corners) and the face's index in the input (materials, groups).
-/// Keep in sync with `FaceExtra` in shaders/common.wgsl.
+/// Keep in sync with `FaceExtra` in shaders/common.inc.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct FaceExtra {
@@ -191,12 +191,12 @@ pub struct DrawArgs {
 }
 
 /// Keys one workgroup of the radix sort takes (256 threads × 4 contiguous keys). Keep in sync
-/// with `SORT_BLOCK` in shaders/cluster.wgsl.
+/// with `SORT_BLOCK` in shaders/cluster/cluster.inc.wgsl.
 pub const SORT_BLOCK: u32 = WG * 4;
 
 /// Which candidate placed a cluster's vertex (`ClusterPlaced::how`), as
 /// `crate::cluster::stages::Placement`. Keep in sync with the `PLACE_*` constants in
-/// shaders/cluster.wgsl.
+/// shaders/cluster/cluster.inc.wgsl.
 pub mod place {
     pub const SINGLE: u32 = 0;
     pub const SOLVE: u32 = 1;
@@ -205,7 +205,7 @@ pub mod place {
 }
 
 /// The clustering stages' constants, a uniform. Keep in sync with `ClusterParams` in
-/// shaders/cluster.wgsl.
+/// shaders/cluster/cluster.inc.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct ClusterParams {
@@ -221,7 +221,7 @@ pub struct ClusterParams {
 }
 
 /// One pass of the radix sort, a uniform (one buffer per pass, so a build records every pass
-/// in one command buffer). Keep in sync with `RadixParams` in shaders/cluster.wgsl.
+/// in one command buffer). Keep in sync with `RadixParams` in shaders/cluster/cluster.inc.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct RadixParams {
@@ -235,7 +235,7 @@ pub struct RadixParams {
 }
 
 /// A cluster's vertex as `cluster_quadrics` writes it (its quadric, relative to `pos`, goes to
-/// a buffer of [`Quadric`] beside). Keep in sync with `ClusterPlaced` in shaders/cluster.wgsl.
+/// a buffer of [`Quadric`] beside). Keep in sync with `ClusterPlaced` in shaders/cluster/cluster.inc.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct ClusterPlaced {
@@ -249,7 +249,7 @@ pub struct ClusterPlaced {
 }
 
 /// The floating cells' constants, a uniform (one buffer per round slot, so a batch of rounds is
-/// recorded in one command buffer). Keep in sync with `FloatParams` in shaders/floating.wgsl.
+/// recorded in one command buffer). Keep in sync with `FloatParams` in shaders/cluster/floating.inc.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct FloatParams {
