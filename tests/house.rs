@@ -1,9 +1,11 @@
-//! The house rules a reviewer would otherwise check by eye: no source file over 800 lines, and no
-//! import circle between source files (file A naming something in file B while B names
+//! The house rules a reviewer would otherwise check by eye: no file over 800 lines in src/,
+//! tests/, benches/ or examples/, no import circle between source files (file A naming something in file B while B names
 //! something in A, directly or through others). Read from the sources, by the paths they write:
 //! `crate::a::b`, `super::c` and `crate::a::{b, c::d}`, comments and unit tests left out. A
 //! file naming its own parent module (a stage's twin using `super::Scatter`) is the module
-//! tree, not a circle, and is not counted.
+//! tree, not a circle, and is not counted. And the GPU layer exists once: only src/compute/
+//! makes compute pipelines and catches the device's errors, and every WGSL stage lives in its
+//! family's folder of shaders/.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -16,6 +18,21 @@ fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
         if path.is_dir() {
             sources(&path, out);
         } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// Code files below `dir`: Rust, shell and Python.
+fn code_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            code_files(&path, out);
+        } else if path
+            .extension()
+            .is_some_and(|e| e == "rs" || e == "sh" || e == "py")
+        {
             out.push(path);
         }
     }
@@ -129,6 +146,18 @@ fn no_source_file_is_over_800_lines_and_no_import_circle() {
             }
         }
     }
+    // The tests, benches and examples are read like the sources (data such as benches/results
+    // is not code).
+    for dir in ["tests", "benches", "examples"] {
+        let mut more = Vec::new();
+        code_files(&Path::new(env!("CARGO_MANIFEST_DIR")).join(dir), &mut more);
+        for file in more {
+            let lines = std::fs::read_to_string(&file).unwrap().lines().count();
+            if lines > MAX_LINES {
+                long.push(format!("{} ({lines} lines)", file.display()));
+            }
+        }
+    }
     assert!(long.is_empty(), "files over {MAX_LINES} lines: {long:?}");
     // A circle: a path back to where it started.
     let name = |m: &Vec<String>| {
@@ -208,4 +237,68 @@ fn the_core_library_depends_on_no_application_crate() {
     for core in ["wgpu", "naga", "bytemuck", "glam", "rayon"] {
         assert!(names.contains(core), "the core lost {core}:\n{tree}");
     }
+}
+
+/// One GPU layer: compute pipelines are made, and the device's errors caught, in src/compute/
+/// alone (its pipeline cache and error scopes, shared by every family and the viewer), so no
+/// family compiles a shared stage twice or installs a handler on a device it only borrows; and
+/// the stages are written with compute's one `stage!` macro.
+#[test]
+fn the_gpu_layer_is_src_compute() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    sources(&root.join("src"), &mut files);
+    let compute = root.join("src").join("compute");
+    let mut outside = Vec::new();
+    for file in files.iter().filter(|f| !f.starts_with(&compute)) {
+        let text = code(&std::fs::read_to_string(file).unwrap());
+        for call in [
+            "create_compute_pipeline",
+            "push_error_scope",
+            "on_uncaptured_error",
+            "macro_rules! stage",
+        ] {
+            if text.contains(call) {
+                outside.push(format!("{}: {call}", file.display()));
+            }
+        }
+    }
+    assert!(
+        outside.is_empty(),
+        "GPU plumbing outside src/compute: {outside:#?}"
+    );
+}
+
+/// shaders/ holds the includes every family shares (`*.inc.wgsl`) at the top and one folder per
+/// family; no stage file sits at the top, and no include shares a name with a stage or with the
+/// viewer's render shaders.
+#[test]
+fn shaders_are_in_family_folders() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let mut names = BTreeMap::new();
+    for entry in std::fs::read_dir(&root).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if path.is_dir() {
+            for inner in std::fs::read_dir(&path).unwrap() {
+                let inner = inner.unwrap().path();
+                let stem = inner.file_name().unwrap().to_string_lossy().into_owned();
+                names
+                    .entry(stem)
+                    .or_insert_with(Vec::new)
+                    .push(format!("{name}/"));
+            }
+        } else {
+            assert!(
+                name.ends_with(".inc.wgsl"),
+                "shaders/{name}: only includes (*.inc.wgsl) sit at the top of shaders/"
+            );
+            names
+                .entry(name)
+                .or_insert_with(Vec::new)
+                .push(String::new());
+        }
+    }
+    let twice: Vec<_> = names.iter().filter(|(_, at)| at.len() > 1).collect();
+    assert!(twice.is_empty(), "shader files sharing a name: {twice:?}");
 }
