@@ -160,31 +160,35 @@ fn each_cluster_stage_matches_its_cpu_twin() {
                 "{label}: the driver's radix_sort"
             );
             gpu.run_part(Part::Cells).unwrap();
-            let cells = cpu.cell_key.len();
+            let cells = cpu.cells.cell_key.len();
             assert_eq!(
                 pod::<u32>(rd(&gpu, CBuf::CellHead, 4 * (nv + 1))),
-                cpu.cell_head,
+                cpu.cells.cell_head,
                 "{label}: cell_head"
             );
             assert_eq!(
                 pod::<u32>(rd(&gpu, CBuf::CellStart, 4 * (cells + 1))),
-                cpu.cell_start,
+                cpu.cells.cell_start,
                 "{label}: cell_start"
             );
             assert_eq!(
                 pod::<u32>(rd(&gpu, CBuf::VertexCell, 4 * nv)),
-                cpu.vertex_cell,
+                cpu.cells.vertex_cell,
                 "{label}: vertex_cell"
             );
             assert_eq!(
                 pod::<u32>(rd(&gpu, CBuf::CellKey, 4 * cells)),
-                cpu.cell_key,
+                cpu.cells.cell_key,
                 "{label}: cell_key"
             );
             let driver = stages::cell_ranges(&sorted, members);
             assert_eq!(
                 (&driver.start, &driver.key, &driver.vertex_cell),
-                (&cpu.cell_start, &cpu.cell_key, &cpu.vertex_cell),
+                (
+                    &cpu.cells.cell_start,
+                    &cpu.cells.cell_key,
+                    &cpu.cells.vertex_cell
+                ),
                 "{label}: the driver's cell_ranges"
             );
             gpu.run_part(Part::Quadrics).unwrap();
@@ -198,39 +202,43 @@ fn each_cluster_stage_matches_its_cpu_twin() {
             gpu.run_part(Part::Faces).unwrap();
             assert_eq!(
                 pod::<u32>(rd(&gpu, CBuf::FaceKey, 12 * nf)),
-                cpu.face_key,
+                cpu.faces.face_key,
                 "{label}: face_key"
             );
             assert_eq!(
                 pod::<u32>(rd(&gpu, CBuf::BucketOffsets, 4 * (nv + 1))),
-                cpu.bucket_offsets,
+                cpu.faces.bucket_offsets,
                 "{label}: bucket_offsets"
             );
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::BucketFaces, 4 * cpu.bucket_faces.len())),
-                cpu.bucket_faces,
+                pod::<u32>(rd(
+                    &gpu,
+                    CBuf::BucketFaces,
+                    4 * cpu.faces.bucket_faces.len()
+                )),
+                cpu.faces.bucket_faces,
                 "{label}: bucket_faces"
             );
-            let mut scanned = cpu.face_keep.clone();
+            let mut scanned = cpu.faces.face_keep.clone();
             meshslim::cpu::prefix_sum::prefix_sum(nf as u32, &mut scanned, &mut Vec::new());
             assert_eq!(
                 pod::<u32>(rd(&gpu, CBuf::FaceKeep, 4 * (nf + 1))),
                 scanned,
                 "{label}: face_keep (scanned)"
             );
-            let kept = cpu.face_origin.len();
+            let kept = cpu.faces.face_origin.len();
             assert_eq!(
                 pod::<u32>(rd(&gpu, CBuf::ClusterFaces, 12 * kept)),
-                cpu.cluster_faces,
+                cpu.faces.cluster_faces,
                 "{label}: cluster_faces"
             );
             assert_eq!(
                 pod::<u32>(rd(&gpu, CBuf::FaceOrigin, 4 * kept)),
-                cpu.face_origin,
+                cpu.faces.face_origin,
                 "{label}: face_origin"
             );
             // The faces are the CPU driver's `cluster_faces`.
-            let driver = stages::cluster_faces(&m.triangles, &cpu.vertex_cell, cells, false);
+            let driver = stages::cluster_faces(&m.triangles, &cpu.cells.vertex_cell, cells, false);
             assert_eq!(
                 cpu.result().faces,
                 driver,

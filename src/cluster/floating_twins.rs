@@ -433,12 +433,11 @@ pub fn run(
 impl FloatBuild {
     /// The build's result, as the GPU's is read back.
     pub fn result(&self) -> ClusterBuild {
-        ClusterBuild::from_buffers(
+        ClusterBuild::from_twins(
             &self.cluster_placed,
             &self.cluster_quadric,
-            &self.faces.cluster_faces,
-            &self.faces.face_origin,
-            self.clusters.vertex_cell.clone(),
+            &self.clusters,
+            &self.faces,
         )
     }
 

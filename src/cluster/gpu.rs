@@ -8,7 +8,7 @@
 use crate::cluster::gpu_schedule::{self as sched, CBuf, CCount, CGrid, CStage, CStep};
 use crate::cluster::grid::Grid;
 use crate::cluster::twins::{self, ClusterBuild};
-use crate::compute::gpu::{ErrorScope, Groups, Pipelines, Runner};
+use crate::compute::gpu::{ErrorScope, Groups, Kernels, Runner};
 use crate::error::{Error, Result};
 use crate::gpu::GpuMesh;
 use crate::gpu::context::{checked_buffer, checked_buffer_init};
@@ -29,35 +29,21 @@ const MAX_PASSES: usize = 4;
 pub struct GpuClusterer {
     pub(super) device: wgpu::Device,
     pub(super) queue: wgpu::Queue,
-    pipelines: HashMap<&'static str, wgpu::ComputePipeline>,
-    max_workgroups: u32,
+    kernels: Kernels,
     /// Seconds spent compiling the shaders.
     pub pipeline_seconds: f64,
 }
 
 impl GpuClusterer {
     /// Compiles every stage of [`sched::STAGES`] on `device` (borrowed: a viewer or the rounds
-    /// may share it; the stages they share come from the device's [`Pipelines`]).
+    /// may share it; the stages they share come from the device's pipeline cache).
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<GpuClusterer> {
-        let limits = device.limits();
-        let most = sched::STAGES
-            .iter()
-            .map(|s| s.storage_buffers())
-            .max()
-            .unwrap_or(0) as u32;
-        if limits.max_storage_buffers_per_shader_stage < most {
-            return Err(Error::Gpu(format!(
-                "the device binds at most {} storage buffers per stage; clustering needs {most}",
-                limits.max_storage_buffers_per_shader_stage
-            )));
-        }
-        let (pipelines, pipeline_seconds) = Pipelines::of(device).get(sched::STAGES)?;
+        let kernels = Kernels::new(device, sched::STAGES, "clustering")?;
         Ok(GpuClusterer {
             device: device.clone(),
             queue: queue.clone(),
-            pipelines,
-            max_workgroups: limits.max_compute_workgroups_per_dimension,
-            pipeline_seconds,
+            pipeline_seconds: kernels.seconds,
+            kernels,
         })
     }
 }
@@ -518,14 +504,12 @@ impl crate::compute::gpu::Runner<CBuf, CGrid, CCount, std::convert::Infallible>
             CGrid::ScanBlocks => scan.map_or(0, |s| self.count(s.0)).div_ceil(SCAN_BLOCK),
             CGrid::One => 1,
         };
-        crate::compute::gpu::pass(
+        self.sim.kernels.pass(
             &self.sim.device,
             enc,
-            &self.sim.pipelines,
             stage,
             |b| self.buffer(b, scan),
             Groups::Direct(groups),
-            self.sim.max_workgroups,
             None,
             None,
         );

@@ -169,14 +169,9 @@ pub const FC_QUADRICS: CStage = crate::stage!(CBuf; fc_quadrics in "cluster/fc_q
     cluster_placed: ReadWrite ClusterPlaced, cluster_quadric: ReadWrite ClusterQuadric);
 
 /// Every stage, each once: the runner makes one pipeline per entry.
-pub const STAGES: &[&CStage] = &[
-    &PREFIX_SUM_REDUCE,
-    &PREFIX_SUM_SPINE,
-    &PREFIX_SUM_APPLY,
-    &ADJACENCY_COUNT,
-    &ADJACENCY_FILL,
-    &ADJACENCY_SORT,
-    &FACE_PLANES,
+pub const STAGES: &[&[&CStage]] = &[SHARED_STAGES, OWN_STAGES];
+/// The family's own stages.
+const OWN_STAGES: &[&CStage] = &[
     &CELL_KEYS,
     &RADIX_COUNT,
     &RADIX_SCATTER,

@@ -385,6 +385,22 @@ impl ClusterBuild {
             vertex_cluster: vertex_cell,
         }
     }
+
+    /// [`Self::from_buffers`] over a twin build's faces part and the cells its vertices fall in.
+    pub fn from_twins(
+        placed: &[ClusterPlaced],
+        quadrics: &[Quadric],
+        cells: &CellsOut,
+        faces: &FacesOut,
+    ) -> ClusterBuild {
+        Self::from_buffers(
+            placed,
+            quadrics,
+            &faces.cluster_faces,
+            &faces.face_origin,
+            cells.vertex_cell.clone(),
+        )
+    }
 }
 
 /// Every buffer of a build on the CPU, as each stage leaves it: what the tests diff.
@@ -398,21 +414,12 @@ pub struct CpuBuild {
     pub keys: (Vec<u32>, Vec<u32>),
     /// After each radix pass: the scanned digit counts and the keys and values it wrote.
     pub passes: Vec<(Vec<u32>, Vec<u32>, Vec<u32>)>,
-    /// Scanned.
-    pub cell_head: Vec<u32>,
-    pub cell_start: Vec<u32>,
-    pub vertex_cell: Vec<u32>,
-    pub cell_key: Vec<u32>,
+    /// The cells part's buffers, as [`cells()`] leaves them.
+    pub cells: CellsOut,
     pub cluster_placed: Vec<ClusterPlaced>,
     pub cluster_quadric: Vec<Quadric>,
-    pub face_key: Vec<u32>,
-    /// After the dedupe, before its scan.
-    pub face_keep: Vec<u32>,
-    pub bucket_offsets: Vec<u32>,
-    /// After the dedupe.
-    pub bucket_faces: Vec<u32>,
-    pub cluster_faces: Vec<u32>,
-    pub face_origin: Vec<u32>,
+    /// The faces part's buffers, as [`faces()`] leaves them.
+    pub faces: FacesOut,
 }
 
 /// The radix passes of a sort of `(keys, vals)`: after each, the scanned digit counts and the
@@ -436,6 +443,7 @@ pub fn sort(keys: &[u32], vals: &[u32], passes: u32) -> Vec<(Vec<u32>, Vec<u32>,
 }
 
 /// `cell_heads`, its prefix sum and `cell_ranges` over sorted keys.
+#[derive(Default)]
 pub struct CellsOut {
     /// Scanned: the cell count at `[n]`.
     pub cell_head: Vec<u32>,
@@ -549,14 +557,8 @@ pub fn run(positions: &[[f32; 4]], faces: &[[u32; 3]], locked: &[bool], grid: &G
     if let Some((_, k, v)) = b.passes.last() {
         (keys, vals) = (k.clone(), v.clone());
     }
-    let cells = self::cells(&c, &keys, &vals);
-    (b.cell_head, b.cell_start, b.vertex_cell, b.cell_key) = (
-        cells.cell_head,
-        cells.cell_start,
-        cells.vertex_cell,
-        cells.cell_key,
-    );
-    let n = b.cell_key.len();
+    b.cells = self::cells(&c, &keys, &vals);
+    let n = b.cells.cell_key.len();
     b.cluster_placed = vec![ClusterPlaced::default(); n];
     b.cluster_quadric = vec![Quadric::default(); n];
     cluster_quadrics(
@@ -567,16 +569,13 @@ pub fn run(positions: &[[f32; 4]], faces: &[[u32; 3]], locked: &[bool], grid: &G
         &csr.vertex_faces,
         &b.face_normals,
         &vals,
-        &b.cell_head,
-        &b.cell_start,
-        &b.cell_key,
+        &b.cells.cell_head,
+        &b.cells.cell_start,
+        &b.cells.cell_key,
         &mut b.cluster_placed,
         &mut b.cluster_quadric,
     );
-    let f = self::faces(&c, indices, &b.vertex_cell);
-    (b.face_key, b.face_keep, b.bucket_offsets, b.bucket_faces) =
-        (f.face_key, f.face_keep, f.bucket_offsets, f.bucket_faces);
-    (b.cluster_faces, b.face_origin) = (f.cluster_faces, f.face_origin);
+    b.faces = self::faces(&c, indices, &b.cells.vertex_cell);
     (b.offsets, b.vertex_faces) = (csr.offsets, csr.vertex_faces);
     b
 }
@@ -584,12 +583,11 @@ pub fn run(positions: &[[f32; 4]], faces: &[[u32; 3]], locked: &[bool], grid: &G
 impl CpuBuild {
     /// The build's result, as the GPU's is read back.
     pub fn result(&self) -> ClusterBuild {
-        ClusterBuild::from_buffers(
+        ClusterBuild::from_twins(
             &self.cluster_placed,
             &self.cluster_quadric,
-            &self.cluster_faces,
-            &self.face_origin,
-            self.vertex_cell.clone(),
+            &self.cells,
+            &self.faces,
         )
     }
 }

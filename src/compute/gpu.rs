@@ -91,6 +91,74 @@ impl Pipelines {
     }
 }
 
+/// A family's compiled stages on one device: what its runner needs to record a pass.
+pub struct Kernels {
+    pipelines: HashMap<&'static str, wgpu::ComputePipeline>,
+    /// The device's `max_compute_workgroups_per_dimension`, read once.
+    max_workgroups: u32,
+    /// Seconds spent compiling the shaders and creating the pipelines this family did not
+    /// find in the device's cache.
+    pub seconds: f64,
+}
+
+impl Kernels {
+    /// The pipelines of the family's stage `lists` on `device` (from its [`Pipelines`] cache),
+    /// after checking that the device binds as many storage buffers per stage as the family's
+    /// widest stage; `family` names it in the error.
+    pub fn new<B, G>(
+        device: &wgpu::Device,
+        lists: &[&[&'static Stage<B, G>]],
+        family: &str,
+    ) -> Result<Kernels> {
+        let stages: Vec<&'static Stage<B, G>> =
+            lists.iter().flat_map(|l| l.iter().copied()).collect();
+        let stages = &stages[..];
+        let limits = device.limits();
+        let most = stages
+            .iter()
+            .map(|s| s.storage_buffers())
+            .max()
+            .unwrap_or(0) as u32;
+        if limits.max_storage_buffers_per_shader_stage < most {
+            return Err(Error::Gpu(format!(
+                "the device binds at most {} storage buffers per stage; {family} needs {most}",
+                limits.max_storage_buffers_per_shader_stage
+            )));
+        }
+        let (pipelines, seconds) = Pipelines::of(device).get(stages)?;
+        Ok(Kernels {
+            pipelines,
+            max_workgroups: limits.max_compute_workgroups_per_dimension,
+            seconds,
+        })
+    }
+
+    /// One compute pass of `stage` into `enc`: see [`pass`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn pass<'b, B: Copy, G>(
+        &self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        stage: &Stage<B, G>,
+        bind: impl Fn(B) -> &'b wgpu::Buffer,
+        groups: Groups,
+        indirect: Option<&wgpu::Buffer>,
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        pass(
+            device,
+            enc,
+            &self.pipelines,
+            stage,
+            bind,
+            groups,
+            self.max_workgroups,
+            indirect,
+            timestamps,
+        )
+    }
+}
+
 /// Validation and out-of-memory errors of the work between [`ErrorScope::push`] and
 /// [`ErrorScope::check`], on this thread (wgpu's scopes are per thread, so a viewer's frames on
 /// another thread are not caught here, nor these there).
@@ -173,7 +241,7 @@ pub fn record<B: Copy + 'static, G: 'static, C: Copy, X: Copy>(
 /// shader folds y back into its index), with `timestamps` when given; `indirect` holds the
 /// arguments of an indirect grid.
 #[allow(clippy::too_many_arguments)]
-pub fn pass<'b, B: Copy, G>(
+fn pass<'b, B: Copy, G>(
     device: &wgpu::Device,
     enc: &mut wgpu::CommandEncoder,
     pipelines: &HashMap<&'static str, wgpu::ComputePipeline>,

@@ -97,8 +97,9 @@ pub use crate::stage;
 /// type, buffer enum and grid and count enums, whose variants must include the names used here
 /// (`Params`, `ScanCount`, `ScanData`, `BlockSums`, `Positions`, `Indices`, `Offsets`, `Cursor`,
 /// `VertexFaces`, `FaceNormals`; grids `Each`, `ScanBlocks`, `One`; counts `Vertices`, `Faces`).
-/// It defines the `PREFIX_SUM_*`, `ADJACENCY_*` and `FACE_PLANES` stages and the [`ADJACENCY`]
-/// part (the vertex→face lists: counts, prefix sum, fill, sort).
+/// It defines the `PREFIX_SUM_*`, `ADJACENCY_*` and `FACE_PLANES` stages, their list
+/// `SHARED_STAGES`, and the `ADJACENCY` part (the vertex→face lists: counts, prefix sum, fill,
+/// sort).
 #[macro_export]
 #[doc(hidden)]
 macro_rules! shared_stages {
@@ -112,6 +113,16 @@ macro_rules! shared_stages {
         pub const PREFIX_SUM_APPLY: $stage = $crate::compute::schedule::stage!($b;
             prefix_sum_apply in "core/prefix_sum" over $g::ScanBlocks;
             scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
+        /// The stages every family runs, each once (a family's `STAGES` starts with these).
+        pub const SHARED_STAGES: &[&$stage] = &[
+            &PREFIX_SUM_REDUCE,
+            &PREFIX_SUM_SPINE,
+            &PREFIX_SUM_APPLY,
+            &ADJACENCY_COUNT,
+            &ADJACENCY_FILL,
+            &ADJACENCY_SORT,
+            &FACE_PLANES,
+        ];
         /// The three passes of a prefix sum, in order.
         pub const PREFIX_SUM: [&$stage; 3] = [&PREFIX_SUM_REDUCE, &PREFIX_SUM_SPINE, &PREFIX_SUM_APPLY];
 
@@ -224,7 +235,7 @@ pub(crate) mod check {
     /// one of the family's `parts`.
     pub fn family<B: Copy + PartialEq + std::fmt::Debug, G, C, X>(
         family: &str,
-        stages: &[&Stage<B, G>],
+        lists: &[&[&Stage<B, G>]],
         roles: &[(&str, B)],
         parts: &[&[Step<B, G, C, X>]],
     ) {
@@ -236,6 +247,7 @@ pub(crate) mod check {
                 _ => false,
             })
         };
+        let stages: Vec<&Stage<B, G>> = lists.iter().flat_map(|l| l.iter().copied()).collect();
         for (i, stage) in stages.iter().enumerate() {
             let declared = shader_bindings(stage.shader)
                 .unwrap_or_else(|e| panic!("{family}: {}: {e}", stage.entry));

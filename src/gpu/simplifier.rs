@@ -4,12 +4,10 @@
 
 use super::context::{checked_buffer, checked_buffer_init};
 use super::types::*;
-use crate::compute::gpu::{ErrorScope, Groups, Pipelines, Runner};
-use crate::compute::shaders::MAX_STORAGE_BUFFERS;
+use crate::compute::gpu::{ErrorScope, Groups, Kernels, Runner};
 use crate::error::{Error, Result};
 use crate::parallel::schedule::{self, Buf, Count, RoundStep, Stage, Step, When};
 use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
-use std::collections::HashMap;
 use std::time::Instant;
 
 const SU: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
@@ -32,34 +30,23 @@ const TENTATIVE_OFFSET: u64 = std::mem::offset_of!(Counters, tentative) as u64;
 pub struct GpuSimplifier {
     device: wgpu::Device,
     queue: wgpu::Queue,
-    pipelines: HashMap<&'static str, wgpu::ComputePipeline>,
+    kernels: Kernels,
     /// Seconds spent compiling shaders and creating pipelines.
     pub pipeline_seconds: f64,
     timestamps: bool,
-    /// The device's `max_compute_workgroups_per_dimension`, read once.
-    max_workgroups: u32,
 }
 
 impl GpuSimplifier {
     /// Compiles every stage on `device` (those another family already made there are taken
-    /// from the device's [`Pipelines`]). Borrows the device: a viewer can share it.
+    /// from the device's pipeline cache). Borrows the device: a viewer can share it.
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<GpuSimplifier> {
-        let limits = device.limits();
-        if limits.max_storage_buffers_per_shader_stage < MAX_STORAGE_BUFFERS {
-            return Err(Error::Gpu(format!(
-                "the device binds at most {} storage buffers per stage; the simplifier needs \
-                 {MAX_STORAGE_BUFFERS}",
-                limits.max_storage_buffers_per_shader_stage
-            )));
-        }
-        let (pipelines, pipeline_seconds) = Pipelines::of(device).get(schedule::STAGES)?;
+        let kernels = Kernels::new(device, schedule::STAGES, "the simplifier")?;
         Ok(GpuSimplifier {
             device: device.clone(),
             queue: queue.clone(),
-            pipelines,
-            pipeline_seconds,
+            pipeline_seconds: kernels.seconds,
+            kernels,
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
-            max_workgroups: limits.max_compute_workgroups_per_dimension,
         })
     }
 
@@ -653,14 +640,12 @@ impl Runner<Buf, schedule::Grid, Count, RoundStep> for GpuRounds<'_> {
             }
             _ => None,
         };
-        crate::compute::gpu::pass(
+        self.sim.kernels.pass(
             &self.sim.device,
             enc,
-            &self.sim.pipelines,
             stage,
             |b| self.buffer(b, scan),
             groups,
-            self.sim.max_workgroups,
             Some(&self.dispatch),
             timestamps,
         );

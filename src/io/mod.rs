@@ -11,6 +11,7 @@
 //! renamed over the target, so a failed or interrupted write never leaves a half-written file.
 
 pub mod gltf;
+mod lines;
 pub mod obj;
 pub mod ply;
 pub mod sink;

@@ -36,6 +36,7 @@ use std::fs::File;
 use std::io::{self, BufRead, BufReader, Write};
 use std::path::Path;
 
+use super::lines::Lines;
 use crate::error::{Error, Location, Result};
 use crate::mesh::{Material, Mesh, UvOrigin};
 
@@ -69,8 +70,9 @@ pub fn read(path: &Path) -> Result<Mesh> {
     read_from(BufReader::with_capacity(1 << 16, file), path)
 }
 
-/// A line's keyword and the rest of it.
+/// A line's keyword and the rest of it, without the whitespace around either.
 fn keyword(line: &str) -> (&str, &str) {
+    let line = line.trim();
     match line.find(|c: char| c.is_ascii_whitespace()) {
         Some(i) => (&line[..i], line[i..].trim()),
         None => (line, ""),
@@ -180,28 +182,17 @@ fn fan(poly: &[u32], err: &dyn Fn(String) -> Error, mut push: impl FnMut([u32; 3
 /// every other statement are skipped. Errors as [`read`]'s, with the line.
 pub fn read_into(path: &Path, sink: &mut dyn crate::io::sink::Sink) -> Result<()> {
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
-    let mut r = BufReader::with_capacity(1 << 16, file);
+    let r = BufReader::with_capacity(1 << 16, file);
     let (wants_v, wants_f) = (sink.wants_vertices(), sink.wants_faces());
     if wants_v {
         sink.begin_vertices(0, Default::default());
     }
     let mut counts = [0usize; 3];
     let mut poly: Vec<u32> = Vec::new();
-    let mut buf = Vec::new();
-    let mut line_no = 0u64;
-    loop {
-        buf.clear();
-        if r.read_until(b'\n', &mut buf)
-            .map_err(|e| Error::io(path, e))?
-            == 0
-        {
-            return Ok(());
-        }
-        line_no += 1;
-        let err = |m: String| Error::parse(path, Location::Line(line_no), m);
-        let text = String::from_utf8_lossy(&buf);
-        let line = text.trim();
-        let (kw, rest) = keyword(line);
+    let mut lines = Lines::new(r, path);
+    while let Some((at, text)) = lines.next_line()? {
+        let err = |m: String| Error::parse(path, at, m);
+        let (kw, rest) = keyword(&text);
         match kw {
             "v" => {
                 if wants_v {
@@ -228,9 +219,10 @@ pub fn read_into(path: &Path, sink: &mut dyn crate::io::sink::Sink) -> Result<()
             _ => {}
         }
     }
+    Ok(())
 }
 
-fn read_from(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
+fn read_from(r: impl BufRead, path: &Path) -> Result<Mesh> {
     let mut positions: Vec<[f32; 3]> = Vec::new();
     let mut colors: Vec<[f32; 4]> = Vec::new();
     let mut any_color = false;
@@ -255,22 +247,10 @@ fn read_from(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
     let mut any_vn_corner = false;
     let mut poly: Vec<u32> = Vec::new();
 
-    let mut buf = Vec::new();
-    let mut line_no = 0u64;
-    loop {
-        buf.clear();
-        let n = r
-            .read_until(b'\n', &mut buf)
-            .map_err(|e| Error::io(path, e))?;
-        if n == 0 {
-            break;
-        }
-        line_no += 1;
-        let at = Location::Line(line_no);
+    let mut lines = Lines::new(r, path);
+    while let Some((at, text)) = lines.next_line()? {
         let err = |m: String| Error::parse(path, at, m);
-        let text = String::from_utf8_lossy(&buf);
-        let line = text.trim();
-        let (kw, rest) = keyword(line);
+        let (kw, rest) = keyword(&text);
         let floats = |rest: &str, what: &str| floats(rest, what, &err);
         match kw {
             "v" => {
@@ -357,13 +337,13 @@ fn read_from(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
             _ => {}
         }
     }
-    if line_no == 0 {
+    if lines.line_no == 0 {
         return Err(Error::parse(path, Location::Byte(0), "empty file"));
     }
     if positions.is_empty() {
         return Err(Error::parse(
             path,
-            Location::Line(line_no),
+            Location::Line(lines.line_no),
             "no vertices (`v` lines) found",
         ));
     }
@@ -371,7 +351,7 @@ fn read_from(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
     if (np as u64) + seam_keys.len() as u64 >= u32::MAX as u64 {
         return Err(Error::parse(
             path,
-            Location::Line(line_no),
+            Location::Line(lines.line_no),
             "too many vertices for 32-bit indices",
         ));
     }

@@ -21,6 +21,7 @@ use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read, Write};
 use std::path::Path;
 
+use super::lines::Lines;
 use crate::error::{Error, Location, Result};
 use crate::mesh::Mesh;
 
@@ -111,24 +112,13 @@ fn read_binary(mut r: impl Read, len: u64, path: &Path) -> Result<Mesh> {
     Ok(mesh)
 }
 
-fn read_ascii(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
+fn read_ascii(r: impl BufRead, path: &Path) -> Result<Mesh> {
     let mut mesh = Mesh::default();
-    let mut buf = Vec::new();
-    let mut line_no = 0u64;
+    let mut lines = Lines::new(r, path);
     let mut in_loop = false;
     let mut facet = 0u64;
     let mut poly: Vec<u32> = Vec::new();
-    loop {
-        buf.clear();
-        let n = r
-            .read_until(b'\n', &mut buf)
-            .map_err(|e| Error::io(path, e))?;
-        if n == 0 {
-            break;
-        }
-        line_no += 1;
-        let at = Location::Line(line_no);
-        let text = String::from_utf8_lossy(&buf);
+    while let Some((at, text)) = lines.next_line()? {
         let mut words = text.split_ascii_whitespace();
         match words.next() {
             Some("vertex") => {
@@ -200,7 +190,7 @@ fn read_ascii(mut r: impl BufRead, path: &Path) -> Result<Mesh> {
     if in_loop {
         return Err(Error::parse(
             path,
-            Location::Line(line_no),
+            Location::Line(lines.line_no),
             "end of file inside a facet",
         ));
     }

@@ -210,14 +210,9 @@ pub const DRAW_ARGS: Stage = crate::stage!(Buf; draw_args in "rounds/draw_args" 
 
 /// Every stage, each once: the GPU makes one pipeline per entry, the test checks each against
 /// its shader.
-pub const STAGES: &[&Stage] = &[
-    &PREFIX_SUM_REDUCE,
-    &PREFIX_SUM_SPINE,
-    &PREFIX_SUM_APPLY,
-    &ADJACENCY_COUNT,
-    &ADJACENCY_FILL,
-    &ADJACENCY_SORT,
-    &FACE_PLANES,
+pub const STAGES: &[&[&Stage]] = &[SHARED_STAGES, OWN_STAGES];
+/// The family's own stages.
+const OWN_STAGES: &[&Stage] = &[
     &VERTEX_FLAGS,
     &VERTEX_QUADRICS,
     &EDGES_COUNT,
