@@ -49,6 +49,7 @@ pub mod gpu;
 mod greedy;
 pub mod io;
 pub mod lod;
+pub mod memory;
 pub mod mesh;
 pub mod metrics;
 pub mod options;

@@ -400,6 +400,18 @@ pub struct DecimateReport {
     pub refused: usize,
 }
 
+impl SimplifyReport {
+    /// The report of a result that was changed after simplifying (remeshed): the same, with
+    /// the output counts of `out`, the mesh a caller writes.
+    pub fn describing(self, out: &crate::mesh::Mesh) -> SimplifyReport {
+        SimplifyReport {
+            output_faces: out.face_count(),
+            output_vertices: out.vertex_count(),
+            ..self
+        }
+    }
+}
+
 /// What the clustering methods did, reported by `--stats` and `--json`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct ClusterReport {

@@ -129,3 +129,35 @@ pub fn auto_backend() -> (Backend, String) {
         Err(e) => (Backend::CpuParallel, format!("cpu-parallel ({e})")),
     }
 }
+
+/// Whether simplifying the file at `path` should stream it (read its faces in blocks, pass by
+/// pass) instead of reading it whole, and why: for `cluster` and `hybrid` (the methods that
+/// stream; not with `lock_border`, and `cluster` not on the `gpu` backend, which holds the mesh
+/// on the device) when reading it whole would take more than `memory` bytes (default
+/// [`crate::memory::default_budget`], half the machine's memory). The estimate is the PLY
+/// header's face count or the OBJ's size times the method's bytes per face. Then
+/// [`crate::cluster::stream::simplify_file`] simplifies it.
+pub fn stream_reason(
+    path: &std::path::Path,
+    opts: &SimplifyOptions,
+    memory: Option<u64>,
+) -> Option<String> {
+    use crate::memory::{default_budget, mib, whole_mesh_estimate};
+    let method = opts.method;
+    if !(matches!(method, Method::Cluster | Method::Hybrid)
+        && !opts.lock_border
+        && (method == Method::Hybrid || opts.backend != Backend::Gpu))
+    {
+        return None;
+    }
+    let budget = memory.unwrap_or_else(default_budget);
+    whole_mesh_estimate(path, method)
+        .filter(|&need| need > budget)
+        .map(|need| {
+            format!(
+                "reading it whole would take about {}, over the {} of --memory",
+                mib(need),
+                mib(budget)
+            )
+        })
+}

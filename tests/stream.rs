@@ -189,6 +189,38 @@ fn what_streaming_cannot_do_is_refused_with_a_reason() {
     assert!(e.contains("missing.ply"), "{e}");
 }
 
+/// The library decides streaming as the command line does (`stream_reason`): a cluster or hybrid
+/// input over the memory budget streams, with the sizes in the reason; under the budget, the
+/// QEM method, a locked border or `cluster` on the GPU (which holds the mesh on the device) read
+/// it whole.
+#[test]
+fn the_library_streams_what_does_not_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("torus.ply");
+    write(&noisy_torus(), &path, false);
+    let reason = |o: &SimplifyOptions, memory: u64| {
+        meshslim::simplify::stream_reason(&path, o, Some(memory))
+    };
+    // 14,400 faces at 64 bytes (cluster) and 128 (hybrid) a face: 900 KiB and 1.8 MiB.
+    let why = reason(&opts(100), 100 << 10).expect("over 100 KiB: streamed");
+    assert!(why.contains("1 MiB") && why.contains("0 MiB"), "{why}");
+    assert_eq!(reason(&opts(100), 1 << 30), None, "under 1 GiB: read whole");
+    let mut hybrid = opts(100);
+    hybrid.method = Method::Hybrid;
+    assert!(reason(&hybrid, 1 << 20).is_some(), "hybrid needs 1.8 MiB");
+    let mut qem = opts(100);
+    qem.method = Method::Qem;
+    assert_eq!(reason(&qem, 1), None, "qem does not stream");
+    let mut locked = opts(100);
+    locked.lock_border = true;
+    assert_eq!(reason(&locked, 1), None, "a locked border needs the whole mesh");
+    let mut gpu = opts(100);
+    gpu.backend = Backend::Gpu;
+    assert_eq!(reason(&gpu, 1), None, "cluster on the GPU holds the mesh there");
+    gpu.method = Method::Hybrid;
+    assert!(reason(&gpu, 1).is_some(), "hybrid's clustering streams on any backend");
+}
+
 #[test]
 fn the_command_line_streams_on_request_or_over_the_budget() {
     let dir = tempfile::tempdir().unwrap();

@@ -279,33 +279,6 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     let progress = Progress::new(!(args.quiet || args.json) && std::io::stderr().is_terminal());
 
     let method = args.method.method();
-    let stream = match &input {
-        Input::Builtin { .. } if args.stream => {
-            return Err(UsageError(
-                "--stream reads a file; a builtin mesh is made in memory".into(),
-            )
-            .into());
-        }
-        Input::File(path) if args.stream => Some((path.clone(), "--stream".to_string())),
-        Input::File(path)
-            if matches!(method, crate::Method::Cluster | crate::Method::Hybrid)
-                && !args.lock_border
-                && (method == crate::Method::Hybrid || args.backend.backend() != Backend::Gpu) =>
-        {
-            let budget = args.memory.unwrap_or_else(super::memory::default_budget);
-            super::memory::whole_mesh_estimate(path, method)
-                .filter(|&need| need > budget)
-                .map(|need| {
-                    let why = format!(
-                        "reading it whole would take about {}, over the {} of --memory",
-                        super::memory::mib(need),
-                        super::memory::mib(budget)
-                    );
-                    (path.clone(), why)
-                })
-        }
-        _ => None,
-    };
     let say = |msg: String| {
         if !args.quiet {
             eprintln!("{msg}");
@@ -324,6 +297,20 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     opts.method = method;
     opts.feature_angle_deg = args.feature_angle;
     opts.removal = args.removal.removal();
+    let stream = match &input {
+        Input::Builtin { .. } if args.stream => {
+            return Err(UsageError(
+                "--stream reads a file; a builtin mesh is made in memory".into(),
+            )
+            .into());
+        }
+        Input::File(path) if args.stream => Some((path.clone(), "--stream".to_string())),
+        // The library's policy: stream a cluster or hybrid input that would not fit in memory.
+        Input::File(path) => {
+            crate::simplify::stream_reason(path, &opts, args.memory).map(|why| (path.clone(), why))
+        }
+        _ => None,
+    };
 
     let (simplified, report, load_s, simplify_s, topology, streamed, original) =
         if let Some((path, why)) = stream {
@@ -396,15 +383,15 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
         };
 
     let (simplified, simplify_s, remeshed) = if args.remesh > 0 {
-        let opts = crate::remesh::RemeshOptions {
-            target: crate::remesh::EdgeTarget::Faces(simplified.face_count()),
-            iterations: args.remesh,
-            lock_border: args.lock_border,
-            ..Default::default()
-        };
         let remeshed = progress.bar("remeshing", |set| {
             // Onto the original where it is in memory (not when streamed): nearer it.
-            crate::remesh::remesh_onto(&simplified, original.as_ref(), &opts, set)
+            crate::remesh::remesh_simplified(
+                &simplified,
+                original.as_ref(),
+                args.remesh,
+                args.lock_border,
+                set,
+            )
         });
         match remeshed {
             Ok((out, r)) => {
@@ -424,11 +411,7 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     };
     // The report describes the file written: the remeshed mesh's counts.
     let report = match &remeshed {
-        Some(_) => crate::SimplifyReport {
-            output_faces: simplified.face_count(),
-            output_vertices: simplified.vertex_count(),
-            ..report
-        },
+        Some(_) => report.describing(&simplified),
         None => report,
     };
 
@@ -462,7 +445,7 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
         let mut json = simplify_json(&input, &output, &report, &times, topology.as_ref());
         json["streamed"] = serde_json::json!(streamed);
         json["remesh"] = serde_json::json!(remeshed);
-        json["peak_resident_bytes"] = serde_json::json!(super::memory::peak_resident_bytes());
+        json["peak_resident_bytes"] = serde_json::json!(crate::memory::peak_resident_bytes());
         writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
     } else if !args.quiet {
         write_summary(
@@ -483,7 +466,7 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
         }
         if let Some(why) = &streamed {
             let peak =
-                super::memory::peak_resident_bytes().map_or("unknown".into(), super::memory::mib);
+                crate::memory::peak_resident_bytes().map_or("unknown".into(), crate::memory::mib);
             writeln!(
                 out,
                 "stream   {why}: faces read in blocks (load is in simplify); peak resident {peak}"

@@ -259,7 +259,7 @@ fn merge(a: MergeArgs) -> Result<ExitCode> {
     let progress = Progress::new(!a.json && std::io::stderr().is_terminal());
     let (mesh, r) = progress
         .bar("merging", |p| {
-            let memory = a.memory.unwrap_or_else(super::memory::default_budget);
+            let memory = a.memory.unwrap_or_else(crate::memory::default_budget);
             crate::tiles::merge(&a.dir, memory, &mut |f| p(f))
         })
         .map_err(lib)?;
@@ -272,8 +272,8 @@ fn merge(a: MergeArgs) -> Result<ExitCode> {
         while let Some(c) = &level.coarser {
             how += &format!(
                 "; needing {} of {}, tiled again coarser ({} faces welded)",
-                super::memory::mib(level.needed_bytes),
-                super::memory::mib(level.memory_budget),
+                crate::memory::mib(level.needed_bytes),
+                crate::memory::mib(level.memory_budget),
                 c.welded_faces
             );
             level = c;

@@ -148,6 +148,26 @@ pub fn remesh_with_progress(
     remesh_onto(mesh, None, opts, progress)
 }
 
+/// A simplification remeshed to its own face count (`simplify --remesh K`): `iterations` of
+/// isotropic remeshing, projected onto `original` where it is in memory (the result comes back
+/// nearer it), the border kept fixed with `lock_border`. On an error the simplification is
+/// still good: a caller keeps it (the command line writes it with a warning).
+pub fn remesh_simplified(
+    simplified: &Mesh,
+    original: Option<&Mesh>,
+    iterations: usize,
+    lock_border: bool,
+    progress: &dyn Fn(f32),
+) -> Result<(Mesh, RemeshReport)> {
+    let opts = RemeshOptions {
+        target: EdgeTarget::Faces(simplified.face_count()),
+        iterations,
+        lock_border,
+        ..Default::default()
+    };
+    remesh_onto(simplified, original, &opts, progress)
+}
+
 /// [`remesh_with_progress`], projecting the vertices onto `onto` rather than onto `mesh`
 /// itself: a simplification remeshed onto its original comes back nearer the original
 /// (feature lines are still `mesh`'s own).
