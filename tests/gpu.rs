@@ -20,6 +20,44 @@ fn close(a: f32, b: f32, tol: f32) -> bool {
     (a - b).abs() <= tol * a.abs().max(b.abs()).max(1e-12)
 }
 
+/// One pipeline cache per device: the rounds and the clustering made from one cache compile the
+/// stages they share (prefix sum, adjacency, face planes) once, and each family's own once; a
+/// family made again from the cache compiles nothing.
+#[test]
+fn families_on_one_device_share_its_pipelines() {
+    let Some(ctx) = gpu_context() else { return };
+    let cache = meshslim::compute::gpu::Pipelines::new(&ctx.device);
+    let rounds = GpuSimplifier::on(&cache, &ctx.queue).unwrap();
+    let after_rounds = cache.compiled();
+    let rounds_stages: Vec<&str> = meshslim::parallel::schedule::STAGES
+        .iter()
+        .flat_map(|l| l.iter().map(|s| s.entry))
+        .collect();
+    assert_eq!(after_rounds.len(), rounds_stages.len());
+    meshslim::cluster::gpu::GpuClusterer::on(&cache, &ctx.queue).unwrap();
+    let cluster_stages: Vec<&str> = meshslim::cluster::gpu_schedule::STAGES
+        .iter()
+        .flat_map(|l| l.iter().map(|s| s.entry))
+        .collect();
+    let shared = cluster_stages
+        .iter()
+        .filter(|e| rounds_stages.contains(e))
+        .count();
+    assert_eq!(shared, 7, "prefix sum (3), adjacency (3), face planes");
+    assert_eq!(
+        cache.compiled().len(),
+        rounds_stages.len() + cluster_stages.len() - shared,
+        "the shared stages compiled once"
+    );
+    let again = GpuSimplifier::on(&cache, &ctx.queue).unwrap();
+    assert!(
+        again.pipeline_seconds < rounds.pipeline_seconds,
+        "nothing left to compile: {} s against {} s",
+        again.pipeline_seconds,
+        rounds.pipeline_seconds
+    );
+}
+
 /// One round from the same upload on both, then every stage's output buffer compared: integer
 /// buffers exactly, floats within 1e-4 relative (the GPU may fuse multiply-adds). The CPU twin
 /// of the selection runs on the GPU's candidates, so an ulp of cost difference cannot make the

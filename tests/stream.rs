@@ -213,12 +213,23 @@ fn the_library_streams_what_does_not_fit() {
     assert_eq!(reason(&qem, 1), None, "qem does not stream");
     let mut locked = opts(100);
     locked.lock_border = true;
-    assert_eq!(reason(&locked, 1), None, "a locked border needs the whole mesh");
+    assert_eq!(
+        reason(&locked, 1),
+        None,
+        "a locked border needs the whole mesh"
+    );
     let mut gpu = opts(100);
     gpu.backend = Backend::Gpu;
-    assert_eq!(reason(&gpu, 1), None, "cluster on the GPU holds the mesh there");
+    assert_eq!(
+        reason(&gpu, 1),
+        None,
+        "cluster on the GPU holds the mesh there"
+    );
     gpu.method = Method::Hybrid;
-    assert!(reason(&gpu, 1).is_some(), "hybrid's clustering streams on any backend");
+    assert!(
+        reason(&gpu, 1).is_some(),
+        "hybrid's clustering streams on any backend"
+    );
 }
 
 #[test]

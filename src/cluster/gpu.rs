@@ -8,7 +8,7 @@
 use crate::cluster::gpu_schedule::{self as sched, CBuf, CCount, CGrid, CStage, CStep};
 use crate::cluster::grid::Grid;
 use crate::cluster::twins::{self, ClusterBuild};
-use crate::compute::gpu::{ErrorScope, Groups, Kernels, Runner};
+use crate::compute::gpu::{ErrorScope, Groups, Kernels, Pipelines, Runner};
 use crate::error::{Error, Result};
 use crate::gpu::GpuMesh;
 use crate::gpu::context::{checked_buffer, checked_buffer_init};
@@ -36,9 +36,16 @@ pub struct GpuClusterer {
 
 impl GpuClusterer {
     /// Compiles every stage of [`sched::STAGES`] on `device` (borrowed: a viewer or the rounds
-    /// may share it; the stages they share come from the device's pipeline cache).
+    /// may share it), with a cache of its own.
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<GpuClusterer> {
-        let kernels = Kernels::new(device, sched::STAGES, "clustering")?;
+        GpuClusterer::on(&Pipelines::new(device), queue)
+    }
+
+    /// Every stage from the device's pipeline `cache`: those the rounds share with it (prefix
+    /// sum, adjacency, face planes) are not compiled again.
+    pub fn on(cache: &Pipelines, queue: &wgpu::Queue) -> Result<GpuClusterer> {
+        let device = cache.device();
+        let kernels = Kernels::new(cache, sched::STAGES, "clustering")?;
         Ok(GpuClusterer {
             device: device.clone(),
             queue: queue.clone(),
@@ -55,7 +62,7 @@ pub fn shared() -> Result<&'static GpuClusterer> {
         std::sync::OnceLock::new();
     let ctx = crate::gpu::shared_context()?;
     CLUSTERER
-        .get_or_init(|| GpuClusterer::new(&ctx.device, &ctx.queue).map_err(|e| e.to_string()))
+        .get_or_init(|| GpuClusterer::on(&ctx.pipelines, &ctx.queue).map_err(|e| e.to_string()))
         .as_ref()
         .map_err(|e| Error::Gpu(e.trim_start_matches("GPU: ").to_string()))
 }

@@ -6,37 +6,40 @@
 use super::schedule::{Stage, Step};
 use crate::error::{Error, Result};
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex, Weak};
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-/// Compute pipelines by entry point, made once per device and shared by every family on it: the
-/// rounds, the clustering and a viewer's window on one device compile the prefix sum, the
-/// vertex→face lists and the face planes once.
+/// Compute pipelines by entry point, made once per device and shared by every family on it:
+/// the rounds, the clustering and a viewer's window on one device compile the prefix sum, the
+/// vertex→face lists and the face planes once. Whoever owns the device owns its cache (the
+/// process's shared [`crate::gpu::GpuContext`], the viewer's window) and hands it to each
+/// family; there is no process-wide registry, since a `wgpu::Device` compares by an id that
+/// devices of two instances can share.
 pub struct Pipelines {
     device: wgpu::Device,
     made: Mutex<HashMap<&'static str, wgpu::ComputePipeline>>,
 }
 
 impl Pipelines {
-    /// The cache of `device`: the one every family on it holds, made on first use. Held by
-    /// [`Arc`]s; the registry keeps only a [`Weak`], so a dropped device is not kept alive.
-    pub fn of(device: &wgpu::Device) -> Arc<Pipelines> {
-        static CACHES: Mutex<Vec<Weak<Pipelines>>> = Mutex::new(Vec::new());
-        let mut caches = CACHES.lock().unwrap_or_else(|p| p.into_inner());
-        caches.retain(|w| w.strong_count() > 0);
-        if let Some(p) = caches
-            .iter()
-            .filter_map(Weak::upgrade)
-            .find(|p| &p.device == device)
-        {
-            return p;
-        }
-        let p = Arc::new(Pipelines {
+    /// An empty cache for `device`.
+    pub fn new(device: &wgpu::Device) -> Arc<Pipelines> {
+        Arc::new(Pipelines {
             device: device.clone(),
             made: Mutex::new(HashMap::new()),
-        });
-        caches.push(Arc::downgrade(&p));
-        p
+        })
+    }
+
+    /// The device the pipelines are made on.
+    pub fn device(&self) -> &wgpu::Device {
+        &self.device
+    }
+
+    /// The entry points compiled so far.
+    pub fn compiled(&self) -> Vec<&'static str> {
+        let made = self.made.lock().unwrap_or_else(|p| p.into_inner());
+        let mut entries: Vec<&'static str> = made.keys().copied().collect();
+        entries.sort_unstable();
+        entries
     }
 
     /// The pipelines of `stages`, compiling those this device has not made yet (each shader
@@ -102,14 +105,15 @@ pub struct Kernels {
 }
 
 impl Kernels {
-    /// The pipelines of the family's stage `lists` on `device` (from its [`Pipelines`] cache),
-    /// after checking that the device binds as many storage buffers per stage as the family's
-    /// widest stage; `family` names it in the error.
+    /// The pipelines of the family's stage `lists` from the device's `cache`, after checking
+    /// that the device binds as many storage buffers per stage as the family's widest stage;
+    /// `family` names it in the error.
     pub fn new<B, G>(
-        device: &wgpu::Device,
+        cache: &Pipelines,
         lists: &[&[&'static Stage<B, G>]],
         family: &str,
     ) -> Result<Kernels> {
+        let device = cache.device();
         let stages: Vec<&'static Stage<B, G>> =
             lists.iter().flat_map(|l| l.iter().copied()).collect();
         let stages = &stages[..];
@@ -125,7 +129,7 @@ impl Kernels {
                 limits.max_storage_buffers_per_shader_stage
             )));
         }
-        let (pipelines, seconds) = Pipelines::of(device).get(stages)?;
+        let (pipelines, seconds) = cache.get(stages)?;
         Ok(Kernels {
             pipelines,
             max_workgroups: limits.max_compute_workgroups_per_dimension,

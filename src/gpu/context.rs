@@ -13,6 +13,8 @@ pub struct GpuContext {
     /// lavapipe at 1%: 9.5 s against 3.2 s for cpu-parallel and 1.1 s for cpu), so `auto` passes
     /// it over.
     pub software: bool,
+    /// The device's pipeline cache, which every family simplifying on it shares.
+    pub pipelines: std::sync::Arc<crate::compute::gpu::Pipelines>,
 }
 
 impl GpuContext {
@@ -39,6 +41,7 @@ impl GpuContext {
             pollster::block_on(adapter.request_device(&device_descriptor(&adapter)))
                 .map_err(|e| Error::Gpu(format!("adapter {} refused a device: {e}", info.name)))?;
         Ok(GpuContext {
+            pipelines: crate::compute::gpu::Pipelines::new(&device),
             device,
             queue,
             adapter_name: info.name,

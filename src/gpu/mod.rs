@@ -32,7 +32,7 @@ pub fn shared() -> Result<(&'static GpuContext, &'static GpuSimplifier)> {
         std::sync::OnceLock::new();
     let ctx = shared_context()?;
     let sim = SIMPLIFIER
-        .get_or_init(|| GpuSimplifier::new(&ctx.device, &ctx.queue).map_err(|e| e.to_string()))
+        .get_or_init(|| GpuSimplifier::on(&ctx.pipelines, &ctx.queue).map_err(|e| e.to_string()))
         .as_ref()
         .map_err(|e| crate::Error::Gpu(e.trim_start_matches("GPU: ").to_string()))?;
     Ok((ctx, sim))

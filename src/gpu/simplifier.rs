@@ -4,7 +4,7 @@
 
 use super::context::{checked_buffer, checked_buffer_init};
 use super::types::*;
-use crate::compute::gpu::{ErrorScope, Groups, Kernels, Runner};
+use crate::compute::gpu::{ErrorScope, Groups, Kernels, Pipelines, Runner};
 use crate::error::{Error, Result};
 use crate::parallel::schedule::{self, Buf, Count, RoundStep, Stage, Step, When};
 use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
@@ -37,10 +37,17 @@ pub struct GpuSimplifier {
 }
 
 impl GpuSimplifier {
-    /// Compiles every stage on `device` (those another family already made there are taken
-    /// from the device's pipeline cache). Borrows the device: a viewer can share it.
+    /// Compiles every stage on `device`, with a cache of its own. Borrows the device: a viewer
+    /// can share it (and its cache, with [`GpuSimplifier::on`]).
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<GpuSimplifier> {
-        let kernels = Kernels::new(device, schedule::STAGES, "the simplifier")?;
+        GpuSimplifier::on(&Pipelines::new(device), queue)
+    }
+
+    /// Every stage from the device's pipeline `cache`, compiling those no other family on it
+    /// made yet.
+    pub fn on(cache: &Pipelines, queue: &wgpu::Queue) -> Result<GpuSimplifier> {
+        let device = cache.device();
+        let kernels = Kernels::new(cache, schedule::STAGES, "the simplifier")?;
         Ok(GpuSimplifier {
             device: device.clone(),
             queue: queue.clone(),

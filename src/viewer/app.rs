@@ -200,7 +200,9 @@ impl ViewerApp {
         let rs = cc.wgpu_render_state.as_ref().ok_or_else(|| {
             Error::Gpu("the window has no wgpu device (eframe runs on wgpu here)".into())
         })?;
-        let (sim, status) = match GpuSimplifier::new(&rs.device, &rs.queue) {
+        // One pipeline cache for the window's device: the rounds and the clustering share it.
+        let cache = crate::compute::gpu::Pipelines::new(&rs.device);
+        let (sim, status) = match GpuSimplifier::on(&cache, &rs.queue) {
             Ok(s) => (Some(Arc::new(s)), String::new()),
             Err(e) => (
                 None,
@@ -208,7 +210,7 @@ impl ViewerApp {
             ),
         };
         let clusterer = sim.as_ref().and_then(|_| {
-            crate::cluster::gpu::GpuClusterer::new(&rs.device, &rs.queue)
+            crate::cluster::gpu::GpuClusterer::on(&cache, &rs.queue)
                 .ok()
                 .map(Arc::new)
         });
