@@ -48,7 +48,9 @@ else
     ratios=(0.1 0.01)
     repeat=${repeat:-3}
 fi
+keep=1
 if [ -z "$out" ]; then
+    keep=0
     out=$(mktemp -d)
     trap 'rm -rf "$out"' EXIT
 fi
@@ -80,7 +82,7 @@ done
 rm -f "$out/o.ply"
 echo "== reports: $((SECONDS - start)) s" >&2
 
-python3 - "$out" <<'EOF'
+KEEP=$keep python3 - "$out" <<'EOF'
 import glob, json, os, sys
 
 out = sys.argv[1]
@@ -166,5 +168,6 @@ for r in reports:
                     "stage_seconds": stages})
 json.dump({"adapter": adapter, "bench": bench, "gpu_runs": summary, "reports": reports},
           open(os.path.join(out, "gpu.json"), "w"), indent=1)
-print(f"\nJSON: {os.path.join(out, 'gpu.json')}")
+print(f"\nJSON: {os.path.join(out, 'gpu.json')}" if os.environ.get("KEEP") == "1"
+      else "\nJSON: give --out DIR to keep it")
 EOF

@@ -1,6 +1,6 @@
 //! The house rules a reviewer would otherwise check by eye: no file over 800 lines in src/,
-//! tests/, benches/ or examples/, no import circle between source files (file A naming something in file B while B names
-//! something in A, directly or through others). Read from the sources, by the paths they write:
+//! tests/, benches/ or examples/; no import circle between source files (file A naming
+//! something in file B while B names something in A, directly or through others). Read from the sources, by the paths they write:
 //! `crate::a::b`, `super::c` and `crate::a::{b, c::d}`, comments and unit tests left out. A
 //! file naming its own parent module (a stage's twin using `super::Scatter`) is the module
 //! tree, not a circle, and is not counted. And the GPU layer exists once: only src/compute/
@@ -270,8 +270,8 @@ fn the_gpu_layer_is_src_compute() {
 }
 
 /// shaders/ holds the includes every family shares (`*.inc.wgsl`) at the top and one folder per
-/// family; no stage file sits at the top, and no include shares a name with a stage or with the
-/// viewer's render shaders.
+/// family; no stage file sits at the top, and no two files share a file name (as
+/// `shaders/mesh.wgsl`, an include, and `shaders/viewer/mesh.wgsl`, the renderer, once did).
 #[test]
 fn shaders_are_in_family_folders() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");

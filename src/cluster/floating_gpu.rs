@@ -108,13 +108,12 @@ impl GpuClusterMesh<'_> {
 
     /// Runs one floating part alone and waits for it.
     pub fn run_fc_part(&mut self, part: FcPart) -> Result<()> {
-        self.floating_buffers()?;
         let scope = ErrorScope::push(&self.sim.device);
+        self.floating_buffers()?;
         let mut enc = self.sim.device.create_command_encoder(&Default::default());
         self.record_fc(&mut enc, part);
         self.sim.queue.submit([enc.finish()]);
-        self.wait()?;
-        scope.check("running a floating-cell stage")
+        scope.check_with("running a floating-cell stage", self.wait())
     }
 
     /// The ranks and the rank order, once per mesh.
@@ -180,8 +179,7 @@ impl GpuClusterMesh<'_> {
         self.record_fc(&mut enc, FcPart::Quadrics);
         self.record_part(&mut enc, Part::Faces);
         self.sim.queue.submit([enc.finish()]);
-        let b = self.read_build()?;
-        scope.check("floating cells on the GPU")?;
+        let b = scope.check_with("floating cells on the GPU", self.read_build())?;
         Ok((b, rounds))
     }
 }

@@ -299,8 +299,7 @@ impl<'a> GpuClusterMesh<'a> {
         let mut enc = self.sim.device.create_command_encoder(&Default::default());
         self.record_part(&mut enc, part);
         self.sim.queue.submit([enc.finish()]);
-        self.wait()?;
-        scope.check("running a clustering stage")
+        scope.check_with("running a clustering stage", self.wait())
     }
 
     /// Runs `steps` alone and waits for them (after [`Self::set_grid`] and the parts they
@@ -310,8 +309,7 @@ impl<'a> GpuClusterMesh<'a> {
         let mut enc = self.sim.device.create_command_encoder(&Default::default());
         self.record(&mut enc, steps);
         self.sim.queue.submit([enc.finish()]);
-        self.wait()?;
-        scope.check("running clustering steps")
+        scope.check_with("running clustering steps", self.wait())
     }
 
     pub(super) fn wait(&self) -> Result<()> {
@@ -340,9 +338,8 @@ impl<'a> GpuClusterMesh<'a> {
             self.record_part(&mut enc, part);
         }
         self.sim.queue.submit([enc.finish()]);
-        let b = self.read_build()?;
+        let b = scope.check_with("clustering on the GPU", self.read_build())?;
         self.grid = Some(*grid);
-        scope.check("clustering on the GPU")?;
         Ok(b)
     }
 
@@ -432,6 +429,13 @@ impl<'a> GpuClusterMesh<'a> {
 
     /// `(buffer, byte offset, bytes)` ranges read back through one staging buffer, one wait.
     pub(super) fn read_many(&self, ranges: &[(CBuf, u64, u64)]) -> Result<Vec<Vec<u8>>> {
+        let dev = &self.sim.device;
+        let scope = ErrorScope::push(dev);
+        let out = self.read_ranges(ranges);
+        scope.check_with("reading back the clustering", out)
+    }
+
+    fn read_ranges(&self, ranges: &[(CBuf, u64, u64)]) -> Result<Vec<Vec<u8>>> {
         let dev = &self.sim.device;
         let total: u64 = ranges.iter().map(|r| r.2.next_multiple_of(4)).sum();
         let staging = dev.create_buffer(&wgpu::BufferDescriptor {

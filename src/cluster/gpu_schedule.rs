@@ -198,8 +198,7 @@ pub type CStep = crate::compute::schedule::Step<CBuf, CGrid, CCount, std::conver
 
 use crate::compute::schedule::Step::{Clear, CopyBuffer, PrefixSum, Run};
 
-/// Once per mesh (the grid does not change them): the vertex→face lists ([`ADJACENCY`]), then
-/// the face planes.
+/// The face planes, once per mesh after [`ADJACENCY`] (the grid changes neither).
 pub const PLANES: &[CStep] = &[Run(&FACE_PLANES)];
 /// Per build: each vertex's cell key.
 pub const KEYS: &[CStep] = &[Run(&CELL_KEYS)];

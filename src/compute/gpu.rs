@@ -11,9 +11,9 @@ use std::time::Instant;
 
 /// Compute pipelines by entry point, made once per device and shared by every family on it:
 /// the rounds, the clustering and a viewer's window on one device compile the prefix sum, the
-/// vertex→face lists and the face planes once. Whoever owns the device owns its cache (the
-/// process's shared [`crate::gpu::GpuContext`], the viewer's window) and hands it to each
-/// family; there is no process-wide registry, since a `wgpu::Device` compares by an id that
+/// vertex→face lists and the face planes once. Whoever owns the device makes its cache (the
+/// process's shared [`crate::gpu::GpuContext`] holds one; the viewer's window makes one for both
+/// families when it opens) and hands it to each family; there is no process-wide registry, since a `wgpu::Device` compares by an id that
 /// devices of two instances can share.
 pub struct Pipelines {
     device: wgpu::Device,
@@ -51,6 +51,7 @@ impl Pipelines {
         let t = Instant::now();
         let mut made = self.made.lock().unwrap_or_else(|p| p.into_inner());
         let scope = ErrorScope::push(&self.device);
+        let cached: Vec<&str> = made.keys().copied().collect();
         let mut modules: HashMap<&str, wgpu::ShaderModule> = HashMap::new();
         let missing: Vec<&Stage<B, G>> = stages
             .iter()
@@ -59,6 +60,7 @@ impl Pipelines {
             .collect();
         for stage in missing {
             let module = modules.entry(stage.shader).or_insert_with(|| {
+                // Every described stage's shader is in SOURCES (the schedules' tests check it).
                 let src = super::shaders::stage_source(stage.shader).unwrap_or_default();
                 self.device
                     .create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -80,8 +82,8 @@ impl Pipelines {
             made.insert(stage.entry, p);
         }
         if let Err(e) = scope.check("creating the compute pipelines") {
-            // A failed pipeline is not kept: the next caller sees the error again.
-            for s in stages {
+            // The pipelines made here are not kept: the next caller sees the error again.
+            for s in stages.iter().filter(|s| !cached.contains(&s.entry)) {
                 made.remove(s.entry);
             }
             return Err(e);
@@ -163,19 +165,27 @@ impl Kernels {
     }
 }
 
-/// Validation and out-of-memory errors of the work between [`ErrorScope::push`] and
-/// [`ErrorScope::check`], on this thread (wgpu's scopes are per thread, so a viewer's frames on
-/// another thread are not caught here, nor these there).
+/// Validation, out-of-memory and internal (a driver's failed compile) errors of the work
+/// between [`ErrorScope::push`] and [`ErrorScope::check`], on this thread (wgpu's scopes are per
+/// thread, so a viewer's frames on another thread are not caught here, nor these there).
 pub struct ErrorScope {
+    // Declared innermost first: a scope dropped on an early return pops its guards in field
+    // order, which must be the reverse of their pushes (wgpu panics on a mismatched pop).
     validation: wgpu::ErrorScopeGuard,
     memory: wgpu::ErrorScopeGuard,
+    internal: wgpu::ErrorScopeGuard,
 }
 
 impl ErrorScope {
     pub fn push(device: &wgpu::Device) -> ErrorScope {
+        let internal = device.push_error_scope(wgpu::ErrorFilter::Internal);
         let memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        ErrorScope { validation, memory }
+        ErrorScope {
+            validation,
+            memory,
+            internal,
+        }
     }
 
     /// The first error the scope caught, as an error saying what was being done.
@@ -183,9 +193,19 @@ impl ErrorScope {
         // Scopes pop in the reverse order of their pushes.
         let validation = pollster::block_on(self.validation.pop());
         let memory = pollster::block_on(self.memory.pop());
-        match validation.or(memory) {
+        let internal = pollster::block_on(self.internal.pop());
+        match validation.or(memory).or(internal) {
             Some(e) => Err(Error::Gpu(format!("{doing}: {e}"))),
             None => Ok(()),
+        }
+    }
+
+    /// `result`, unless the scope caught the error behind it (a failed read-back after a
+    /// refused pass): then that error, which says what went wrong first.
+    pub fn check_with<T>(self, doing: &str, result: Result<T>) -> Result<T> {
+        match result {
+            Ok(v) => self.check(doing).map(|()| v),
+            Err(e) => Err(self.check(doing).err().unwrap_or(e)),
         }
     }
 }

@@ -21,4 +21,27 @@ mod tests {
         crate::parallel::schedule::check_schedule();
         crate::cluster::gpu_schedule::check_schedule();
     }
+
+    /// The pipeline cache is keyed by entry point: two families may name one entry only when it
+    /// is the same stage of the same shader (the shared ones).
+    #[test]
+    fn an_entry_point_names_one_stage_across_families() {
+        let rounds = crate::parallel::schedule::STAGES
+            .iter()
+            .flat_map(|l| l.iter())
+            .map(|s| (s.entry, s.shader));
+        let cluster = crate::cluster::gpu_schedule::STAGES
+            .iter()
+            .flat_map(|l| l.iter())
+            .map(|s| (s.entry, s.shader));
+        let all: Vec<(&str, &str)> = rounds.chain(cluster).collect();
+        for (i, (entry, shader)) in all.iter().enumerate() {
+            for (e2, s2) in &all[..i] {
+                assert!(
+                    e2 != entry || s2 == shader,
+                    "{entry} is shaders/{shader}.wgsl and shaders/{s2}.wgsl"
+                );
+            }
+        }
+    }
 }

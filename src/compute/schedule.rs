@@ -163,17 +163,21 @@ pub use crate::shared_stages;
 pub(crate) mod check {
     use super::{Access, Stage, Step};
 
-    /// The bindings `shaders/<shader>.wgsl` declares, by binding number: each variable's name and
-    /// access: what every family's schedule test compares with the stages' descriptions.
-    pub fn shader_bindings(shader: &str) -> std::result::Result<Vec<(String, Access)>, String> {
+    /// The entry points `shaders/<shader>.wgsl` defines, and the bindings it declares by binding
+    /// number (each variable's name and access): what every family's schedule is checked against.
+    #[allow(clippy::type_complexity)]
+    pub fn shader_module(
+        shader: &str,
+    ) -> std::result::Result<(Vec<String>, Vec<(String, Access)>), String> {
         let src = crate::compute::shaders::stage_source(shader).ok_or("no such shader file")?;
         let module = naga::front::wgsl::parse_str(&src).map_err(|e| e.message().to_string())?;
+        let entries = module.entry_points.iter().map(|e| e.name.clone()).collect();
         let mut vars: Vec<(u32, String, Access)> = Vec::new();
         for (_, v) in module.global_variables.iter() {
             let Some(binding) = &v.binding else { continue };
             if binding.group != 0 {
                 return Err(format!(
-                    "binding group {} (the rounds use group 0)",
+                    "binding group {} (every family binds group 0)",
                     binding.group
                 ));
             }
@@ -199,10 +203,12 @@ pub(crate) mod check {
                 ));
             }
         }
-        Ok(vars
-            .into_iter()
-            .map(|(_, name, access)| (name, access))
-            .collect())
+        Ok((
+            entries,
+            vars.into_iter()
+                .map(|(_, name, access)| (name, access))
+                .collect(),
+        ))
     }
 
     /// Whether bindings come in the house order: uniform params, then read-only, then
@@ -249,8 +255,14 @@ pub(crate) mod check {
         };
         let stages: Vec<&Stage<B, G>> = lists.iter().flat_map(|l| l.iter().copied()).collect();
         for (i, stage) in stages.iter().enumerate() {
-            let declared = shader_bindings(stage.shader)
+            let (entries, declared) = shader_module(stage.shader)
                 .unwrap_or_else(|e| panic!("{family}: {}: {e}", stage.entry));
+            assert!(
+                entries.iter().any(|e| e == stage.entry),
+                "{family}: shaders/{}.wgsl has no entry point {}",
+                stage.shader,
+                stage.entry
+            );
             let described: Vec<(String, Access)> = stage
                 .bindings
                 .iter()

@@ -1,5 +1,5 @@
-//! Backend `gpu`: the rounds as WGSL compute passes run by wgpu (shaders/ holds one file per
-//! stage; src/cpu/ holds their twins).
+//! Backend `gpu`: the rounds as WGSL compute passes run by wgpu (shaders/core/ and
+//! shaders/rounds/ hold one file per stage; src/cpu/ holds their twins).
 
 pub mod context;
 pub mod simplifier;

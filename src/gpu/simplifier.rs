@@ -93,6 +93,7 @@ impl GpuMesh {
         center: [f64; 3],
         scale: f64,
     ) -> Result<GpuMesh> {
+        let scope = ErrorScope::push(device);
         let init = |label: &str, data: &[u8], usage| {
             checked_buffer_init(device, label, data, data.len(), usage)
         };
@@ -101,7 +102,7 @@ impl GpuMesh {
             instance_count: 1,
             ..Default::default()
         };
-        Ok(GpuMesh {
+        let mesh = GpuMesh {
             positions: init(
                 "meshslim.mesh.positions",
                 bytemuck::cast_slice(positions),
@@ -119,7 +120,9 @@ impl GpuMesh {
             )?,
             center,
             scale,
-        })
+        };
+        scope.check("uploading a mesh to draw")?;
+        Ok(mesh)
     }
 }
 
@@ -425,7 +428,9 @@ impl<'a> GpuRounds<'a> {
         let mut enc = dev.create_command_encoder(&Default::default());
         enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
         self.sim.queue.submit([enc.finish()]);
-        map_wait(dev, &staging)?;
+        if let Err(e) = map_wait(dev, &staging) {
+            return scope.check_with("reading back", Err(e));
+        }
         let data = staging
             .get_mapped_range(..)
             .map_err(|e| Error::Gpu(format!("reading back: {e}")))?[..bytes as usize]
@@ -510,7 +515,9 @@ impl RoundRunner for GpuRounds<'_> {
         }
         let t = Instant::now();
         q.submit([enc.finish()]);
-        map_wait(dev, &self.readback)?;
+        if let Err(e) = map_wait(dev, &self.readback) {
+            return scope.check_with("running a round", Err(e));
+        }
         let wall = t.elapsed().as_secs_f64();
         self.wait_seconds += wall;
         let (counters_out, stamps) = {

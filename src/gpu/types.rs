@@ -1,6 +1,6 @@
 //! Structs shared by the WGSL stages and their CPU twins. Keep in sync with
 //! shaders/common.inc.wgsl: every struct here has a WGSL twin of the same name and layout, and
-//! `tests` in `src/gpu/shaders.rs` compare naga's sizes with `size_of`.
+//! `tests` in `src/compute/shaders.rs` compare naga's sizes with `size_of`.
 //! No `vec3` members: storage structs are packed into `vec4`s so the layouts need no padding
 //! rules beyond 16-byte alignment.
 

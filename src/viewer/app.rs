@@ -214,7 +214,9 @@ impl ViewerApp {
                 .ok()
                 .map(Arc::new)
         });
+        let scope = crate::compute::gpu::ErrorScope::push(&rs.device);
         let renderer = Renderer::new(&rs.device, &rs.queue);
+        scope.check("making the renderer")?;
         let mut app = ViewerApp {
             gpu: Gpu {
                 device: rs.device.clone(),
@@ -357,6 +359,7 @@ impl ViewerApp {
         self.texture_note = m.texture_note.clone();
         let tex = m.texture.as_ref().map(|i| (&i.rgba[..], i.size));
         let max = self.gpu.device.limits().max_texture_dimension_2d;
+        let scope = crate::compute::gpu::ErrorScope::push(&self.gpu.device);
         if let Some((_, (w, h))) = tex.filter(|(_, (w, h))| *w > max || *h > max) {
             self.texture_note = Some(format!(
                 "texture {w}x{h} is larger than this device's {max} pixels a side"
@@ -366,6 +369,9 @@ impl ViewerApp {
         } else {
             self.renderer
                 .set_texture(&self.gpu.device, &self.gpu.queue, tex);
+        }
+        if let Err(e) = scope.check("uploading the texture") {
+            self.texture_note = Some(e.to_string());
         }
         if self.style.mode == Mode::Texture && !self.renderer.has_texture() {
             self.style.mode = Mode::Shaded;

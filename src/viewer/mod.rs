@@ -59,6 +59,9 @@ pub fn screenshot_with(
         )));
     }
     let (ctx, sim) = crate::gpu::shared()?;
+    // Every piece of device work below (uploads, the simplification, the texture, the draw) is
+    // caught here and becomes an error, not a panic in wgpu's default handler.
+    let scope = crate::compute::gpu::ErrorScope::push(&ctx.device);
     let mut style = style;
     let (scene, faces) = if ratio < 1.0 {
         let mut opts = SimplifyOptions::with_ratio(model.up.face_count(), ratio)?;
@@ -115,7 +118,6 @@ pub fn screenshot_with(
     // The normalized frame: centred, bounding-box diagonal 1, so a sphere of radius 0.5 holds it.
     cam.fit(glam::Vec3::ZERO, 0.5, size.0 as f32 / size.1 as f32);
     let items = [(&scene, cam.model)];
-    let scope = crate::compute::gpu::ErrorScope::push(&ctx.device);
     let rgba = render::render_rgba(
         &ctx.device,
         &ctx.queue,

@@ -204,6 +204,7 @@ impl Target {
                 "image size {width}x{height}: each side must be 1..={max} on this device"
             )));
         }
+        let scope = crate::compute::gpu::ErrorScope::push(device);
         let size = wgpu::Extent3d {
             width,
             height,
@@ -233,16 +234,25 @@ impl Target {
             DEPTH,
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         );
-        Ok(Target {
+        let target = Target {
             color_view: color.create_view(&Default::default()),
             depth_view: depth.create_view(&Default::default()),
             color,
             size: (width, height),
-        })
+        };
+        scope.check("making a view's image")?;
+        Ok(target)
     }
 
-    /// The pixels as RGBA8 rows (waits for the GPU).
+    /// The pixels as RGBA8 rows (waits for the GPU); the device's errors on the way are this
+    /// call's error.
     pub fn read_rgba(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<u8>> {
+        let scope = crate::compute::gpu::ErrorScope::push(device);
+        let rgba = self.copy_rgba(device, queue);
+        scope.check_with("reading the frame", rgba)
+    }
+
+    fn copy_rgba(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<u8>> {
         let (width, height) = self.size;
         // Rows of a texture copy are padded to 256 bytes.
         let row = (width * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
