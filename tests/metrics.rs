@@ -272,3 +272,70 @@ fn empty_meshes_are_refused() {
     };
     assert!(compare(&a, &a, &zero).is_err());
 }
+
+/// An icosphere painted by height (red rising with z) with its unit normals.
+fn painted_sphere(level: u32) -> Mesh {
+    let mut m = icosphere(level);
+    m.colors = Some(
+        m.positions
+            .iter()
+            .map(|p| [0.5 + 0.4 * p[2], 0.2, 0.7, 1.0])
+            .collect(),
+    );
+    m.normals = Some(
+        m.positions
+            .iter()
+            .map(|p| {
+                let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+                p.map(|c| c / l)
+            })
+            .collect(),
+    );
+    m
+}
+
+/// The colour and normal differences, at the distance's samples: none against itself; a
+/// colour shifted by 0.1 in one channel is 0.1 off everywhere; normals turned around are 180
+/// degrees off; a mesh without colours has no colour figure, and one with no attribute the
+/// other has, no appearance at all (nor an `appearance` key in the JSON).
+#[test]
+fn appearance_measures_colour_and_normal_differences() {
+    let a = painted_sphere(3);
+    let same = compare(&a, &a, &CompareOptions::default()).unwrap();
+    let look = same.appearance.as_ref().expect("both have colours and normals");
+    let (c, n) = (look.color.as_ref().unwrap(), look.normal_deg.as_ref().unwrap());
+    assert!(c.max < 1e-6 && n.max < 1e-3, "{look:?}");
+
+    let mut shifted = a.clone();
+    for c in shifted.colors.as_mut().unwrap() {
+        c[1] += 0.1;
+    }
+    for n in shifted.normals.as_mut().unwrap() {
+        *n = n.map(|x| -x);
+    }
+    let diff = compare(&a, &shifted, &CompareOptions::default()).unwrap();
+    let look = diff.appearance.unwrap();
+    let c = look.color.unwrap();
+    assert!(close(c.mean, 0.1, 1e-5) && close(c.max, 0.1, 1e-5), "{c:?}");
+    assert!(close(c.a_to_b_mean, c.b_to_a_mean, 1e-6), "{c:?}");
+    let n = look.normal_deg.unwrap();
+    assert!(n.mean > 179.9, "{n:?}");
+
+    // A coarser painted sphere: colour error grows with the gradient lost between vertices.
+    let coarse = compare(&a, &painted_sphere(1), &CompareOptions::default()).unwrap();
+    let c = coarse.appearance.unwrap().color.unwrap();
+    assert!(c.mean > 1e-4 && c.mean < 0.05, "{c:?}");
+
+    let mut plain = a.clone();
+    plain.colors = None;
+    let look = compare(&a, &plain, &CompareOptions::default())
+        .unwrap()
+        .appearance
+        .unwrap();
+    assert!(look.color.is_none() && look.normal_deg.is_some());
+    plain.normals = None;
+    let none = compare(&a, &plain, &CompareOptions::default()).unwrap();
+    assert!(none.appearance.is_none());
+    let json = serde_json::to_value(&none).unwrap();
+    assert!(json.get("appearance").is_none(), "{json}");
+}

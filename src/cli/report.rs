@@ -302,6 +302,25 @@ pub(super) fn write_comparison(
         cell(t.mean, t.mean_rel),
         cell(t.rms, t.rms_rel)
     )?;
+    if let Some(look) = &c.appearance {
+        writeln!(
+            out,
+            "\nappearance at the same samples   {:>10} {:>10} {:>10}  {:>10} {:>10}",
+            "mean", "RMS", "max", "A -> B", "B -> A"
+        )?;
+        for (name, s) in [
+            ("colour (RGB distance, 0..1)", &look.color),
+            ("normals (angle, degrees)", &look.normal_deg),
+        ] {
+            if let Some(s) = s {
+                writeln!(
+                    out,
+                    "  {name:<30} {:>10.5} {:>10.5} {:>10.5}  {:>10.5} {:>10.5}",
+                    s.mean, s.rms, s.max, s.a_to_b_mean, s.b_to_a_mean
+                )?;
+            }
+        }
+    }
     let pct = |r: Option<f64>| r.map_or("n/a".to_string(), |r| format!("{:+.4}%", 100.0 * r));
     writeln!(out)?;
     writeln!(

@@ -261,12 +261,63 @@ fn unique_edges(mesh: &Mesh) -> Vec<u64> {
     keys
 }
 
+/// Systematic area-uniform samples of a mesh's faces: the i-th falls at area (i + u)·total/n of
+/// the faces' cumulated areas for one seeded offset u, so each face gets its expected count
+/// rounded up or down, and is placed uniformly at random in its face with a generator seeded by
+/// (seed, i). The distance and the appearance measures share them.
+pub(super) struct AreaSamples {
+    /// Cumulated face areas, in f64, summed in face order.
+    cum: Vec<f64>,
+    pub total: f64,
+    n: usize,
+    offset: f64,
+    seed: u64,
+}
+
+impl AreaSamples {
+    /// `n` samples of `x` (none on a mesh of zero area).
+    pub fn new(x: &Mesh, n: usize, seed: u64) -> AreaSamples {
+        let mut cum = Vec::with_capacity(x.triangles.len());
+        let mut total = 0.0;
+        for f in 0..x.triangles.len() {
+            total += x.face_area(f);
+            cum.push(total);
+        }
+        AreaSamples {
+            cum,
+            total,
+            n: if total > 0.0 { n } else { 0 },
+            offset: SplitMix64(seed).next_f64(),
+            seed,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// Sample `i`: its face, its barycentric weights there, and the point.
+    pub fn sample(&self, x: &Mesh, i: usize) -> (usize, [f64; 3], [f64; 3]) {
+        let s = (i as f64 + self.offset) * self.total / self.n as f64;
+        let f = self
+            .cum
+            .partition_point(|&c| c <= s)
+            .min(self.cum.len() - 1);
+        let [a, b, c] = x.triangles[f].map(|v| p64(x.positions[v as usize]));
+        let mut rng = sample_rng(self.seed, i);
+        let (mut u, mut v) = (rng.next_f64(), rng.next_f64());
+        if u + v > 1.0 {
+            (u, v) = (1.0 - u, 1.0 - v);
+        }
+        let p = [0, 1, 2].map(|k| a[k] + u * (b[k] - a[k]) + v * (c[k] - a[k]));
+        (f, [1.0 - u - v, u, v], p)
+    }
+}
+
 /// Samples mesh `x` and measures each sample's distance to the surface indexed by `y`.
 ///
-/// Face samples: `face_samples` points by systematic sampling of the cumulated face areas (the
-/// i-th sample falls at area (i + u)·total/n for one seeded offset u, so each face gets its
-/// expected count rounded up or down), each placed uniformly at random in its face with a
-/// generator seeded by (seed, i). Then, when `vertices_and_edges`, every vertex used by a face
+/// Face samples: `face_samples` points by systematic sampling of the cumulated face areas
+/// ([`AreaSamples`]). Then, when `vertices_and_edges`, every vertex used by a face
 /// and points along every edge ([`sample_edges`]), so that the maximum is not missed between
 /// random samples.
 pub(crate) fn one_direction(
@@ -277,26 +328,9 @@ pub(crate) fn one_direction(
     seed: u64,
     diagonal: f64,
 ) -> DirectionStats {
-    // Cumulated areas, in f64; the order of the sum is the face order.
-    let mut cum = Vec::with_capacity(x.triangles.len());
-    let mut total = 0.0;
-    for f in 0..x.triangles.len() {
-        total += x.face_area(f);
-        cum.push(total);
-    }
-    let n_faces = if total > 0.0 { face_samples } else { 0 };
-    let offset = SplitMix64(seed).next_f64();
-    let faces = measure(n_faces, y, |i| {
-        let s = (i as f64 + offset) * total / n_faces as f64;
-        let f = cum.partition_point(|&c| c <= s).min(cum.len() - 1);
-        let [a, b, c] = x.triangles[f].map(|v| p64(x.positions[v as usize]));
-        let mut rng = sample_rng(seed, i);
-        let (mut u, mut v) = (rng.next_f64(), rng.next_f64());
-        if u + v > 1.0 {
-            (u, v) = (1.0 - u, 1.0 - v);
-        }
-        [0, 1, 2].map(|k| a[k] + u * (b[k] - a[k]) + v * (c[k] - a[k]))
-    });
+    let samples = AreaSamples::new(x, face_samples, seed);
+    let (n_faces, total) = (samples.len(), samples.total);
+    let faces = measure(n_faces, y, |i| samples.sample(x, i).2);
 
     let (verts, edges) = if vertices_and_edges {
         let mut used = vec![false; x.positions.len()];

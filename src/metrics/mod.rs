@@ -20,9 +20,12 @@
 //! assert!(c.distance.two_sided.max_rel > 0.0 && c.distance.two_sided.max_rel < 0.05);
 //! ```
 
+mod appearance;
 mod bvh;
 mod distance;
 
+pub use appearance::{Appearance, AttributeStats};
+pub(crate) use appearance::{mix, weights_at};
 pub use bvh::{Hit, TriangleBvh, point_triangle_dist2};
 pub use distance::DirectionStats;
 
@@ -283,6 +286,10 @@ pub struct Comparison {
     pub volume: Change,
     pub quality_b: TriangleQuality,
     pub topology: TopologyDelta,
+    /// The vertex colours' and normals' difference at the same samples, for the attributes both
+    /// meshes have (absent, and not in the JSON, when they share none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub appearance: Option<Appearance>,
 }
 
 /// Compares B with A, the reference: the Metro distance both ways, area and volume change,
@@ -311,11 +318,12 @@ pub fn compare(a: &Mesh, b: &Mesh, opts: &CompareOptions) -> Result<Comparison> 
     let seed_ab = opts.seed;
     let seed_ba = opts.seed ^ SEED_BA;
 
-    let ((ta, tb), (a_to_b, b_to_a)) = rayon::join(
+    let ((ta, tb), ((a_to_b, b_to_a), appearance)) = rayon::join(
         || rayon::join(|| topology(a), || topology(b)),
         || {
             let (bvh_a, bvh_b) = rayon::join(|| TriangleBvh::new(a), || TriangleBvh::new(b));
-            rayon::join(
+            let look = appearance::appearance(a, b, (&bvh_a, &bvh_b), (na, nb), (seed_ab, seed_ba));
+            let distance = rayon::join(
                 || {
                     distance::one_direction(
                         a,
@@ -336,7 +344,8 @@ pub fn compare(a: &Mesh, b: &Mesh, opts: &CompareOptions) -> Result<Comparison> 
                         diagonal,
                     )
                 },
-            )
+            );
+            (distance, look)
         },
     );
     let rel = |v: f64| if diagonal > 0.0 { v / diagonal } else { 0.0 };
@@ -374,6 +383,7 @@ pub fn compare(a: &Mesh, b: &Mesh, opts: &CompareOptions) -> Result<Comparison> 
             genus_a: ta.genus,
             genus_b: tb.genus,
         },
+        appearance,
     })
 }
 

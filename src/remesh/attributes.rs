@@ -5,7 +5,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::Mesh;
-use crate::metrics::TriangleBvh;
+use crate::metrics::{TriangleBvh, mix, weights_at};
 
 /// Fills `out`'s normals, colours and UVs from `source` (whose faces `surface` indexes) where
 /// `source` has them; with UV seams, `out`'s vertices on them are split per side. Returns
@@ -24,7 +24,7 @@ pub(super) fn carry(source: &Mesh, surface: &TriangleBvh, out: &mut Mesh) -> Vec
         .par_iter()
         .map(|p| {
             let p = DVec3::from_array(p.map(f64::from));
-            weights_at(source, surface, p, None)
+            weights_at(source, surface, p, None, None)
         })
         .collect();
     if let Some(n) = &source.normals {
@@ -72,7 +72,7 @@ fn corner_uvs(source: &Mesh, surface: &TriangleBvh, uv: &[[f32; 2]], out: &mut M
             let centre = (pos(t[0]) + pos(t[1]) + pos(t[2])) / 3.0;
             t.map(|v| {
                 let p = pos(v);
-                let (f, w) = weights_at(source, surface, p + (centre - p) * 1e-3, Some(p));
+                let (f, w) = weights_at(source, surface, p + (centre - p) * 1e-3, Some(p), None);
                 mix(source, f, w, uv)
             })
         })
@@ -114,35 +114,6 @@ fn corner_uvs(source: &Mesh, surface: &TriangleBvh, uv: &[[f32; 2]], out: &mut M
     out.uvs = Some(uvs);
 }
 
-/// The input face nearest `query` and the barycentric weights in it of `at`, or of the
-/// closest point itself without one.
-fn weights_at(
-    source: &Mesh,
-    surface: &TriangleBvh,
-    query: DVec3,
-    at: Option<DVec3>,
-) -> (u32, [f64; 3]) {
-    // The remesher refused a surface without faces, so there is always a closest one.
-    let (q, hit) = surface
-        .closest_point(query, None)
-        .expect("the surface has faces");
-    let t = source.triangles[hit.face as usize];
-    let [a, b, c] = t.map(|v| DVec3::from_array(source.positions[v as usize].map(f64::from)));
-    (hit.face, barycentric(at.unwrap_or(q), a, b, c))
-}
-
-/// The mix of input face `f`'s corner values by the weights `w`, summed in f64.
-fn mix<const N: usize>(source: &Mesh, f: u32, w: [f64; 3], values: &[[f32; N]]) -> [f32; N] {
-    let t = source.triangles[f as usize];
-    let mut acc = [0.0f64; N];
-    for k in 0..3 {
-        for (a, &x) in acc.iter_mut().zip(&values[t[k] as usize]) {
-            *a += w[k] * x as f64;
-        }
-    }
-    acc.map(|x| x as f32)
-}
-
 /// Whether two vertices at one position have different UVs.
 fn has_seams(m: &Mesh, uvs: &[[f32; 2]]) -> bool {
     let (class, firsts) = crate::mesh::weld::position_classes(&m.positions);
@@ -150,34 +121,4 @@ fn has_seams(m: &Mesh, uvs: &[[f32; 2]]) -> bool {
         .iter()
         .enumerate()
         .any(|(v, &c)| uvs[v] != uvs[firsts[c as usize] as usize])
-}
-
-/// The barycentric weights of `p` (on the triangle's plane) in (a, b, c); a corner's own for a
-/// degenerate triangle.
-fn barycentric(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> [f64; 3] {
-    let (v0, v1, v2) = (b - a, c - a, p - a);
-    let (d00, d01, d11) = (v0.dot(v0), v0.dot(v1), v1.dot(v1));
-    let (d20, d21) = (v2.dot(v0), v2.dot(v1));
-    let denom = d00 * d11 - d01 * d01;
-    if denom.abs() <= f64::EPSILON * d00 * d11 || !denom.is_finite() {
-        return [1.0, 0.0, 0.0];
-    }
-    let v = ((d11 * d20 - d01 * d21) / denom).clamp(0.0, 1.0);
-    let w = ((d00 * d21 - d01 * d20) / denom).clamp(0.0, 1.0 - v);
-    [1.0 - v - w, v, w]
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn barycentric_weights_rebuild_the_point() {
-        let (a, b, c) = (DVec3::ZERO, DVec3::X, DVec3::Y);
-        let p = DVec3::new(0.25, 0.5, 0.0);
-        let w = barycentric(p, a, b, c);
-        let q = a * w[0] + b * w[1] + c * w[2];
-        assert!(q.distance(p) < 1e-12, "{w:?}");
-        assert_eq!(barycentric(p, a, a, a), [1.0, 0.0, 0.0]);
-    }
 }
