@@ -113,15 +113,16 @@ pub fn run(
                     step();
                 }
                 let out = out.expect("repeat is at least 1");
-                let d = if out.face_count() == 0 {
+                let c = if out.face_count() == 0 {
                     None
                 } else {
-                    Some(
-                        metrics::compare(mesh, &out, &opts.compare)?
-                            .distance
-                            .two_sided,
-                    )
+                    Some(metrics::compare(mesh, &out, &opts.compare)?)
                 };
+                let color_err = c
+                    .as_ref()
+                    .and_then(|c| c.appearance.as_ref()?.color.as_ref())
+                    .map(|s| s.mean);
+                let d = c.map(|c| c.distance.two_sided);
                 step();
                 let median_s = median(&times);
                 rows.push(Row {
@@ -143,6 +144,7 @@ pub fn run(
                     max_err: d.as_ref().map(|d| d.max),
                     mean_err_rel: d.as_ref().map(|d| d.mean_rel),
                     max_err_rel: d.as_ref().map(|d| d.max_rel),
+                    color_err,
                 });
             }
         }

@@ -22,9 +22,12 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
         .chain([7])
         .max()
         .unwrap_or(7);
+    // The colour column only when some input has colours (attribute-free tables stay as they
+    // were).
+    let colors = report.rows.iter().any(|r| r.color_err.is_some());
     writeln!(
         out,
-        "{:<mesh_w$} {:>9} {:>6} {:<backend_w$} {:>9} {:>9} {:>7} {:>8} {:>9} {:>9}",
+        "{:<mesh_w$} {:>9} {:>6} {:<backend_w$} {:>9} {:>9} {:>7} {:>8} {:>9} {:>9}{}",
         "mesh",
         "faces",
         "ratio",
@@ -34,7 +37,8 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
         "Mtri/s",
         "peak MiB",
         "mean err",
-        "max err"
+        "max err",
+        if colors { "  colour err" } else { "" }
     )?;
     let opt = |v: Option<f64>, prec: usize, e: bool| match (v, e) {
         (None, _) => "n/a".to_string(),
@@ -44,7 +48,7 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
     for r in &report.rows {
         writeln!(
             out,
-            "{:<mesh_w$} {:>9} {:>6} {:<backend_w$} {:>9} {:>9.4} {:>7.2} {:>8} {:>9} {:>9}",
+            "{:<mesh_w$} {:>9} {:>6} {:<backend_w$} {:>9} {:>9.4} {:>7.2} {:>8} {:>9} {:>9}{}",
             r.mesh,
             r.input_faces,
             r.ratio,
@@ -59,6 +63,11 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
             opt(r.peak_mib, 1, false),
             opt(r.mean_err_rel, 2, true),
             opt(r.max_err_rel, 2, true),
+            if colors {
+                format!("  {:>10}", opt(r.color_err, 4, false))
+            } else {
+                String::new()
+            },
         )?;
     }
     let devices: Vec<&str> = report.rows.iter().fold(Vec::new(), |mut v, r| {
@@ -75,6 +84,13 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
          memory is not counted)",
         report.repeat
     )?;
+    if colors {
+        writeln!(
+            out,
+            "colour err: mean RGB distance (0..1 units) of the vertex colours at the same samples \
+             ('meshslim compare'); n/a where the output has no colours"
+        )?;
+    }
     if let Some(r) = report.rows.iter().find(|r| r.missed_target) {
         writeln!(
             out,

@@ -61,6 +61,10 @@ pub struct Row {
     pub max_err: Option<f64>,
     pub mean_err_rel: Option<f64>,
     pub max_err_rel: Option<f64>,
+    /// Mean colour deviation (`meshslim compare`'s, RGB distance in 0..1 units) when the input
+    /// and the output both have vertex colours; absent from the JSON otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub color_err: Option<f64>,
 }
 
 /// Everything `meshslim bench` measured; serializes to its JSON.
