@@ -302,8 +302,14 @@ fn painted_sphere(level: u32) -> Mesh {
 fn appearance_measures_colour_and_normal_differences() {
     let a = painted_sphere(3);
     let same = compare(&a, &a, &CompareOptions::default()).unwrap();
-    let look = same.appearance.as_ref().expect("both have colours and normals");
-    let (c, n) = (look.color.as_ref().unwrap(), look.normal_deg.as_ref().unwrap());
+    let look = same
+        .appearance
+        .as_ref()
+        .expect("both have colours and normals");
+    let (c, n) = (
+        look.color.as_ref().unwrap(),
+        look.normal_deg.as_ref().unwrap(),
+    );
     assert!(c.max < 1e-6 && n.max < 1e-3, "{look:?}");
 
     let mut shifted = a.clone();
