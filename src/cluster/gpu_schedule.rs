@@ -97,71 +97,71 @@ use CGrid::{Each, SortBlocks};
 // The prefix sum, the vertex→face lists and the face planes: the core's, on these buffers.
 crate::compute::schedule::shared_stages!(CStage, CStep, CBuf, CGrid, CCount);
 
-pub const CELL_KEYS: CStage = crate::stage!(CBuf; cell_keys in "cluster/cell_keys" over Each(Vertices);
+pub static CELL_KEYS: CStage = crate::stage!(CBuf; cell_keys in "cluster/cell_keys" over Each(Vertices);
     cluster: Uniform Cluster, positions: Read Positions, locked: Read Locked,
     sort_keys: ReadWrite SortKeys, sort_vals: ReadWrite SortVals);
-pub const RADIX_COUNT: CStage = crate::stage!(CBuf; radix_count in "cluster/radix_count" over SortBlocks;
+pub static RADIX_COUNT: CStage = crate::stage!(CBuf; radix_count in "cluster/radix_count" over SortBlocks;
     radix: Uniform Radix, keys: Read SortKeys, digit_counts: ReadWrite DigitCounts);
-pub const RADIX_SCATTER: CStage = crate::stage!(CBuf; radix_scatter in "cluster/radix_scatter" over SortBlocks;
+pub static RADIX_SCATTER: CStage = crate::stage!(CBuf; radix_scatter in "cluster/radix_scatter" over SortBlocks;
     radix: Uniform Radix, keys: Read SortKeys, vals: Read SortVals,
     digit_counts: Read DigitCounts, keys_out: ReadWrite SortKeysOut,
     vals_out: ReadWrite SortValsOut);
-pub const CELL_HEADS: CStage = crate::stage!(CBuf; cell_heads in "cluster/cell_heads" over Each(Vertices);
+pub static CELL_HEADS: CStage = crate::stage!(CBuf; cell_heads in "cluster/cell_heads" over Each(Vertices);
     cluster: Uniform Cluster, sort_keys: Read SortKeys, cell_head: ReadWrite CellHead);
-pub const CELL_RANGES: CStage = crate::stage!(CBuf; cell_ranges in "cluster/cell_ranges" over Each(Vertices);
+pub static CELL_RANGES: CStage = crate::stage!(CBuf; cell_ranges in "cluster/cell_ranges" over Each(Vertices);
     cluster: Uniform Cluster, cell_head: Read CellHead, sort_keys: Read SortKeys,
     sort_vals: Read SortVals, cell_start: ReadWrite CellStart,
     vertex_cell: ReadWrite VertexCell, cell_key: ReadWrite CellKey);
-pub const CLUSTER_QUADRICS: CStage = crate::stage!(CBuf; cluster_quadrics in "cluster/cluster_quadrics" over Each(Vertices);
+pub static CLUSTER_QUADRICS: CStage = crate::stage!(CBuf; cluster_quadrics in "cluster/cluster_quadrics" over Each(Vertices);
     cluster: Uniform Cluster, positions: Read Positions, indices: Read Indices,
     offsets: Read Offsets, vertex_faces: Read VertexFaces, face_normals: Read FaceNormals,
     sort_vals: Read SortVals, cell_head: Read CellHead, cell_start: Read CellStart,
     cell_key: Read CellKey, cluster_placed: ReadWrite ClusterPlaced,
     cluster_quadric: ReadWrite ClusterQuadric);
-pub const CLUSTER_FACES_MARK: CStage = crate::stage!(CBuf; cluster_faces_mark in "cluster/cluster_faces_mark" over Each(Faces);
+pub static CLUSTER_FACES_MARK: CStage = crate::stage!(CBuf; cluster_faces_mark in "cluster/cluster_faces_mark" over Each(Faces);
     cluster: Uniform Cluster, indices: Read Indices, vertex_cell: Read VertexCell,
     face_key: ReadWrite FaceKey, face_keep: ReadWrite FaceKeep,
     bucket_counts: ReadWrite BucketOffsets);
-pub const CLUSTER_FACES_FILL: CStage = crate::stage!(CBuf; cluster_faces_fill in "cluster/cluster_faces_fill" over Each(Faces);
+pub static CLUSTER_FACES_FILL: CStage = crate::stage!(CBuf; cluster_faces_fill in "cluster/cluster_faces_fill" over Each(Faces);
     cluster: Uniform Cluster, face_key: Read FaceKey, face_keep: Read FaceKeep,
     bucket_offsets: Read BucketOffsets, bucket_cursor: ReadWrite BucketCursor,
     bucket_faces: ReadWrite BucketFaces);
-pub const CLUSTER_FACES_DEDUPE: CStage = crate::stage!(CBuf; cluster_faces_dedupe in "cluster/cluster_faces_dedupe" over Each(Vertices);
+pub static CLUSTER_FACES_DEDUPE: CStage = crate::stage!(CBuf; cluster_faces_dedupe in "cluster/cluster_faces_dedupe" over Each(Vertices);
     cluster: Uniform Cluster, face_key: Read FaceKey, bucket_offsets: Read BucketOffsets,
     bucket_faces: ReadWrite BucketFaces, face_keep: ReadWrite FaceKeep);
-pub const CLUSTER_FACES_COMPACT: CStage = crate::stage!(CBuf; cluster_faces_compact in "cluster/cluster_faces_compact" over Each(Faces);
+pub static CLUSTER_FACES_COMPACT: CStage = crate::stage!(CBuf; cluster_faces_compact in "cluster/cluster_faces_compact" over Each(Faces);
     cluster: Uniform Cluster, face_key: Read FaceKey, face_keep: Read FaceKeep,
     cluster_faces: ReadWrite ClusterFaces, face_origin: ReadWrite FaceOrigin);
 
-pub const CLUSTER_MESH: CStage = crate::stage!(CBuf; cluster_mesh in "cluster/cluster_mesh" over Each(Vertices);
+pub static CLUSTER_MESH: CStage = crate::stage!(CBuf; cluster_mesh in "cluster/cluster_mesh" over Each(Vertices);
     cluster: Uniform Cluster, cell_head: Read CellHead, cluster_placed: Read ClusterPlaced,
     mesh_positions: ReadWrite MeshPositions);
-pub const FC_GRADES: CStage = crate::stage!(CBuf; fc_grades in "cluster/fc_grades" over Each(Vertices);
+pub static FC_GRADES: CStage = crate::stage!(CBuf; fc_grades in "cluster/fc_grades" over Each(Vertices);
     params: Uniform Params, positions: Read Positions, indices: Read Indices,
     offsets: Read Offsets, vertex_faces: Read VertexFaces, fc_grade: ReadWrite FcGrade);
-pub const FC_RANKS: CStage = crate::stage!(CBuf; fc_ranks in "cluster/fc_ranks" over Each(Vertices);
+pub static FC_RANKS: CStage = crate::stage!(CBuf; fc_ranks in "cluster/fc_ranks" over Each(Vertices);
     params: Uniform Params, fc_grade: Read FcGrade, fc_rank: ReadWrite FcRank,
     sort_keys: ReadWrite SortKeys, sort_vals: ReadWrite SortVals);
-pub const FC_KEYS: CStage = crate::stage!(CBuf; fc_keys in "cluster/fc_keys" over Each(Vertices);
+pub static FC_KEYS: CStage = crate::stage!(CBuf; fc_keys in "cluster/fc_keys" over Each(Vertices);
     cluster: Uniform Cluster, positions: Read Positions, fc_order: Read FcOrder,
     sort_keys: ReadWrite SortKeys, sort_vals: ReadWrite SortVals);
-pub const FC_INIT: CStage = crate::stage!(CBuf; fc_init in "cluster/fc_init" over Each(Vertices);
+pub static FC_INIT: CStage = crate::stage!(CBuf; fc_init in "cluster/fc_init" over Each(Vertices);
     cluster: Uniform Cluster, locked: Read Locked, fc_centre: ReadWrite FcCentre,
     fc_head: ReadWrite FcHead);
-pub const FC_DECIDE: CStage = crate::stage!(CBuf; fc_decide in "cluster/fc_decide" over Each(Vertices);
+pub static FC_DECIDE: CStage = crate::stage!(CBuf; fc_decide in "cluster/fc_decide" over Each(Vertices);
     cluster: Uniform Cluster, floating: Uniform Floating, positions: Read Positions,
     fc_rank: Read FcRank, sort_vals: Read SortVals, cell_head: Read CellHead,
     cell_start: Read CellStart, cell_key: Read CellKey, fc_centre: Read FcCentre,
     fc_decided: ReadWrite FcDecided, fc_live: ReadWrite FcLive);
-pub const FC_CLAIM: CStage = crate::stage!(CBuf; fc_claim in "cluster/fc_claim" over Each(Vertices);
+pub static FC_CLAIM: CStage = crate::stage!(CBuf; fc_claim in "cluster/fc_claim" over Each(Vertices);
     cluster: Uniform Cluster, floating: Uniform Floating, positions: Read Positions,
     sort_vals: Read SortVals, cell_head: Read CellHead, cell_start: Read CellStart,
     cell_key: Read CellKey, fc_decided: Read FcDecided, fc_centre: ReadWrite FcCentre,
     fc_head: ReadWrite FcHead);
-pub const FC_CLUSTER_KEYS: CStage = crate::stage!(CBuf; fc_cluster_keys in "cluster/fc_cluster_keys" over Each(Vertices);
+pub static FC_CLUSTER_KEYS: CStage = crate::stage!(CBuf; fc_cluster_keys in "cluster/fc_cluster_keys" over Each(Vertices);
     cluster: Uniform Cluster, fc_centre: Read FcCentre, fc_head: Read FcHead,
     sort_keys: ReadWrite SortKeys, sort_vals: ReadWrite SortVals);
-pub const FC_QUADRICS: CStage = crate::stage!(CBuf; fc_quadrics in "cluster/fc_quadrics" over Each(Vertices);
+pub static FC_QUADRICS: CStage = crate::stage!(CBuf; fc_quadrics in "cluster/fc_quadrics" over Each(Vertices);
     cluster: Uniform Cluster, floating: Uniform Floating, positions: Read Positions,
     indices: Read Indices, offsets: Read Offsets, vertex_faces: Read VertexFaces,
     face_normals: Read FaceNormals, locked: Read Locked, fc_centre: Read FcCentre,

@@ -104,13 +104,13 @@ pub use crate::stage;
 #[doc(hidden)]
 macro_rules! shared_stages {
     ($stage:ty, $step:ty, $b:ident, $g:ident, $c:ident) => {
-        pub const PREFIX_SUM_REDUCE: $stage = $crate::compute::schedule::stage!($b;
+        pub static PREFIX_SUM_REDUCE: $stage = $crate::compute::schedule::stage!($b;
             prefix_sum_reduce in "core/prefix_sum" over $g::ScanBlocks;
             scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
-        pub const PREFIX_SUM_SPINE: $stage = $crate::compute::schedule::stage!($b;
+        pub static PREFIX_SUM_SPINE: $stage = $crate::compute::schedule::stage!($b;
             prefix_sum_spine in "core/prefix_sum" over $g::One;
             scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
-        pub const PREFIX_SUM_APPLY: $stage = $crate::compute::schedule::stage!($b;
+        pub static PREFIX_SUM_APPLY: $stage = $crate::compute::schedule::stage!($b;
             prefix_sum_apply in "core/prefix_sum" over $g::ScanBlocks;
             scan: Uniform ScanCount, data: ReadWrite ScanData, block_sums: ReadWrite BlockSums);
         /// The stages every family runs, each once (a family's `STAGES` starts with these).
@@ -126,17 +126,17 @@ macro_rules! shared_stages {
         /// The three passes of a prefix sum, in order.
         pub const PREFIX_SUM: [&$stage; 3] = [&PREFIX_SUM_REDUCE, &PREFIX_SUM_SPINE, &PREFIX_SUM_APPLY];
 
-        pub const ADJACENCY_COUNT: $stage = $crate::compute::schedule::stage!($b;
+        pub static ADJACENCY_COUNT: $stage = $crate::compute::schedule::stage!($b;
             adjacency_count in "core/adjacency_count" over $g::Each($c::Faces);
             params: Uniform Params, indices: Read Indices, counts: ReadWrite Offsets);
-        pub const ADJACENCY_FILL: $stage = $crate::compute::schedule::stage!($b;
+        pub static ADJACENCY_FILL: $stage = $crate::compute::schedule::stage!($b;
             adjacency_fill in "core/adjacency_fill" over $g::Each($c::Faces);
             params: Uniform Params, indices: Read Indices, offsets: Read Offsets,
             cursor: ReadWrite Cursor, vertex_faces: ReadWrite VertexFaces);
-        pub const ADJACENCY_SORT: $stage = $crate::compute::schedule::stage!($b;
+        pub static ADJACENCY_SORT: $stage = $crate::compute::schedule::stage!($b;
             adjacency_sort in "core/adjacency_sort" over $g::Each($c::Vertices);
             params: Uniform Params, offsets: Read Offsets, vertex_faces: ReadWrite VertexFaces);
-        pub const FACE_PLANES: $stage = $crate::compute::schedule::stage!($b;
+        pub static FACE_PLANES: $stage = $crate::compute::schedule::stage!($b;
             face_planes in "core/face_planes" over $g::Each($c::Faces);
             params: Uniform Params, positions: Read Positions, indices: Read Indices,
             face_normals: ReadWrite FaceNormals);

@@ -119,92 +119,92 @@ use Grid::{Each, One, PerEdge, PerLive, PerTentative, VerticesOrFaces};
 // The prefix sum, the vertex→face lists and the face planes: written once for every family.
 crate::compute::schedule::shared_stages!(Stage, Step, Buf, Grid, Count);
 
-pub const VERTEX_FLAGS: Stage = crate::stage!(Buf; vertex_flags in "rounds/vertex_flags" over Each(Vertices);
+pub static VERTEX_FLAGS: Stage = crate::stage!(Buf; vertex_flags in "rounds/vertex_flags" over Each(Vertices);
     params: Uniform Params, indices: Read Indices, offsets: Read Offsets,
     vertex_faces: Read VertexFaces, flags: ReadWrite Flags);
-pub const VERTEX_QUADRICS: Stage = crate::stage!(Buf; vertex_quadrics in "rounds/vertex_quadrics" over Each(Vertices);
+pub static VERTEX_QUADRICS: Stage = crate::stage!(Buf; vertex_quadrics in "rounds/vertex_quadrics" over Each(Vertices);
     params: Uniform Params, positions: Read Positions, indices: Read Indices,
     offsets: Read Offsets, vertex_faces: Read VertexFaces, face_normals: Read FaceNormals,
     face_extra: Read FaceExtra, quadrics: ReadWrite Quadrics);
 
-pub const EDGES_COUNT: Stage = crate::stage!(Buf; edges_count in "rounds/edges_count" over Each(Vertices);
+pub static EDGES_COUNT: Stage = crate::stage!(Buf; edges_count in "rounds/edges_count" over Each(Vertices);
     params: Uniform Params, indices: Read Indices, offsets: Read Offsets,
     vertex_faces: Read VertexFaces, edge_counts: ReadWrite EdgeOffsets, remap: ReadWrite Remap,
     neighbours: ReadWrite Neighbours);
-pub const EDGES_FILL: Stage = crate::stage!(Buf; edges_fill in "rounds/edges_fill" over Each(Vertices);
+pub static EDGES_FILL: Stage = crate::stage!(Buf; edges_fill in "rounds/edges_fill" over Each(Vertices);
     params: Uniform Params, offsets: Read Offsets, neighbours: Read Neighbours,
     edge_offsets: Read EdgeOffsets, edges: ReadWrite Edges);
-pub const DISPATCH_ARGS: Stage = crate::stage!(Buf; dispatch_args in "rounds/dispatch_args" over One;
+pub static DISPATCH_ARGS: Stage = crate::stage!(Buf; dispatch_args in "rounds/dispatch_args" over One;
     params: Uniform Params, edge_offsets: Read EdgeOffsets, counters: Read Counters,
     args: ReadWrite Dispatch);
 
-pub const EDGE_ERRORS: Stage = crate::stage!(Buf; edge_errors in "rounds/edge_errors" over PerEdge;
+pub static EDGE_ERRORS: Stage = crate::stage!(Buf; edge_errors in "rounds/edge_errors" over PerEdge;
     params: Uniform Params, positions: Read Positions, quadrics: Read Quadrics, flags: Read Flags,
     indices: Read Indices, offsets: Read Offsets, vertex_faces: Read VertexFaces,
     edges: Read Edges, edge_offsets: Read EdgeOffsets, face_extra: Read FaceExtra,
     candidates: ReadWrite Candidates, edge_state: ReadWrite EdgeState,
     histogram: ReadWrite Histogram, counters: ReadWrite Counters);
-pub const COST_CEILING: Stage = crate::stage!(Buf; cost_ceiling in "rounds/cost_ceiling" over One;
+pub static COST_CEILING: Stage = crate::stage!(Buf; cost_ceiling in "rounds/cost_ceiling" over One;
     params: Uniform Params, histogram: Read Histogram, counters: ReadWrite Counters);
-pub const LIVE_LIST: Stage = crate::stage!(Buf; live_list in "rounds/live_list" over PerEdge;
+pub static LIVE_LIST: Stage = crate::stage!(Buf; live_list in "rounds/live_list" over PerEdge;
     params: Uniform Params, edge_offsets: Read EdgeOffsets, candidates: Read Candidates,
     edge_state: ReadWrite EdgeState, counters: ReadWrite Counters, live: ReadWrite Live);
-pub const EDGE_COSTS: Stage = crate::stage!(Buf; edge_costs in "rounds/edge_costs" over PerLive;
+pub static EDGE_COSTS: Stage = crate::stage!(Buf; edge_costs in "rounds/edge_costs" over PerLive;
     params: Uniform Params, positions: Read Positions, indices: Read Indices,
     offsets: Read Offsets, vertex_faces: Read VertexFaces, face_normals: Read FaceNormals,
     live: Read Live, candidates: ReadWrite Candidates, edge_state: ReadWrite EdgeState,
     counters: ReadWrite Counters);
 
-pub const SELECT_COST: Stage = crate::stage!(Buf; select_cost in "rounds/select_cost" over PerLive;
+pub static SELECT_COST: Stage = crate::stage!(Buf; select_cost in "rounds/select_cost" over PerLive;
     offsets: Read Offsets, vertex_faces: Read VertexFaces, edges: Read Edges, live: Read Live,
     candidates: Read Candidates, vertex_lock: Read VertexLock, counters: Read Counters,
     edge_state: ReadWrite EdgeState, face_best: ReadWrite FaceBest);
-pub const SELECT_ID: Stage = crate::stage!(Buf; select_id in "rounds/select_id" over PerLive;
+pub static SELECT_ID: Stage = crate::stage!(Buf; select_id in "rounds/select_id" over PerLive;
     offsets: Read Offsets, vertex_faces: Read VertexFaces, edges: Read Edges, live: Read Live,
     candidates: Read Candidates, face_best: Read FaceBest, counters: Read Counters,
     edge_state: ReadWrite EdgeState, face_id: ReadWrite FaceId);
-pub const SELECT_WIN: Stage = crate::stage!(Buf; select_win in "rounds/select_win" over PerLive;
+pub static SELECT_WIN: Stage = crate::stage!(Buf; select_win in "rounds/select_win" over PerLive;
     offsets: Read Offsets, vertex_faces: Read VertexFaces, edges: Read Edges, live: Read Live,
     face_id: Read FaceId, edge_state: ReadWrite EdgeState, tentative: ReadWrite Tentative,
     counters: ReadWrite Counters);
-pub const VALIDATE: Stage = crate::stage!(Buf; validate in "rounds/validate" over PerTentative;
+pub static VALIDATE: Stage = crate::stage!(Buf; validate in "rounds/validate" over PerTentative;
     params: Uniform Params, flags: Read Flags, indices: Read Indices, offsets: Read Offsets,
     vertex_faces: Read VertexFaces, edges: Read Edges, tentative: Read Tentative,
     candidates: ReadWrite Candidates, edge_state: ReadWrite EdgeState,
     vertex_lock: ReadWrite VertexLock, counters: ReadWrite Counters);
 
-pub const TRIM_HISTOGRAM: Stage = crate::stage!(Buf; trim_histogram in "rounds/trim_histogram" over PerEdge;
+pub static TRIM_HISTOGRAM: Stage = crate::stage!(Buf; trim_histogram in "rounds/trim_histogram" over PerEdge;
     params: Uniform Params, candidates: Read Candidates, edge_state: Read EdgeState,
     edge_offsets: Read EdgeOffsets, histogram: ReadWrite TrimHistogram);
-pub const TRIM_CEILING: Stage = crate::stage!(Buf; trim_ceiling in "rounds/trim_ceiling" over One;
+pub static TRIM_CEILING: Stage = crate::stage!(Buf; trim_ceiling in "rounds/trim_ceiling" over One;
     params: Uniform Params, histogram: Read TrimHistogram, counters: ReadWrite Counters);
-pub const TRIM_MARK: Stage = crate::stage!(Buf; trim_mark in "rounds/trim_mark" over Each(EdgeSlots);
+pub static TRIM_MARK: Stage = crate::stage!(Buf; trim_mark in "rounds/trim_mark" over Each(EdgeSlots);
     params: Uniform Params, candidates: Read Candidates, edge_state: Read EdgeState,
     edge_offsets: Read EdgeOffsets, counters: Read Counters, marks: ReadWrite Marks);
-pub const TRIM_APPLY: Stage = crate::stage!(Buf; trim_apply in "rounds/trim_apply" over PerEdge;
+pub static TRIM_APPLY: Stage = crate::stage!(Buf; trim_apply in "rounds/trim_apply" over PerEdge;
     params: Uniform Params, candidates: Read Candidates, marks: Read Marks,
     counters: Read Counters, edge_offsets: Read EdgeOffsets, edge_state: ReadWrite EdgeState);
 
-pub const COLLAPSE: Stage = crate::stage!(Buf; collapse in "rounds/collapse" over PerEdge;
+pub static COLLAPSE: Stage = crate::stage!(Buf; collapse in "rounds/collapse" over PerEdge;
     params: Uniform Params, candidates: Read Candidates, edge_state: Read EdgeState,
     edge_offsets: Read EdgeOffsets, indices: Read Indices, offsets: Read Offsets,
     vertex_faces: Read VertexFaces, positions: ReadWrite Positions,
     quadrics: ReadWrite Quadrics, flags: ReadWrite Flags, remap: ReadWrite Remap,
     face_extra: ReadWrite FaceExtra);
-pub const COMPACT_MARK: Stage = crate::stage!(Buf; compact_mark in "rounds/compact_mark" over VerticesOrFaces;
+pub static COMPACT_MARK: Stage = crate::stage!(Buf; compact_mark in "rounds/compact_mark" over VerticesOrFaces;
     params: Uniform Params, indices: Read Indices, remap: Read Remap,
     vertex_keep: ReadWrite VertexKeep, face_keep: ReadWrite FaceKeep);
-pub const COMPACT_VERTICES: Stage = crate::stage!(Buf; compact_vertices in "rounds/compact_vertices" over Each(Vertices);
+pub static COMPACT_VERTICES: Stage = crate::stage!(Buf; compact_vertices in "rounds/compact_vertices" over Each(Vertices);
     params: Uniform Params, vertex_keep: Read VertexKeep, positions: Read Positions,
     quadrics: Read Quadrics, flags: Read Flags, vertex_attr: Read VertexAttr,
     positions_out: ReadWrite PositionsOut, quadrics_out: ReadWrite QuadricsOut,
     flags_out: ReadWrite FlagsOut, vertex_attr_out: ReadWrite VertexAttrOut);
-pub const COMPACT_FACES: Stage = crate::stage!(Buf; compact_faces in "rounds/compact_faces" over Each(Faces);
+pub static COMPACT_FACES: Stage = crate::stage!(Buf; compact_faces in "rounds/compact_faces" over Each(Faces);
     params: Uniform Params, indices: Read Indices, face_normals: Read FaceNormals,
     face_extra: Read FaceExtra, remap: Read Remap, vertex_keep: Read VertexKeep,
     face_keep: Read FaceKeep, indices_out: ReadWrite IndicesOut,
     face_normals_out: ReadWrite FaceNormalsOut, face_extra_out: ReadWrite FaceExtraOut);
-pub const DRAW_ARGS: Stage = crate::stage!(Buf; draw_args in "rounds/draw_args" over One;
+pub static DRAW_ARGS: Stage = crate::stage!(Buf; draw_args in "rounds/draw_args" over One;
     params: Uniform Params, vertex_keep: Read VertexKeep, face_keep: Read FaceKeep,
     counters: ReadWrite Counters, draw: ReadWrite DrawArgs);
 
