@@ -15,27 +15,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     };
     let mut m = meshslim::io::read(std::path::Path::new(&input))?;
-    let bb = m.bounds().ok_or("the mesh has no vertices")?;
-    let colors = m
-        .positions
-        .iter()
-        .map(|p| {
-            // Coordinates in 0..1 over the bounding box.
-            let t: [f32; 3] = std::array::from_fn(|k| {
-                let span = (bb.max[k] - bb.min[k]).max(1e-12);
-                (p[k] - bb.min[k]) / span
-            });
-            // Smooth bands along x, a gradient along y, sharp stripes along z.
-            let band = 0.5 + 0.5 * (t[0] * std::f32::consts::TAU * 3.0).sin();
-            let stripe = if (t[2] * 8.0).floor() as i32 % 2 == 0 {
-                0.9
-            } else {
-                0.1
-            };
-            [band, t[1], stripe, 1.0]
-        })
-        .collect();
-    m.colors = Some(colors);
+    if m.positions.is_empty() {
+        return Err("the mesh has no vertices".into());
+    }
+    meshslim::mesh::paint(&mut m);
     meshslim::io::write(std::path::Path::new(&output), &m)?;
     println!(
         "{input}: {} vertices painted -> {output}",

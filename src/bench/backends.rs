@@ -1,7 +1,7 @@
 //! What the benchmark can run: every backend with its help line, the call that is timed, and the
 //! device that runs it (the CPU's model or the GPU adapter).
 
-use super::peers::{meshopt_simplify, meshopt_simplify_sloppy};
+use super::peers::{meshopt_simplify, meshopt_simplify_sloppy, meshopt_simplify_with_attributes};
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::options::SimplifyOptions;
@@ -124,6 +124,27 @@ pub static BACKENDS: &[BenchBackend] = &[
         band: 0.0,
     },
     BenchBackend {
+        name: "meshopt-attr-0.1",
+        about: "meshoptimizer's simplifyWithAttributes, colours and UVs weighted 0.1",
+        simplify: |m, faces| Ok(meshopt_simplify_with_attributes(m, faces, 0.1)),
+        device: cpu_name,
+        band: 0.0,
+    },
+    BenchBackend {
+        name: "meshopt-attr-0.3",
+        about: "meshoptimizer's simplifyWithAttributes, colours and UVs weighted 0.3",
+        simplify: |m, faces| Ok(meshopt_simplify_with_attributes(m, faces, 0.3)),
+        device: cpu_name,
+        band: 0.0,
+    },
+    BenchBackend {
+        name: "meshopt-attr-1",
+        about: "meshoptimizer's simplifyWithAttributes, colours and UVs weighted 1",
+        simplify: |m, faces| Ok(meshopt_simplify_with_attributes(m, faces, 1.0)),
+        device: cpu_name,
+        band: 0.0,
+    },
+    BenchBackend {
         name: "meshopt-sloppy",
         about: "meshoptimizer's simplifySloppy (vertex clustering, topology not kept)",
         simplify: |m, faces| Ok(meshopt_simplify_sloppy(m, faces)),
@@ -154,13 +175,16 @@ pub fn gpu_name() -> String {
     .clone()
 }
 
-/// Every backend this machine can run: all of [`BACKENDS`], less the GPU ones (`gpu`,
+/// Every backend this machine can run: all of [`BACKENDS`] but the `meshopt-attr-*` ones, less the GPU ones (`gpu`,
 /// `cluster-gpu`) without an adapter.
 pub fn available_backends() -> Vec<&'static BenchBackend> {
     let gpu = crate::gpu::shared().is_ok();
     BACKENDS
         .iter()
         .filter(|b| gpu || !b.name.ends_with("gpu"))
+        // meshoptimizer with attribute weights runs when named: on most inputs (no colours,
+        // no UVs) it is plain `meshopt` again.
+        .filter(|b| !b.name.starts_with("meshopt-attr"))
         .collect()
 }
 

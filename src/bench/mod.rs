@@ -122,6 +122,10 @@ pub fn run(
                     .as_ref()
                     .and_then(|c| c.appearance.as_ref()?.color.as_ref())
                     .map(|s| s.mean);
+                let texture_err = c
+                    .as_ref()
+                    .and_then(|c| c.appearance.as_ref()?.texture.as_ref())
+                    .map(|s| s.mean);
                 let d = c.map(|c| c.distance.two_sided);
                 step();
                 let median_s = median(&times);
@@ -145,6 +149,7 @@ pub fn run(
                     mean_err_rel: d.as_ref().map(|d| d.mean_rel),
                     max_err_rel: d.as_ref().map(|d| d.max_rel),
                     color_err,
+                    texture_err,
                 });
             }
         }

@@ -23,6 +23,49 @@ pub fn meshopt_simplify(mesh: &Mesh, target_faces: usize) -> Mesh {
     })
 }
 
+/// Simplifies with meshoptimizer's `meshopt_simplifyWithAttributes`: the edge collapse with
+/// the vertex colours (RGB) and UVs the mesh has in its quadrics, each weighted by `weight`
+/// (meshoptimizer's own scale: positions are normalized by the mesh's extent). It keeps input
+/// vertices and their attributes. Without colours and UVs this is [`meshopt_simplify`].
+pub fn meshopt_simplify_with_attributes(mesh: &Mesh, target_faces: usize, weight: f32) -> Mesh {
+    let n = mesh.positions.len();
+    let mut stride = 0;
+    if mesh.colors.is_some() {
+        stride += 3;
+    }
+    if mesh.uvs.is_some() {
+        stride += 2;
+    }
+    if stride == 0 {
+        return meshopt_simplify(mesh, target_faces);
+    }
+    let mut attrs = Vec::with_capacity(n * stride);
+    for v in 0..n {
+        if let Some(c) = &mesh.colors {
+            attrs.extend_from_slice(&c[v][..3]);
+        }
+        if let Some(t) = &mesh.uvs {
+            attrs.extend_from_slice(&t[v]);
+        }
+    }
+    let weights = vec![weight; stride];
+    let locks = vec![false; n];
+    with_meshopt(mesh, |indices, vertices| {
+        meshopt::simplify_with_attributes_and_locks(
+            indices,
+            vertices,
+            &attrs,
+            &weights,
+            stride * std::mem::size_of::<f32>(),
+            &locks,
+            target_faces * 3,
+            1.0,
+            meshopt::SimplifyOptions::None,
+            None,
+        )
+    })
+}
+
 /// Simplifies with meshoptimizer's `meshopt_simplifySloppy` (vertex clustering on a grid, no
 /// topology kept) to about `target_faces`: the throughput end of the scale. The target error
 /// is 1.0 so that the face count alone stops it. Positions only, as [`meshopt_simplify`]; the

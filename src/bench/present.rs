@@ -25,9 +25,10 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
     // The colour column only when some input has colours (attribute-free tables stay as they
     // were).
     let colors = report.rows.iter().any(|r| r.color_err.is_some());
+    let textures = report.rows.iter().any(|r| r.texture_err.is_some());
     writeln!(
         out,
-        "{:<mesh_w$} {:>9} {:>6} {:<backend_w$} {:>9} {:>9} {:>7} {:>8} {:>9} {:>9}{}",
+        "{:<mesh_w$} {:>9} {:>6} {:<backend_w$} {:>9} {:>9} {:>7} {:>8} {:>9} {:>9}{}{}",
         "mesh",
         "faces",
         "ratio",
@@ -38,7 +39,8 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
         "peak MiB",
         "mean err",
         "max err",
-        if colors { "  colour err" } else { "" }
+        if colors { "  colour err" } else { "" },
+        if textures { " texture err" } else { "" }
     )?;
     let opt = |v: Option<f64>, prec: usize, e: bool| match (v, e) {
         (None, _) => "n/a".to_string(),
@@ -48,7 +50,7 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
     for r in &report.rows {
         writeln!(
             out,
-            "{:<mesh_w$} {:>9} {:>6} {:<backend_w$} {:>9} {:>9.4} {:>7.2} {:>8} {:>9} {:>9}{}",
+            "{:<mesh_w$} {:>9} {:>6} {:<backend_w$} {:>9} {:>9.4} {:>7.2} {:>8} {:>9} {:>9}{}{}",
             r.mesh,
             r.input_faces,
             r.ratio,
@@ -65,6 +67,11 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
             opt(r.max_err_rel, 2, true),
             if colors {
                 format!("  {:>10}", opt(r.color_err, 4, false))
+            } else {
+                String::new()
+            },
+            if textures {
+                format!("  {:>10}", opt(r.texture_err, 4, false))
             } else {
                 String::new()
             },
@@ -89,6 +96,13 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
             out,
             "colour err: mean RGB distance (0..1 units) of the vertex colours at the same samples \
              ('meshslim compare'); n/a where the output has no colours"
+        )?;
+    }
+    if textures {
+        writeln!(
+            out,
+            "texture err: mean RGB distance (0..1 units) of the texture's colour at the \
+             interpolated UVs ('meshslim compare --texture'); n/a where the output has no UVs"
         )?;
     }
     if let Some(r) = report.rows.iter().find(|r| r.missed_target) {

@@ -65,6 +65,10 @@ pub struct Row {
     /// and the output both have vertex colours; absent from the JSON otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub color_err: Option<f64>,
+    /// Mean texture-colour deviation at the UVs (`meshslim compare --texture`) when a texture
+    /// was given and the input and the output have UVs; absent from the JSON otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub texture_err: Option<f64>,
 }
 
 /// Everything `meshslim bench` measured; serializes to its JSON.

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use super::builtins::{BUILTIN_PREFIX, BuiltinMesh, parse_builtin};
+use crate::options::AttributeWeights;
 
 /// A mesh to read: a file, or a generated mesh `builtin:NAME[:FACES]`.
 #[derive(Debug, Clone)]
@@ -113,5 +114,36 @@ pub(super) fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
         (Ok(w), Ok(h)) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => Ok((w, h)),
         (Ok(w), Ok(h)) => Err(format!("{w}x{h}: each side must be 1 to 16384 pixels")),
         _ => Err(bad()),
+    }
+}
+
+/// How much appearance counts in the collapse cost (`--method qem`, `--backend cpu`).
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct AttributeArgs {
+    /// Weight of vertex colours in the collapse cost: a colour difference of 1 (black to full
+    /// red) costs like moving the surface by W bounding-box diagonals. Survivors take the best
+    /// colour for their place instead of an endpoint's. 0 lets colours ride along
+    #[arg(long, value_name = "W", default_value_t = AttributeWeights::default().color, value_parser = parse_non_negative, allow_negative_numbers = true, help_heading = "Appearance")]
+    pub color_weight: f64,
+
+    /// Weight of UVs in the collapse cost, as --color-weight (a UV difference of 1 spans the
+    /// texture). A solved UV stays within the range its two endpoints had; seams keep a UV on
+    /// each side. 0 lets UVs ride along
+    #[arg(long, value_name = "W", default_value_t = AttributeWeights::default().uv, value_parser = parse_non_negative, allow_negative_numbers = true, help_heading = "Appearance")]
+    pub uv_weight: f64,
+
+    /// Weight of the input's vertex normals in the collapse cost; above 0 the output keeps the
+    /// solved normals (unit length) instead of making new ones from its faces
+    #[arg(long, value_name = "W", default_value_t = AttributeWeights::default().normal, value_parser = parse_non_negative, allow_negative_numbers = true, help_heading = "Appearance")]
+    pub normal_weight: f64,
+}
+
+impl AttributeArgs {
+    pub fn weights(&self) -> AttributeWeights {
+        AttributeWeights {
+            color: self.color_weight,
+            uv: self.uv_weight,
+            normal: self.normal_weight,
+        }
     }
 }

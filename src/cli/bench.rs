@@ -69,6 +69,11 @@ pub struct BenchArgs {
     /// Seed of the error's sample positions
     #[arg(long, value_name = "S", default_value_t = 1)]
     pub seed: u64,
+
+    /// A PNG or JPEG the meshes' UVs look up: adds a texture-error column (the texture's colour
+    /// at the interpolated UVs, as 'meshslim compare --texture')
+    #[arg(long, value_name = "IMAGE")]
+    pub texture: Option<std::path::PathBuf>,
 }
 
 fn parse_bench_ratio(s: &str) -> std::result::Result<f64, String> {
@@ -149,6 +154,11 @@ pub(super) fn run_bench(args: BenchArgs) -> Result<ExitCode> {
         compare: crate::metrics::CompareOptions {
             samples: args.samples.map(|n| n as usize),
             seed: args.seed,
+            texture: args
+                .texture
+                .as_deref()
+                .map(super::files::load_texture)
+                .transpose()?,
             ..Default::default()
         },
     };

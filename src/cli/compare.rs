@@ -43,6 +43,11 @@ pub struct CompareArgs {
     #[arg(long, value_name = "S", default_value_t = 1)]
     pub seed: u64,
 
+    /// A PNG or JPEG both meshes' UVs look up: adds the texture colour's deviation (RGB
+    /// distance in 0..1 units at the interpolated UVs) to the appearance figures
+    #[arg(long, value_name = "IMAGE")]
+    pub texture: Option<std::path::PathBuf>,
+
     /// Print one JSON object with every figure on stdout
     #[arg(long)]
     pub json: bool,
@@ -57,6 +62,11 @@ pub(super) fn run_compare(args: CompareArgs) -> Result<ExitCode> {
     let opts = crate::metrics::CompareOptions {
         samples: args.samples.map(|n| n as usize),
         seed: args.seed,
+        texture: args
+            .texture
+            .as_deref()
+            .map(super::files::load_texture)
+            .transpose()?,
         ..Default::default()
     };
     let t = Instant::now();

@@ -71,3 +71,21 @@ fn same_file(a: &Path, b: &Path) -> bool {
     }
     false
 }
+
+/// The texture image at `path` (PNG or JPEG) for the appearance measures.
+pub(super) fn load_texture(path: &Path) -> Result<std::sync::Arc<crate::metrics::Texture>> {
+    let img = crate::viewer::scene::read_texture(path)
+        .map_err(lib)
+        .with_context(|| format!("cannot use {} as a texture", path.display()))?;
+    let (w, h) = (img.size.0 as usize, img.size.1 as usize);
+    let rgb = img
+        .rgba
+        .chunks_exact(4)
+        .map(|p| [0, 1, 2].map(|k| f32::from(p[k]) / 255.0))
+        .collect();
+    Ok(std::sync::Arc::new(crate::metrics::Texture {
+        width: w,
+        height: h,
+        rgb,
+    }))
+}

@@ -311,6 +311,7 @@ pub(super) fn write_comparison(
         for (name, s) in [
             ("colour (RGB distance, 0..1)", &look.color),
             ("normals (angle, degrees)", &look.normal_deg),
+            ("texture (RGB at the UVs, 0..1)", &look.texture),
         ] {
             if let Some(s) = s {
                 writeln!(

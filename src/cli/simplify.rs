@@ -84,6 +84,9 @@ pub struct SimplifyArgs {
     #[arg(long, value_name = "W", default_value_t = 1.0, value_parser = parse_non_negative, allow_negative_numbers = true)]
     pub border_weight: f64,
 
+    #[command(flatten)]
+    pub attributes: super::args::AttributeArgs,
+
     /// Refuse a collapse that turns any surrounding face's normal by more than DEG degrees,
     /// in (0, 180]
     #[arg(long = "max-normal-angle", value_name = "DEG", default_value_t = 90.0, value_parser = parse_angle, allow_negative_numbers = true)]
@@ -291,6 +294,7 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     opts.max_error = args.max_error;
     opts.lock_border = args.lock_border;
     opts.border_weight = args.border_weight;
+    opts.attributes = args.attributes.weights();
     opts.max_normal_angle_deg = args.max_normal_angle;
     opts.quality_threshold = args.quality_threshold;
     opts.backend = args.backend.backend();

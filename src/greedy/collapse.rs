@@ -47,6 +47,16 @@ impl<'a> State<'a> {
             }
             moved.push(f);
         }
+        if let Some(at) = self.p.attrs.as_mut() {
+            // Only a survivor that moved takes solved values; one that stays put (a border, a
+            // seam, a pin: a tile's border among them, so tiles still meet) keeps its own.
+            let solve = self.p.mobility[k] == super::prepare::Mobility::Free;
+            for &(from, to) in &c.attr_map {
+                if from != u32::MAX {
+                    at.merge_into(to, from, c.pos, solve);
+                }
+            }
+        }
         let topo_faces = &self.topo_faces;
         self.vert_faces
             .merge_into(k, r, |f| topo_faces[f as usize][0] != DEAD, &moved);

@@ -38,6 +38,15 @@ pub(crate) fn build_output(
     if normals == OutputNormals::Keep {
         out.normals = p.mesh.normals.clone();
     }
+    // Solved normals (a normal weight above zero) are the output's; otherwise they are made
+    // again from the output's faces.
+    let solved_normals = p.attrs.as_ref().is_some_and(|a| a.layout.normal);
+    if solved_normals {
+        out.normals = p.mesh.normals.clone();
+    }
+    if let Some(at) = &p.attrs {
+        at.write(&mut out);
+    }
     for (v, pos) in out.positions.iter_mut().enumerate() {
         let t = p.topo[v] as usize;
         // Only moved vertices go back through the frame: a round trip through f64 could shift
@@ -60,7 +69,7 @@ pub(crate) fn build_output(
         .as_ref()
         .map(|g| live.iter().map(|&f| g[origin(f)]).collect());
     out.remove_unused_vertices();
-    if normals == OutputNormals::Recompute {
+    if normals == OutputNormals::Recompute && !solved_normals {
         out.recompute_normals();
     }
     out

@@ -242,12 +242,33 @@ pub(super) fn partitioned_level(
                 p.border[g] = st.p.border[lt];
             }
         }
+        // Attribute vertices of the region's own vertices: values and sums as solved.
+        if let (Some(whole), Some(local)) = (p.attrs.as_mut(), st.p.attrs.as_ref()) {
+            let (m, s) = (whole.layout.m, whole.layout.stride());
+            for (la, &ga) in st.p.attr_global.iter().enumerate() {
+                if region_of(p.topo[ga as usize]) == r as u32 {
+                    let (la, ga) = (la, ga as usize);
+                    whole.value[ga * m..(ga + 1) * m]
+                        .copy_from_slice(&local.value[la * m..(la + 1) * m]);
+                    whole.sums[ga * s..(ga + 1) * s]
+                        .copy_from_slice(&local.sums[la * s..(la + 1) * s]);
+                }
+            }
+        }
+        let to_whole = |t: [u32; 3]| {
+            if st.p.attr_global.is_empty() {
+                t
+            } else {
+                t.map(|a| st.p.attr_global[a as usize])
+            }
+        };
         for (sf, &alive) in st.face_alive.iter().enumerate() {
-            // A sub-problem's faces carry their attribute vertices of the whole mesh and, as
-            // origin, their index in the whole mesh's face list.
+            // A sub-problem's faces carry their attribute vertices of the whole mesh (or, with
+            // attributes, its own, mapped back) and, as origin, their index in the whole mesh's
+            // face list.
             let gf = st.p.face_origin[sf] as usize;
             if alive && face_region[gf] == r as u32 {
-                faces.push(st.p.faces[sf]);
+                faces.push(to_whole(st.p.faces[sf]));
                 origin.push(p.face_origin[gf]);
                 ref_normal.push(p.ref_normal[gf]);
             }

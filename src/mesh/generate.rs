@@ -349,6 +349,34 @@ pub fn displaced_sphere(min_faces: usize, seed: u64) -> Mesh {
     m
 }
 
+/// Paints `mesh` with vertex colours in the frame of its bounding box: smooth bands along x,
+/// a gradient along y, sharp-edged stripes along z — the painted scans the appearance
+/// measurements and tests use. Same mesh, same colours; nothing for a mesh without vertices.
+pub fn paint(mesh: &mut Mesh) {
+    let Some(bb) = mesh.bounds() else {
+        return;
+    };
+    let colors = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            // Coordinates in 0..1 over the bounding box.
+            let t: [f32; 3] = std::array::from_fn(|k| {
+                let span = (bb.max[k] - bb.min[k]).max(1e-12);
+                (p[k] - bb.min[k]) / span
+            });
+            let band = 0.5 + 0.5 * (t[0] * std::f32::consts::TAU * 3.0).sin();
+            let stripe = if (t[2] * 8.0).floor() as i32 % 2 == 0 {
+                0.9
+            } else {
+                0.1
+            };
+            [band, t[1], stripe, 1.0]
+        })
+        .collect();
+    mesh.colors = Some(colors);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -208,6 +208,34 @@ impl Mesh {
         check_len("normals", self.normals.as_ref().map(Vec::len), n)?;
         check_len("uvs", self.uvs.as_ref().map(Vec::len), n)?;
         check_len("colors", self.colors.as_ref().map(Vec::len), n)?;
+        // Attributes enter the collapse cost: a NaN there would poison every quadric near it.
+        let bad = |name: &str, i: usize, v: &[f32]| {
+            Err(Error::InvalidMesh(format!("vertex {i} has {name} {v:?}")))
+        };
+        if let Some(i) = self
+            .normals
+            .as_ref()
+            .and_then(|a| a.iter().position(|x| !x.iter().all(|c| c.is_finite())))
+        {
+            return bad("a non-finite normal", i, &self.normals.as_ref().unwrap()[i]);
+        }
+        if let Some(i) = self
+            .uvs
+            .as_ref()
+            .and_then(|a| a.iter().position(|x| !x.iter().all(|c| c.is_finite())))
+        {
+            return bad("a non-finite UV", i, &self.uvs.as_ref().unwrap()[i]);
+        }
+        if let Some(i) = self.colors.as_ref().and_then(|a| {
+            a.iter()
+                .position(|x| !x.iter().all(|c| (0.0..=1.0).contains(c)))
+        }) {
+            return bad(
+                "a colour outside 0..1 (or not a number)",
+                i,
+                &self.colors.as_ref().unwrap()[i],
+            );
+        }
         let nf = self.triangles.len();
         check_len(
             "face_materials",

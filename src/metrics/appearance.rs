@@ -14,7 +14,7 @@ use serde::Serialize;
 
 use super::bvh::TriangleBvh;
 use super::distance::AreaSamples;
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, UvOrigin};
 
 /// Samples per parallel task (fixed, so that the sums do not depend on the thread count).
 const CHUNK: usize = 8192;
@@ -42,6 +42,51 @@ pub struct Appearance {
     /// Angle between the vertex normals, degrees.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub normal_deg: Option<AttributeStats>,
+    /// RGB distance of the texture's colour at the interpolated UVs (0..1 channel units), when
+    /// a texture was given and both meshes have UVs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub texture: Option<AttributeStats>,
+}
+
+/// A texture image to look the UVs up in: RGB in 0..1 (the file's own encoding), sampled
+/// bilinearly, repeating outside 0..1 as GPUs do by default.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Texture {
+    pub width: usize,
+    pub height: usize,
+    /// Row-major from the image's top row.
+    pub rgb: Vec<[f32; 3]>,
+}
+
+impl Texture {
+    /// The colour at `uv` of a mesh whose UVs count from `origin`.
+    pub fn sample(&self, uv: [f64; 2], origin: UvOrigin) -> [f64; 3] {
+        let (w, h) = (self.width, self.height);
+        if w == 0 || h == 0 {
+            return [0.0; 3];
+        }
+        let v = match origin {
+            UvOrigin::BottomLeft => 1.0 - uv[1],
+            UvOrigin::TopLeft => uv[1],
+        };
+        // Texel centres at (i + 0.5) / w.
+        let x = uv[0] * w as f64 - 0.5;
+        let y = v * h as f64 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let wrap = |i: f64, n: usize| (i as i64).rem_euclid(n as i64) as usize;
+        let at = |i: f64, j: f64| self.rgb[wrap(j, h) * w + wrap(i, w)].map(f64::from);
+        let (c00, c10, c01, c11) = (
+            at(x0, y0),
+            at(x0 + 1.0, y0),
+            at(x0, y0 + 1.0),
+            at(x0 + 1.0, y0 + 1.0),
+        );
+        [0, 1, 2].map(|k| {
+            (c00[k] * (1.0 - fx) + c10[k] * fx) * (1.0 - fy)
+                + (c01[k] * (1.0 - fx) + c11[k] * fx) * fy
+        })
+    }
 }
 
 /// The appearance difference of B from A at `na` samples of A and `nb` of B (seeded as the
@@ -52,9 +97,10 @@ pub(super) fn appearance(
     (bvh_a, bvh_b): (&TriangleBvh, &TriangleBvh),
     (na, nb): (usize, usize),
     (seed_ab, seed_ba): (u64, u64),
+    texture: Option<&Texture>,
 ) -> Option<Appearance> {
     // Both differences are symmetric, so one function serves both directions.
-    let both = |f: &Diff| {
+    let both = |f: &Diff<'_>| {
         combine(
             one_direction(a, b, bvh_b, na, seed_ab, f),
             one_direction(b, a, bvh_a, nb, seed_ba, f),
@@ -87,7 +133,23 @@ pub(super) fn appearance(
             }
         })
     });
-    (color.is_some() || normal_deg.is_some()).then_some(Appearance { color, normal_deg })
+    let texture = texture
+        .filter(|_| a.uvs.is_some() && b.uvs.is_some())
+        .map(|tex| {
+            both(&|x, fx, wx, y, fy, wy| {
+                let uv = |m: &Mesh, f, w| {
+                    let t = mix(m, f, w, m.uvs.as_deref().unwrap_or_default());
+                    tex.sample(t.map(f64::from), m.uv_origin)
+                };
+                let (cx, cy) = (uv(x, fx, wx), uv(y, fy, wy));
+                DVec3::from_array(cx).distance(DVec3::from_array(cy))
+            })
+        });
+    (color.is_some() || normal_deg.is_some() || texture.is_some()).then_some(Appearance {
+        color,
+        normal_deg,
+        texture,
+    })
 }
 
 /// Sums of one direction: (sum, sum of squares, max, count).
@@ -95,7 +157,7 @@ type Sums = (f64, f64, f64, usize);
 
 /// The difference of an attribute between a point of one mesh (its face and weights) and a
 /// point of the other.
-type Diff = dyn Fn(&Mesh, u32, [f64; 3], &Mesh, u32, [f64; 3]) -> f64 + Sync;
+type Diff<'a> = dyn Fn(&Mesh, u32, [f64; 3], &Mesh, u32, [f64; 3]) -> f64 + Sync + 'a;
 
 /// `n` samples of `x`, each compared by `diff` with `y` at the closest point of its surface
 /// (`y_bvh`).
@@ -105,7 +167,7 @@ fn one_direction(
     y_bvh: &TriangleBvh,
     n: usize,
     seed: u64,
-    diff: &Diff,
+    diff: &Diff<'_>,
 ) -> Sums {
     let samples = AreaSamples::new(x, n, seed);
     let parts: Vec<Sums> = (0..samples.len().div_ceil(CHUNK))

@@ -24,7 +24,7 @@ mod appearance;
 mod bvh;
 mod distance;
 
-pub use appearance::{Appearance, AttributeStats};
+pub use appearance::{Appearance, AttributeStats, Texture};
 pub(crate) use appearance::{mix, weights_at};
 pub use bvh::{Hit, TriangleBvh, point_triangle_dist2};
 pub use distance::DirectionStats;
@@ -49,6 +49,9 @@ pub struct CompareOptions {
     pub seed: u64,
     /// Also measure every vertex and points along every edge (for the maximum).
     pub vertices_and_edges: bool,
+    /// The texture both meshes' UVs look up: adds the texture colour's deviation to the
+    /// appearance.
+    pub texture: Option<std::sync::Arc<Texture>>,
 }
 
 impl Default for CompareOptions {
@@ -57,6 +60,7 @@ impl Default for CompareOptions {
             samples: None,
             seed: 1,
             vertices_and_edges: true,
+            texture: None,
         }
     }
 }
@@ -322,7 +326,14 @@ pub fn compare(a: &Mesh, b: &Mesh, opts: &CompareOptions) -> Result<Comparison> 
         || rayon::join(|| topology(a), || topology(b)),
         || {
             let (bvh_a, bvh_b) = rayon::join(|| TriangleBvh::new(a), || TriangleBvh::new(b));
-            let look = appearance::appearance(a, b, (&bvh_a, &bvh_b), (na, nb), (seed_ab, seed_ba));
+            let look = appearance::appearance(
+                a,
+                b,
+                (&bvh_a, &bvh_b),
+                (na, nb),
+                (seed_ab, seed_ba),
+                opts.texture.as_deref(),
+            );
             let distance = rayon::join(
                 || {
                     distance::one_direction(

@@ -4,6 +4,8 @@
 //! `E(p) = pᵀAp + 2bᵀp + c`, and the summed weight, so that `E / weight` is a mean squared
 //! distance: the simplifier reports `sqrt(E / weight)` as an error in units of length.
 
+pub(crate) mod attributes;
+
 /// A weighted sum of squared distances to planes. All f64: f32 loses the small differences of
 /// large sums on million-triangle meshes.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
