@@ -290,3 +290,42 @@ fn the_command_line_streams_on_request_or_over_the_budget() {
     expect_code(&o, 2);
     assert!(String::from_utf8_lossy(&o.stderr).contains("not a size"));
 }
+
+/// A painted scan streams with its colours: each cluster takes its nearest member's colour,
+/// exactly what the whole-mesh clustering gives without a colour weight; a colour out of range
+/// in the file is an error naming it.
+#[test]
+fn streamed_clustering_carries_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut m = noisy_torus();
+    meshslim::mesh::paint(&mut m);
+    let path = dir.path().join("painted.ply");
+    write(&m, &path, false);
+    let whole = meshslim::io::read(&path).unwrap();
+    let mut o = opts(1000);
+    o.attributes = meshslim::options::AttributeWeights::OFF;
+    let (a, _) = simplify(&whole, &o).unwrap();
+    let (b, _) =
+        simplify_file_in_blocks(&path, Target::Faces(1000), &opts(0), 4096, &mut |_| {}).unwrap();
+    assert_eq!(a.triangles, b.triangles);
+    assert!(a.colors.is_some());
+    assert_eq!(a.colors, b.colors, "the nearest members' colours");
+
+    // Written by hand: the writers refuse such a mesh.
+    let bad_path = dir.path().join("bad.ply");
+    std::fs::write(
+        &bad_path,
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+         property float z\nproperty float red\nproperty float green\nproperty float blue\n\
+         element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+         0 0 0 nan 0 0\n1 0 0 0 0 0\n0 1 0 0 0 0\n3 0 1 2\n",
+    )
+    .unwrap();
+    match simplify_file_in_blocks(&bad_path, Target::Faces(1000), &opts(0), 4096, &mut |_| {}) {
+        Err(e) => assert!(
+            e.to_string().contains("bad.ply") && e.to_string().contains("colour"),
+            "{e}"
+        ),
+        Ok(_) => panic!("a NaN colour was streamed"),
+    }
+}

@@ -25,6 +25,7 @@ fn frames_cover_the_mesh_and_modes_differ() {
     }
     let mut m = meshslim::mesh::noisy_sphere(4, 0.01, 5);
     m.uvs = Some(spherical_uvs(&m.positions));
+    meshslim::mesh::paint(&mut m);
     let mut model = Model::from_mesh("noisy sphere".into(), m).unwrap();
     model.texture = Some(checker(64));
     let size = (160, 120);
@@ -422,4 +423,63 @@ fn the_quality_mode_shows_slivers_red_and_even_faces_blue() {
         p[0] *= 10.0;
     }
     assert!(reddish(flat) > 0.5);
+}
+
+/// The vertex-colour mode draws the colours the simplification solved: a sphere red above and
+/// blue below shows red in the upper half of the picture and blue in the lower, at 20% of its
+/// faces; `--mode color` on a mesh without colours is an error, not a grey picture.
+#[test]
+fn colour_mode_draws_the_vertex_colours() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let mut m = meshslim::mesh::icosphere(4);
+    m.colors = Some(
+        m.positions
+            .iter()
+            .map(|p| {
+                if p[1] > 0.0 {
+                    [0.9, 0.1, 0.1, 1.0]
+                } else {
+                    [0.1, 0.1, 0.9, 1.0]
+                }
+            })
+            .collect(),
+    );
+    let model = Model::from_mesh("two-tone sphere".into(), m.clone()).unwrap();
+    let style = Style {
+        mode: Mode::Color,
+        ..Style::default()
+    };
+    let img = Pixmap::decode_png(&screenshot(&model, 0.2, style, (96, 72)).unwrap().png).unwrap();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let share = |rows: std::ops::Range<usize>, red: bool| {
+        let px: Vec<&[u8]> = rows
+            .flat_map(|y| (0..w).map(move |x| (y * w + x) * 4))
+            .map(|i| &img.data()[i..i + 4])
+            .filter(|p| !is_background(p))
+            .collect();
+        let hit = |p: &&&[u8]| {
+            if red {
+                p[0] > 2 * p[2]
+            } else {
+                p[2] > 2 * p[0]
+            }
+        };
+        px.iter().filter(hit).count() as f64 / px.len().max(1) as f64
+    };
+    // The camera looks a little down on the sphere, so the red cap reaches into the lower
+    // half of the picture; every drawn pixel is one colour or the other, never grey.
+    let (top_red, bottom_blue) = (share(0..h / 2, true), share(h / 2..h, false));
+    let (all_red, all_blue) = (share(0..h, true), share(0..h, false));
+    assert!(
+        top_red > 0.9 && bottom_blue > 0.6 && all_red + all_blue > 0.99,
+        "{top_red:.2} of the upper half red, {bottom_blue:.2} of the lower half blue, \
+         {:.2} of all pixels red or blue",
+        all_red + all_blue
+    );
+    m.colors = None;
+    let plain = Model::from_mesh("sphere".into(), m).unwrap();
+    let err = screenshot(&plain, 0.2, style, (96, 72)).unwrap_err();
+    assert!(err.to_string().contains("no vertex colours"), "{err}");
 }

@@ -173,8 +173,9 @@ fn modes_change_the_frame_and_keys_respect_text_fields() {
     );
     assert_ne!(frames[0], frames[1], "normals look shaded");
     assert_ne!(frames[0], frames[2], "no wireframe drawn");
-    // No texture on this mesh: the texture mode stays off.
+    // No texture and no colours on this mesh: those modes stay off.
     assert!(!h.state().mode_available(Mode::Texture));
+    assert!(!h.state().mode_available(Mode::Color));
 
     // Keys act on the view…
     assert!(!h.state().side_by_side);
@@ -610,4 +611,30 @@ fn manifests_open_into_the_lod_scene_and_the_front_plot() {
         status.contains("builtin:sphere:500") && status.contains("meshslim view"),
         "{status}"
     );
+}
+
+/// A painted mesh opens in the vertex-colour mode; `1` shades it, `6` shows its colours again,
+/// and the two frames differ.
+#[test]
+fn a_coloured_mesh_opens_in_colour_mode() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let mut m = meshslim::mesh::torus(1.0, 0.35, 48, 24);
+    meshslim::mesh::paint(&mut m);
+    let mut h = harness(Model::from_mesh("painted torus".into(), m).unwrap());
+    h.step();
+    assert_eq!(h.state().style.mode, Mode::Color);
+    let coloured = h.state().pane_rgba(0).unwrap().0;
+    h.key_press(egui::Key::Num1);
+    h.step();
+    assert_eq!(h.state().style.mode, Mode::Shaded);
+    assert_ne!(
+        h.state().pane_rgba(0).unwrap().0,
+        coloured,
+        "colours look shaded"
+    );
+    h.key_press(egui::Key::Num6);
+    h.step();
+    assert_eq!(h.state().style.mode, Mode::Color);
 }

@@ -2,11 +2,11 @@
 // read by the vertex shader (vertex pulling: the draw runs one invocation per corner, so a seam
 // vertex can show each side's texture coordinate), plus extras the viewer keeps beside them:
 // per vertex the distance to the original surface (heatmap) and a smooth normal, per corner a
-// texture coordinate. Flat normals come from screen-space derivatives, so the flat modes need
+// texture coordinate and a vertex colour. Flat normals come from screen-space derivatives, so the flat modes need
 // none of the extras; the triangle-quality mode reads each face's three corners in the vertex
 // shader (corner / 3 is the face), so it needs none either.
 // Relies on: the per-vertex extras hold one entry per vertex of the GpuMesh drawn with them and
-// the UVs one per corner (SceneMesh sizes them so), as the indirect draw may reach any corner
+// the UVs and colours one per corner (SceneMesh sizes them so), as the indirect draw may reach any corner
 // and vertex the rounds kept.
 
 // One per drawn instance (dynamic uniform offset). Keep in sync with `ViewUniform` in
@@ -16,7 +16,7 @@ struct View {
     view_proj: mat4x4<f32>,
     // The camera in the mesh's frame, for the headlight.
     eye: vec4<f32>,
-    // x: mode (0 shaded, 1 normals, 2 heatmap, 3 texture, 4 quality), y: error at the top of the colour
+    // x: mode (0 shaded, 1 normals, 2 heatmap, 3 texture, 4 quality, 5 vertex colour), y: error at the top of the colour
     // ramp, z: 1 for smooth shading, w: unused.
     mode: vec4<f32>,
 }
@@ -29,6 +29,7 @@ struct View {
 @group(2) @binding(2) var<storage, read> errors: array<f32>;          // per vertex
 @group(2) @binding(3) var<storage, read> normals: array<f32>;         // per vertex × 3
 @group(2) @binding(4) var<storage, read> uvs: array<vec2<f32>>;       // per corner
+@group(2) @binding(5) var<storage, read> colors: array<u32>;          // per corner, RGBA8
 
 struct VOut {
     @builtin(position) clip: vec4<f32>,
@@ -38,6 +39,7 @@ struct VOut {
     @location(3) uv: vec2<f32>,
     // The face's smallest angle in degrees, the same at its three corners.
     @location(4) @interpolate(flat) min_angle: f32,
+    @location(5) color: vec4<f32>,
 }
 
 // The smallest angle (degrees) of the triangle (a, b, c); 0 for a degenerate one. The frame
@@ -69,6 +71,7 @@ fn vs_main(@builtin(vertex_index) corner: u32) -> VOut {
     o.error = errors[v];
     o.normal = vec3<f32>(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);
     o.uv = uvs[corner];
+    o.color = unpack4x8unorm(colors[corner]);
     let first = corner - corner % 3u;
     o.min_angle = smallest_angle(
         positions[indices[first]].xyz,
@@ -108,6 +111,9 @@ fn fs_main(v: VOut) -> @location(0) vec4<f32> {
     if (mode == 4u) {
         // Red for a sliver, blue for an equilateral face (its smallest angle is 60).
         return vec4<f32>(ramp(1.0 - v.min_angle / 60.0) * light, 1.0);
+    }
+    if (mode == 5u) {
+        return vec4<f32>(v.color.rgb * light, 1.0);
     }
     return vec4<f32>(vec3<f32>(0.82, 0.78, 0.70) * light, 1.0);
 }

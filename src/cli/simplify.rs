@@ -121,8 +121,8 @@ pub struct SimplifyArgs {
     /// Stream the input (a PLY or OBJ file, --method cluster or hybrid): hold its vertices and read
     /// its faces again in blocks at each clustering pass, so memory follows the vertices and
     /// the output, not the faces (hybrid's rounds then run on the clustered mesh). Chosen by
-    /// itself when reading the file whole would take more than --memory. Normals, colours and
-    /// UVs are not carried when streaming
+    /// itself when reading the file whole would take more than --memory. Vertex colours are
+    /// carried (each cluster its nearest member's); normals and UVs are not
     #[arg(long)]
     pub stream: bool,
 

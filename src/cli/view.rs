@@ -63,9 +63,9 @@ pub struct ViewArgs {
     #[arg(long, value_enum, default_value_t = super::simplify::MethodArg::Qem)]
     pub method: super::simplify::MethodArg,
 
-    /// What the surface shows
-    #[arg(long, value_enum, default_value_t = crate::viewer::Mode::Shaded)]
-    pub mode: crate::viewer::Mode,
+    /// What the surface shows [default: color for a mesh with vertex colours, else shaded]
+    #[arg(long, value_enum)]
+    pub mode: Option<crate::viewer::Mode>,
 
     /// Smooth shading (per-vertex normals) instead of flat faces
     #[arg(long)]
@@ -88,8 +88,9 @@ pub struct ViewArgs {
 
 pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     let progress = Progress::new(std::io::stderr().is_terminal());
+    // The window picks colour mode itself for a coloured mesh (and each file opened next).
     let style = crate::viewer::Style {
-        mode: args.mode,
+        mode: args.mode.unwrap_or(crate::viewer::Mode::Shaded),
         smooth: args.smooth,
         wireframe: args.wireframe,
         error_scale: 0.0,
@@ -187,6 +188,14 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     // Before any reading or rendering: a screenshot with nowhere to go fails at once.
     check_directory(&png, "the screenshot's directory")?;
     let model = model(input)?;
+    let style = crate::viewer::Style {
+        mode: args.mode.unwrap_or(if model.mesh.colors.is_some() {
+            crate::viewer::Mode::Color
+        } else {
+            crate::viewer::Mode::Shaded
+        }),
+        ..style
+    };
     let size = args.size.unwrap_or((1024, 768));
     let frame = progress
         .spinner("simplifying and rendering on the GPU".to_string(), || {
@@ -202,7 +211,7 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     crate::io::write_atomic(&png, |w| w.write_all(&frame.png))
         .map_err(lib)
         .context("cannot write the screenshot")?;
-    let heat = if args.mode == crate::viewer::Mode::Heatmap {
+    let heat = if style.mode == crate::viewer::Mode::Heatmap {
         format!(", heatmap red at {:.3e} of the diagonal", frame.max_error)
     } else {
         String::new()

@@ -418,7 +418,7 @@ pub(super) fn floating_on(
         }
         None => None,
     };
-    let (out, _) = output(mesh, work.pts, &built);
+    let (out, _) = output(mesh, work.pts, &built, opts.attributes.color > 0.0);
     report.seconds = t.elapsed().as_secs_f64();
     let report = clustered_report(mesh, opts, backend, &out, &built, stop, report);
     Ok((out, report, drawn))

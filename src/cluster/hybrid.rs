@@ -165,7 +165,7 @@ pub(crate) fn hybrid_upload(
         tally(&mut report, &built);
         report.cell_size = grid.h as f64;
         report.intermediate_faces = Some(built.faces.len());
-        let (clustered, quadrics) = output(mesh, work.pts, &built);
+        let (clustered, quadrics) = output(mesh, work.pts, &built, opts.attributes.color > 0.0);
         let frame = (work.pts.center, work.pts.scale);
         (
             crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics),

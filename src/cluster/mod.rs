@@ -4,10 +4,12 @@
 //! quadric carried over, Garland & Shaffer 2002). Every stage is a map, a sort or a gather
 //! (stages.rs); the grid's size is searched by counting passes (grid.rs).
 //!
-//! Attributes are not kept apart: a cluster's vertex takes the UV, normal and colour of its
-//! member nearest to it, so UV seams inside a cell close (as meshoptimizer's sloppy
-//! simplifier's do). `qem` keeps seams.
+//! Attributes are not kept apart: a cluster's vertex takes the UV and normal of its member
+//! nearest to it, so UV seams inside a cell close (as meshoptimizer's sloppy simplifier's do),
+//! and, with a colour weight above 0, the colour its cell's attribute quadric fits (colors.rs).
+//! `qem` keeps seams.
 
+mod colors;
 pub mod floating;
 // `floating-cell` on the gpu backend: its stages' twins and its build on `gpu::GpuClusterMesh`.
 pub mod floating_gpu;
@@ -450,9 +452,10 @@ fn count_at(probed: &[(f64, f64)], h: f64) -> f64 {
     (a * b).sqrt()
 }
 
-/// What to hand out: the mesh (vertices at the clusters, attributes of the nearest member,
-/// unused clusters dropped) and each output vertex's quadric.
-fn output(mesh: &Mesh, pts: &Points, b: &Built) -> (Mesh, Vec<Quadric>) {
+/// What to hand out: the mesh (vertices at the clusters, attributes of the nearest member or,
+/// with `fit_colors`, colours fitted over the cell; unused clusters dropped) and each output
+/// vertex's quadric.
+fn output(mesh: &Mesh, pts: &Points, b: &Built, fit_colors: bool) -> (Mesh, Vec<Quadric>) {
     let mut id = vec![u32::MAX; b.clusters];
     let mut order = Vec::new();
     for (_, t) in &b.faces {
@@ -485,10 +488,14 @@ fn output(mesh: &Mesh, pts: &Points, b: &Built) -> (Mesh, Vec<Quadric>) {
         .uvs
         .as_ref()
         .map(|n| order.iter().map(|&k| n[src(k)]).collect());
-    out.colors = mesh
-        .colors
-        .as_ref()
-        .map(|n| order.iter().map(|&k| n[src(k)]).collect());
+    out.colors = fit_colors
+        .then(|| colors::cluster_colors(mesh, pts, b, &order))
+        .flatten()
+        .or_else(|| {
+            mesh.colors
+                .as_ref()
+                .map(|n| order.iter().map(|&k| n[src(k)]).collect())
+        });
     out.triangles = b
         .faces
         .iter()
@@ -745,7 +752,7 @@ fn cluster_on(
         }
         None => None,
     };
-    let (out, _) = output(mesh, work.pts, &built);
+    let (out, _) = output(mesh, work.pts, &built, opts.attributes.color > 0.0);
     report.seconds = t.elapsed().as_secs_f64();
     let report = clustered_report(mesh, opts, backend, &out, &built, stop, report);
     Ok((out, report, drawn))

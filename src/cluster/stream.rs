@@ -7,13 +7,15 @@
 //! hybrid splits cells by connectivity with a union-find fed block by block, scatters its
 //! quadrics (no vertex→face lists), then runs the rounds in memory on the clustered mesh.
 //!
-//! Not carried: normals, colours and UVs (they would be held per vertex); the output's vertices
-//! are the clusters' positions. PLY (ascii or binary) and OBJ stream; an OBJ's faces refer to
-//! its positions alone (no seam vertices: nothing is carried that would need them).
+//! Vertex colours are carried (held per vertex, as the positions are): each cluster takes its
+//! nearest member's, as the in-memory clustering without a colour weight does; coloured scans
+//! are the big ones. Not carried: normals and UVs. PLY (ascii or binary) and OBJ stream; an
+//! OBJ's faces refer to its positions alone (no seam vertices: nothing is carried that would
+//! need them).
 
 use super::{Built, ClusterReport, Points, StopReason, cluster_to, max_error, prepare, tally};
 use crate::error::{Error, Result};
-use crate::io::stream::{BLOCK, FileFaces, read_positions};
+use crate::io::stream::{BLOCK, FileFaces, read_vertices};
 use crate::mesh::Mesh;
 use crate::mesh::prepare::denormalize;
 use crate::options::{Backend, Method, SimplifyOptions, SimplifyReport};
@@ -76,7 +78,7 @@ pub fn simplify_file_in_blocks(
         ));
     }
     let t = Instant::now();
-    let positions = read_positions(path)?;
+    let (positions, colors) = read_vertices(path, true)?;
     let vertices = positions.len();
     let mut pts = {
         let m = Mesh {
@@ -121,7 +123,7 @@ pub fn simplify_file_in_blocks(
     opts.cancel.check()?;
     tally(&mut report, &built);
     report.cell_size = grid.h as f64;
-    let (clustered, quadrics) = output(work.pts, &built);
+    let (clustered, quadrics) = output(work.pts, &built, colors.as_deref());
     let built_error = max_error(&built);
     let frame = (work.pts.center, work.pts.scale);
     drop(work);
@@ -181,10 +183,16 @@ struct Counts {
 }
 
 /// The clusters the kept faces use, numbered in order of first use (as the in-memory output),
-/// at their placed positions, and their quadrics.
-fn output(pts: &Points, b: &Built) -> (Mesh, Vec<crate::gpu::types::Quadric>) {
+/// at their placed positions, with their nearest member's colour where the input has colours,
+/// and their quadrics.
+fn output(
+    pts: &Points,
+    b: &Built,
+    colors: Option<&[[f32; 4]]>,
+) -> (Mesh, Vec<crate::gpu::types::Quadric>) {
     let mut id = vec![u32::MAX; b.clusters];
     let mut positions = Vec::new();
+    let mut out_colors = Vec::new();
     let mut quadrics = Vec::new();
     let mut triangles = Vec::with_capacity(b.faces.len());
     for (_, t) in &b.faces {
@@ -193,6 +201,9 @@ fn output(pts: &Points, b: &Built) -> (Mesh, Vec<crate::gpu::types::Quadric>) {
                 id[k as usize] = positions.len() as u32;
                 let p = b.placed[k as usize].pos.map(|x| x as f64);
                 positions.push(denormalize(p, pts.center, pts.scale));
+                if let Some(c) = colors {
+                    out_colors.push(c[pts.attr[b.placed[k as usize].attr as usize] as usize]);
+                }
                 quadrics.push(b.placed[k as usize].quadric);
             }
             id[k as usize]
@@ -201,6 +212,7 @@ fn output(pts: &Points, b: &Built) -> (Mesh, Vec<crate::gpu::types::Quadric>) {
     let mesh = Mesh {
         positions,
         triangles,
+        colors: colors.map(|_| out_colors),
         ..Mesh::default()
     };
     (mesh, quadrics)

@@ -97,24 +97,53 @@ pub fn read_into(path: &Path, sink: &mut dyn Sink) -> Result<()> {
 
 /// The positions of a PLY's or an OBJ's vertices, the faces not read.
 pub fn read_positions(path: &Path) -> Result<Vec<[f32; 3]>> {
-    let mut p = Positions::default();
-    read_into(path, &mut p)?;
-    Ok(p.0)
+    Ok(read_vertices(path, false)?.0)
 }
 
-/// The vertex pass: positions only, the faces not read.
-#[derive(Default)]
-struct Positions(Vec<[f32; 3]>);
+/// Linear RGBA per vertex.
+pub type Colors = Vec<[f32; 4]>;
 
-impl Sink for Positions {
+/// The positions of a PLY's or an OBJ's vertices and, with `colors`, their colours where the
+/// file has them (checked as a whole read checks them: finite and in 0..1); the faces not read.
+pub fn read_vertices(path: &Path, colors: bool) -> Result<(Vec<[f32; 3]>, Option<Colors>)> {
+    let mut p = Vertices {
+        want_colors: colors,
+        ..Vertices::default()
+    };
+    read_into(path, &mut p)?;
+    let mesh = crate::mesh::Mesh {
+        positions: p.positions,
+        colors: p.colors,
+        ..Default::default()
+    };
+    mesh.validate()
+        .map_err(|e| Error::parse(path, crate::error::Location::Unknown, e.to_string()))?;
+    Ok((mesh.positions, mesh.colors))
+}
+
+/// The vertex pass: positions (and colours when wanted), the faces not read.
+#[derive(Default)]
+struct Vertices {
+    want_colors: bool,
+    positions: Vec<[f32; 3]>,
+    colors: Option<Vec<[f32; 4]>>,
+}
+
+impl Sink for Vertices {
     fn wants_faces(&self) -> bool {
         false
     }
-    fn begin_vertices(&mut self, reserve: usize, _: crate::io::sink::VertexAttributes) {
-        self.0.reserve(reserve);
+    fn begin_vertices(&mut self, reserve: usize, a: crate::io::sink::VertexAttributes) {
+        self.positions.reserve(reserve);
+        if self.want_colors && a.colors {
+            self.colors = Some(Vec::with_capacity(reserve));
+        }
     }
     fn vertex(&mut self, v: &Vertex) {
-        self.0.push(v.position);
+        self.positions.push(v.position);
+        if let Some(c) = &mut self.colors {
+            c.push(v.color);
+        }
     }
     fn triangle(&mut self, _: [u32; 3]) {}
 }

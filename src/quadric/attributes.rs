@@ -80,6 +80,20 @@ impl Layout {
         })
     }
 
+    /// `n` colour channels alone, weight 1: for fitting colours without a collapse cost (the
+    /// best values do not depend on the weight).
+    pub(crate) fn colors(n: usize) -> Layout {
+        let mut weight = [0.0; MAX_CHANNELS];
+        weight[..n].fill(1.0);
+        Layout {
+            m: n,
+            color: n,
+            uv: false,
+            normal: false,
+            weight,
+        }
+    }
+
     /// Numbers per attribute vertex in [`Attributes::sums`].
     pub(crate) fn stride(&self) -> usize {
         4 * self.m + 1
@@ -348,7 +362,12 @@ pub(crate) fn hold(q: &Quadric, layout: &Layout, g: &[f64; MAX_STRIDE], values: 
 }
 
 /// The best values of a group's channels at `p`, unweighted; false for a group without area.
-fn optimum_values(layout: &Layout, g: &[f64], p: [f64; 3], out: &mut [f64; MAX_CHANNELS]) -> bool {
+pub(crate) fn optimum_values(
+    layout: &Layout,
+    g: &[f64],
+    p: [f64; 3],
+    out: &mut [f64; MAX_CHANNELS],
+) -> bool {
     let m = layout.m;
     let w = g[4 * m];
     if w.is_nan() || w <= 0.0 {

@@ -376,6 +376,13 @@ impl ViewerApp {
         if self.style.mode == Mode::Texture && !self.renderer.has_texture() {
             self.style.mode = Mode::Shaded;
         }
+        // A painted scan is looked at for its colours: shown by default, and a mesh without
+        // them falls back to shading.
+        match (original.has_colors, self.style.mode) {
+            (true, Mode::Shaded) => self.style.mode = Mode::Color,
+            (false, Mode::Color) => self.style.mode = Mode::Shaded,
+            _ => {}
+        }
         self.save_path = m.path.as_ref().map_or("simplified.ply".into(), |p| {
             let stem = p.file_stem().map_or("mesh".into(), |s| s.to_string_lossy());
             // A glTF is saved as glTF, which keeps its materials and textures; anything else as
@@ -473,6 +480,7 @@ impl ViewerApp {
             Mode::Texture => {
                 self.renderer.has_texture() && self.original.as_ref().is_some_and(|o| o.has_uvs)
             }
+            Mode::Color => self.original.as_ref().is_some_and(|o| o.has_colors),
             _ => true,
         }
     }

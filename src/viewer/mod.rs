@@ -49,7 +49,12 @@ pub fn screenshot_with(
     style: Style,
     size: (u32, u32),
 ) -> Result<Frame> {
-    // Checked before the GPU work: a texture mode without a texture fails at once.
+    // Checked before the GPU work: a texture or colour mode with nothing to show fails at once.
+    if style.mode == Mode::Color && model.mesh.colors.is_none() {
+        return Err(Error::InvalidOption(
+            "--mode color: the mesh has no vertex colours".into(),
+        ));
+    }
     if style.mode == Mode::Texture && !(model.mesh.uvs.is_some() && model.texture.is_some()) {
         return Err(Error::InvalidOption(format!(
             "--mode texture: {}",

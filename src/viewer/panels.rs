@@ -70,9 +70,16 @@ impl ViewerApp {
         if pressed(Key::Enter) {
             self.simplify();
         }
-        for (k, mode) in [Key::Num1, Key::Num2, Key::Num3, Key::Num4, Key::Num5]
-            .into_iter()
-            .zip(Mode::ALL)
+        for (k, mode) in [
+            Key::Num1,
+            Key::Num2,
+            Key::Num3,
+            Key::Num4,
+            Key::Num5,
+            Key::Num6,
+        ]
+        .into_iter()
+        .zip(Mode::ALL)
         {
             if pressed(k) && self.mode_available(mode) {
                 self.style.mode = mode;
@@ -217,6 +224,8 @@ impl ViewerApp {
                             .clone()
                             .unwrap_or_else(|| "the mesh has no UVs or no texture".into()),
                     );
+                } else if !ok && m == Mode::Color {
+                    r.on_disabled_hover_text("the mesh has no vertex colours");
                 }
             }
         });
@@ -488,8 +497,8 @@ pub const HELP: &[(&str, &str)] = &[
     ("F", "frame the mesh"),
     ("R", "reset the view"),
     (
-        "1 2 3 4 5",
-        "shaded, normals, error heatmap, texture, triangle quality",
+        "1 2 3 4 5 6",
+        "shaded, normals, error heatmap, texture, triangle quality, vertex colour",
     ),
     ("M", "smooth / flat shading"),
     ("X", "wireframe overlay"),

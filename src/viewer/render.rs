@@ -24,15 +24,18 @@ pub enum Mode {
     /// Each face's smallest angle, red (0 degrees) to blue (60, equilateral): where a mesh
     /// has slivers, before and after remeshing.
     Quality,
+    /// The mesh's vertex colours (a painted or photographed scan), lit like `shaded`.
+    Color,
 }
 
 impl Mode {
-    pub const ALL: [Mode; 5] = [
+    pub const ALL: [Mode; 6] = [
         Mode::Shaded,
         Mode::Normals,
         Mode::Heatmap,
         Mode::Texture,
         Mode::Quality,
+        Mode::Color,
     ];
     pub fn label(self) -> &'static str {
         match self {
@@ -41,6 +44,7 @@ impl Mode {
             Mode::Heatmap => "error heatmap",
             Mode::Texture => "texture",
             Mode::Quality => "triangle quality",
+            Mode::Color => "vertex colour",
         }
     }
 }
@@ -80,22 +84,33 @@ pub struct SceneMesh {
     pub normals: wgpu::Buffer,
     /// [f32; 2] per corner (3 per face), so that a seam vertex shows each side's own.
     pub uvs: wgpu::Buffer,
+    /// RGBA8 (packed in a u32) per corner, as the UVs.
+    pub colors: wgpu::Buffer,
     pub vertices: usize,
     pub faces: usize,
     pub has_uvs: bool,
+    pub has_colors: bool,
     /// Largest value in `error`.
     pub max_error: f32,
     /// The buffers the vertex shader reads, bound once, on first draw.
     group: std::sync::OnceLock<wgpu::BindGroup>,
 }
 
-/// Extras made on the host: per vertex, except the UVs (per corner).
+/// Extras made on the host: per vertex, except the UVs and colours (per corner).
 #[derive(Debug, Clone, Default)]
 pub struct Extras {
     pub error: Vec<f32>,
     pub normals: Vec<[f32; 3]>,
     /// Per corner (3 per face).
     pub uvs: Option<Vec<[f32; 2]>>,
+    /// Per corner, RGBA8 packed as WGSL's `unpack4x8unorm` reads it ([`pack_color`]).
+    pub colors: Option<Vec<u32>>,
+}
+
+/// A linear RGBA colour in 0..1 as four bytes in a u32, red in the lowest.
+pub fn pack_color(c: [f32; 4]) -> u32 {
+    let b = c.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u32);
+    b[0] | (b[1] << 8) | (b[2] << 16) | (b[3] << 24)
 }
 
 impl SceneMesh {
@@ -119,6 +134,7 @@ impl SceneMesh {
         };
         let max_error = extras.error.iter().fold(0f32, |m, &e| m.max(e));
         let uvs = extras.uvs.as_deref().unwrap_or(&[]);
+        let colors = extras.colors.as_deref().unwrap_or(&[]);
         Ok(SceneMesh {
             error: buf(
                 "meshslim.viewer.vertex_error",
@@ -142,7 +158,17 @@ impl SceneMesh {
                     0
                 },
             )?,
+            colors: buf(
+                "meshslim.viewer.corner_colors",
+                bytemuck::cast_slice(colors),
+                if extras.colors.is_some() {
+                    faces * 3 * 4
+                } else {
+                    0
+                },
+            )?,
             has_uvs: extras.uvs.is_some(),
+            has_colors: extras.colors.is_some(),
             gpu,
             vertices,
             faces,
@@ -310,7 +336,7 @@ impl Target {
 }
 
 /// Storage buffers of one mesh the vertex shader reads (group 2 of shaders/viewer/mesh.wgsl).
-const MESH_BINDINGS: u32 = 5;
+const MESH_BINDINGS: u32 = 6;
 
 /// The mesh pipelines (fill, and wireframe where the device draws line polygons) and the
 /// per-instance uniforms.
@@ -650,6 +676,7 @@ impl Renderer {
                         &mesh.error,
                         &mesh.normals,
                         &mesh.uvs,
+                        &mesh.colors,
                     ];
                     device.create_bind_group(&wgpu::BindGroupDescriptor {
                         label: Some("meshslim.viewer.mesh_buffers"),

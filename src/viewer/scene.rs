@@ -4,7 +4,7 @@
 
 use super::camera::Up;
 use super::front::Front;
-use super::render::{Extras, SceneMesh, vertex_normals};
+use super::render::{Extras, SceneMesh, pack_color, vertex_normals};
 use crate::cluster::gpu::GpuClusterer;
 use crate::error::{Error, Result};
 use crate::gpu::{GpuMesh, GpuRounds, GpuSimplifier};
@@ -204,14 +204,12 @@ impl Model {
     pub fn original(&self, device: &wgpu::Device) -> Result<SceneMesh> {
         let up = &self.up;
         let gpu = GpuMesh::from_arrays(device, &up.positions, &up.indices, up.center, up.scale)?;
-        let uvs = corner_uvs(
-            up,
-            &corner_attributes(&up.flags, &up.vertex_attr, &up.indices, &up.face_extra),
-        );
+        let corners = corner_attributes(&up.flags, &up.vertex_attr, &up.indices, &up.face_extra);
         let extras = Extras {
             error: Vec::new(),
             normals: vertex_normals(&up.positions, &up.indices),
-            uvs,
+            uvs: corner_uvs(up, &corners),
+            colors: corner_colors(&up.welded, corners.iter().copied()),
         };
         SceneMesh::new(device, gpu, up.positions.len(), up.face_count(), &extras)
     }
@@ -250,6 +248,13 @@ impl Model {
 fn corner_uvs(up: &Upload, corner_attr: &[u32]) -> Option<Vec<[f32; 2]>> {
     let uv = up.welded.uvs_from(UvOrigin::BottomLeft)?;
     Some(corner_attr.iter().map(|&a| uv[a as usize]).collect())
+}
+
+/// Each corner's vertex colour, packed for the renderer: that of the vertex of `mesh` each
+/// corner names.
+fn corner_colors(mesh: &Mesh, corners: impl Iterator<Item = u32>) -> Option<Vec<u32>> {
+    let c = mesh.colors.as_ref()?;
+    Some(corners.map(|v| pack_color(c[v as usize])).collect())
 }
 
 /// A glTF material's base colour texture, else the first material library's first `map_Kd`;
@@ -416,7 +421,7 @@ pub fn simplify(
 ) -> Result<Simplified> {
     let t = Instant::now();
     phase(&format!("simplifying ({})", opts.backend.name()));
-    let (gpu, positions, indices, mesh, report, uvs) = match opts.backend {
+    let (gpu, positions, indices, mesh, report, uvs, colors) = match opts.backend {
         Backend::Gpu if opts.method == crate::Method::Qem => {
             let sim = on
                 .rounds
@@ -441,12 +446,11 @@ pub fn simplify(
             // back; what is drawn is the rounds' own buffers.
             let d = rounds.download()?;
             let indices = d.indices.clone();
-            let uvs = corner_uvs(
-                up,
-                &corner_attributes(&d.flags, &d.vertex_attr, &d.indices, &d.face_extra),
-            );
+            let corners = corner_attributes(&d.flags, &d.vertex_attr, &d.indices, &d.face_extra);
+            let uvs = corner_uvs(up, &corners);
+            let colors = corner_colors(&up.welded, corners.iter().copied());
             let gpu = rounds.into_mesh(up)?;
-            (gpu, d.positions, indices, mesh, report, uvs)
+            (gpu, d.positions, indices, mesh, report, uvs, colors)
         }
         Backend::Gpu
             if matches!(
@@ -467,13 +471,15 @@ pub fn simplify(
                     .map(|&v| uv[v as usize])
                     .collect()
             });
-            (drawn.gpu, drawn.positions, drawn.indices, mesh, report, uvs)
+            let colors = corner_colors(&mesh, mesh.triangles.iter().flatten().copied());
+            let (gpu, positions, indices) = (drawn.gpu, drawn.positions, drawn.indices);
+            (gpu, positions, indices, mesh, report, uvs, colors)
         }
         _ => {
             let (mesh, report) =
                 crate::simplify::simplify_with_progress(&model.mesh, opts, progress)?;
             let d = model.upload(device, &mesh)?;
-            (d.gpu, d.positions, d.indices, mesh, report, d.uvs)
+            (d.gpu, d.positions, d.indices, mesh, report, d.uvs, d.colors)
         }
     };
     let seconds = t.elapsed().as_secs_f64();
@@ -482,6 +488,7 @@ pub fn simplify(
         positions,
         indices,
         uvs,
+        colors,
     };
     finish(
         device,
@@ -516,6 +523,7 @@ struct Drawn {
     positions: Vec<[f32; 4]>,
     indices: Vec<u32>,
     uvs: Option<Vec<[f32; 2]>>,
+    colors: Option<Vec<u32>>,
 }
 
 impl Model {
@@ -529,11 +537,13 @@ impl Model {
         let uvs = mesh
             .uvs_from(UvOrigin::BottomLeft)
             .map(|uv| indices.iter().map(|&v| uv[v as usize]).collect());
+        let colors = corner_colors(mesh, indices.iter().copied());
         Ok(Drawn {
             gpu,
             positions,
             indices,
             uvs,
+            colors,
         })
     }
 
@@ -545,6 +555,7 @@ impl Model {
             error: Vec::new(),
             normals: vertex_normals(&d.positions, &d.indices),
             uvs: d.uvs,
+            colors: d.colors,
         };
         SceneMesh::new(
             device,
@@ -575,11 +586,13 @@ fn finish(
         positions,
         indices,
         uvs,
+        colors,
     } = drawn;
     let extras = Extras {
         error: model.errors(&positions),
         normals: vertex_normals(&positions, &indices),
         uvs,
+        colors,
     };
     let scene = SceneMesh::new(device, gpu, positions.len(), indices.len() / 3, &extras)?;
     // The mean and max shown in the window: the same two-sided measure as `meshslim compare`,

@@ -150,7 +150,9 @@ impl ViewerApp {
                     .unwrap_or_default(),
             };
             let mut style = self.style;
-            if style.mode == Mode::Texture && !mesh.is_some_and(|m| m.has_uvs) {
+            if style.mode == Mode::Texture && !mesh.is_some_and(|m| m.has_uvs)
+                || style.mode == Mode::Color && !mesh.is_some_and(|m| m.has_colors)
+            {
                 style.mode = Mode::Shaded;
             }
             // One submission per pane: the renderer's uniforms are written through the queue,

@@ -1,0 +1,74 @@
+//! A cluster's colour from its attribute quadric (Hoppe 1999, as `qem` weighs colours; see
+//! `crate::quadric::attributes`): the faces around the cluster's members each carry the linear
+//! colour function through their corners; their area-weighted least-squares fit, evaluated at
+//! the cluster's position, is the vertex's colour. The nearest member's colour, which clustering
+//! took before, is one sample of that field; the fit is the whole cell's.
+
+use super::{Built, Points};
+use crate::mesh::Mesh;
+use crate::quadric::attributes::{FaceTerms, Layout, MAX_CHANNELS, optimum_values};
+
+/// The colour of each cluster in `order`, or `None` without colours or without faces in memory
+/// (`--stream` reads them a block at a time). A cluster whose faces have no area keeps its
+/// nearest member's colour; solved colours are clamped to 0..1.
+pub(super) fn cluster_colors(
+    mesh: &Mesh,
+    pts: &Points,
+    b: &Built,
+    order: &[u32],
+) -> Option<Vec<[f32; 4]>> {
+    let colors = mesh.colors.as_ref()?;
+    if pts.faces.is_empty() {
+        return None;
+    }
+    let alpha = colors.iter().any(|c| c[3] != 1.0);
+    let layout = Layout::colors(if alpha { 4 } else { 3 });
+    let stride = layout.stride();
+    let at = |i: u32| {
+        let q = pts.positions[i as usize];
+        [q[0], q[1], q[2]].map(f64::from)
+    };
+    let value = |i: u32| colors[pts.attr[i as usize] as usize].map(f64::from);
+    let mut sums = vec![0.0f64; b.clusters * stride];
+    for t in pts.faces.iter() {
+        let p = t.map(at);
+        let v = t.map(value);
+        let Some(ft) = FaceTerms::new(&layout, p, [&v[0], &v[1], &v[2]]) else {
+            continue;
+        };
+        let (e1, e2) = (
+            [0, 1, 2].map(|k| p[1][k] - p[0][k]),
+            [0, 1, 2].map(|k| p[2][k] - p[0][k]),
+        );
+        let c = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        let area = 0.5 * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        for &i in t {
+            let k = b.vertex_cluster[i as usize] as usize;
+            ft.add_to(&mut sums[k * stride..(k + 1) * stride], area);
+        }
+    }
+    Some(
+        order
+            .iter()
+            .map(|&k| {
+                let placed = &b.placed[k as usize];
+                let nearest = colors[pts.attr[placed.attr as usize] as usize];
+                let pos = placed.pos.map(f64::from);
+                let mut best = [0.0; MAX_CHANNELS];
+                let k = k as usize;
+                if !optimum_values(&layout, &sums[k * stride..(k + 1) * stride], pos, &mut best) {
+                    return nearest;
+                }
+                let mut c = nearest;
+                for (out, x) in c.iter_mut().zip(best).take(layout.m) {
+                    *out = (x as f32).clamp(0.0, 1.0);
+                }
+                c
+            })
+            .collect(),
+    )
+}
