@@ -240,3 +240,33 @@ fn bad_attribute_data_is_an_error_naming_the_file() {
         assert!(!err.contains("panicked"), "{name}: {err}");
     }
 }
+
+/// `cluster` fits each cluster's colour over its cell: lower colour error than the nearest
+/// member's (weight 0), the same cells and positions, colours in 0..1, and the same bytes on
+/// one thread as on every core.
+#[test]
+fn clustering_fits_colours_over_the_cell() {
+    let m = painted(mesh::displaced_sphere(60_000, 4));
+    let cluster = |w: AttributeWeights| {
+        let mut o = SimplifyOptions::with_ratio(m.triangles.len(), 0.05).unwrap();
+        o.method = meshslim::Method::Cluster;
+        o.attributes = w;
+        simplify(&m, &o).unwrap().0
+    };
+    let fitted = cluster(AttributeWeights::default());
+    let nearest = cluster(AttributeWeights::OFF);
+    assert_eq!(fitted.positions, nearest.positions);
+    assert_eq!(fitted.triangles, nearest.triangles);
+    let (c_fit, _) = errors(&m, &fitted);
+    let (c_near, _) = errors(&m, &nearest);
+    assert!(c_fit < c_near, "fitted {c_fit:.4}, nearest {c_near:.4}");
+    for c in fitted.colors.as_ref().unwrap() {
+        assert!(c.iter().all(|x| (0.0..=1.0).contains(x)), "{c:?}");
+    }
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| cluster(AttributeWeights::default()));
+    assert_eq!(one, fitted);
+}

@@ -7,6 +7,7 @@
 use super::{Built, Points};
 use crate::mesh::Mesh;
 use crate::quadric::attributes::{FaceTerms, Layout, MAX_CHANNELS, optimum_values};
+use rayon::prelude::*;
 
 /// The colour of each cluster in `order`, or `None` without colours or without faces in memory
 /// (`--stream` reads them a block at a time). A cluster whose faces have no area keeps its
@@ -29,26 +30,47 @@ pub(super) fn cluster_colors(
         [q[0], q[1], q[2]].map(f64::from)
     };
     let value = |i: u32| colors[pts.attr[i as usize] as usize].map(f64::from);
-    let mut sums = vec![0.0f64; b.clusters * stride];
-    for t in pts.faces.iter() {
-        let p = t.map(at);
-        let v = t.map(value);
-        let Some(ft) = FaceTerms::new(&layout, p, [&v[0], &v[1], &v[2]]) else {
-            continue;
-        };
-        let (e1, e2) = (
-            [0, 1, 2].map(|k| p[1][k] - p[0][k]),
-            [0, 1, 2].map(|k| p[2][k] - p[0][k]),
-        );
-        let c = [
-            e1[1] * e2[2] - e1[2] * e2[1],
-            e1[2] * e2[0] - e1[0] * e2[2],
-            e1[0] * e2[1] - e1[1] * e2[0],
-        ];
-        let area = 0.5 * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
-        for &i in t {
-            let k = b.vertex_cluster[i as usize] as usize;
-            ft.add_to(&mut sums[k * stride..(k + 1) * stride], area);
+    // In a fixed number of chunks (from the counts alone, so the sums do not depend on the
+    // thread count), each summing into its own array, added in order: one sequential pass
+    // took 0.08 s on the painted 1M scan, as long as the whole clustering.
+    let faces: &[[u32; 3]] = &pts.faces;
+    let chunks = (faces.len() / (2 * b.clusters).max(1)).clamp(1, 8);
+    let per = faces.len().div_ceil(chunks).max(1);
+    let parts: Vec<Vec<f64>> = faces
+        .par_chunks(per)
+        .map(|part| {
+            let mut sums = vec![0.0f64; b.clusters * stride];
+            for t in part {
+                let p = t.map(at);
+                let v = t.map(value);
+                let Some(ft) = FaceTerms::new(&layout, p, [&v[0], &v[1], &v[2]]) else {
+                    continue;
+                };
+                let (e1, e2) = (
+                    [0, 1, 2].map(|k| p[1][k] - p[0][k]),
+                    [0, 1, 2].map(|k| p[2][k] - p[0][k]),
+                );
+                let c = [
+                    e1[1] * e2[2] - e1[2] * e2[1],
+                    e1[2] * e2[0] - e1[0] * e2[2],
+                    e1[0] * e2[1] - e1[1] * e2[0],
+                ];
+                let area = 0.5 * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+                for &i in t {
+                    let k = b.vertex_cluster[i as usize] as usize;
+                    ft.add_to(&mut sums[k * stride..(k + 1) * stride], area);
+                }
+            }
+            sums
+        })
+        .collect();
+    let mut parts = parts.into_iter();
+    let mut sums = parts
+        .next()
+        .unwrap_or_else(|| vec![0.0; b.clusters * stride]);
+    for part in parts {
+        for (s, x) in sums.iter_mut().zip(part) {
+            *s += x;
         }
     }
     Some(
