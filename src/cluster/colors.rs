@@ -40,12 +40,13 @@ pub(super) fn cluster_colors(
         .par_chunks(per)
         .map(|part| {
             let mut sums = vec![0.0f64; b.clusters * stride];
+            let mut ft = FaceTerms::default();
             for t in part {
                 let p = t.map(at);
                 let v = t.map(value);
-                let Some(ft) = FaceTerms::new(&layout, p, [&v[0], &v[1], &v[2]]) else {
+                if !ft.set(&layout, p, [&v[0], &v[1], &v[2]]) {
                     continue;
-                };
+                }
                 let (e1, e2) = (
                     [0, 1, 2].map(|k| p[1][k] - p[0][k]),
                     [0, 1, 2].map(|k| p[2][k] - p[0][k]),
