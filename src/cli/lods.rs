@@ -79,6 +79,8 @@ pub struct LodsArgs {
     /// Keep border vertices where they are
     #[arg(long)]
     pub lock_border: bool,
+    #[command(flatten)]
+    pub attributes: super::args::AttributeArgs,
     /// The levels' file format (default: the input's; ply for a generated mesh)
     #[arg(long, value_name = "EXT")]
     pub format: Option<String>,
@@ -247,6 +249,7 @@ pub(super) fn run_lods(args: LodsArgs) -> Result<ExitCode> {
     opts.feature_angle_deg = args.feature_angle;
     opts.removal = args.removal.removal();
     opts.lock_border = args.lock_border;
+    opts.attributes = args.attributes.weights();
     let t = Instant::now();
     let (levels, backend) = progress
         .bar("making the levels", |set| {

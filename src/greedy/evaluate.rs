@@ -130,11 +130,7 @@ impl<'a> State<'a> {
     /// `keep`'s attribute vertices (at most [`GROUPS`]; a seam junction with more leaves the
     /// rest out) and which of `remove`'s joins which (`(from, to)` pairs), or `None` when
     /// `remove`'s sides cannot be matched.
-    fn attribute_groups(
-        &self,
-        keep: u32,
-        remove: u32,
-    ) -> Option<SurvivorSides> {
+    fn attribute_groups(&self, keep: u32, remove: u32) -> Option<SurvivorSides> {
         let (k, r) = (keep as usize, remove as usize);
         let map = if self.p.mobility[r] == Mobility::Seam {
             self.seam_slide(remove, keep)?
