@@ -343,3 +343,36 @@ fn a_manifest_that_cannot_be_trusted_is_refused() {
     m.backend = "gpu".into();
     refused(&m, "simplified by cpu");
 }
+
+/// Vertex colours travel through split, simplify and merge: the merged mesh has them, welded
+/// shut, and their error is that of a run that weighs them (well under half of a run that
+/// lets them ride along).
+#[test]
+fn tiles_carry_vertex_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut m = noisy_torus();
+    meshslim::mesh::paint(&mut m);
+    let input = dir.path().join("painted.ply");
+    meshslim::io::write(&input, &m).unwrap();
+    let tiles = dir.path().join("tiles");
+    let man = split(&input, &tiles, &split_opts(4, 0.1), &mut |_| {}).unwrap();
+    for i in 0..man.tiles {
+        simplify_tile(&tiles, i, &mut |_| {}).unwrap();
+    }
+    let (out, _) = merge(&tiles, u64::MAX, &mut |_| {}).unwrap();
+    let topo = meshslim::mesh::topology(&out);
+    assert!(topo.is_closed() && topo.is_manifold(), "{topo:?}");
+    let colors = out.colors.as_ref().expect("the merged mesh has colours");
+    assert!(colors.iter().flatten().all(|x| (0.0..=1.0).contains(x)));
+    let riding = SimplifyOptions {
+        attributes: meshslim::options::AttributeWeights::OFF,
+        ..SimplifyOptions::with_faces(out.triangles.len())
+    };
+    let (plain, _) = simplify(&m, &riding).unwrap();
+    let colour = |o: &Mesh| {
+        let c = meshslim::metrics::compare(&m, o, &Default::default()).unwrap();
+        c.appearance.unwrap().color.unwrap().mean
+    };
+    let (tiled, ridden) = (colour(&out), colour(&plain));
+    assert!(tiled < 0.5 * ridden, "tiled {tiled:.4}, riding {ridden:.4}");
+}

@@ -118,6 +118,8 @@ pub fn welded(dir: &Path) -> Result<Mesh> {
 /// also how many vertices were joined to one of an earlier tile.
 fn weld(dir: &Path, m: &Manifest) -> Result<(Mesh, usize)> {
     let mut out = Mesh::default();
+    // Colours when every tile has them (a split of a coloured scan).
+    let mut colors: Option<Vec<[f32; 4]>> = Some(Vec::new());
     let mut by_gid: FxHashMap<u32, u32> = FxHashMap::default();
     let mut joined = 0;
     for (i, t) in m.tile.iter().enumerate() {
@@ -152,8 +154,23 @@ fn weld(dir: &Path, m: &Manifest) -> Result<(Mesh, usize)> {
                 v
             })
             .collect();
+        // A joined vertex is a pinned border vertex: every tile kept its colour as read.
+        colors = match (colors, &mesh.colors) {
+            (Some(mut all), Some(c)) => {
+                let mut seen = all.len();
+                for (v, &m) in map.iter().enumerate() {
+                    if m as usize == seen {
+                        all.push(c[v]);
+                        seen += 1;
+                    }
+                }
+                Some(all)
+            }
+            _ => None,
+        };
         out.triangles
             .extend(mesh.triangles.iter().map(|t| t.map(|v| map[v as usize])));
     }
+    out.colors = colors.filter(|c| c.len() == out.positions.len());
     Ok((out, joined))
 }

@@ -7,7 +7,7 @@ use super::{FORMAT, Manifest, TILE_SHARE, Tile, at, grid_for};
 use crate::Backend;
 use crate::cluster::stream::Target;
 use crate::error::{Error, Result};
-use crate::io::stream::{FileFaces, read_positions};
+use crate::io::stream::{FileFaces, read_vertices};
 use rustc_hash::FxHashMap;
 use std::io::{BufWriter, Read, Write};
 use std::path::Path;
@@ -87,7 +87,9 @@ pub fn split(
         }
         _ => {}
     }
-    let positions = read_positions(input)?;
+    // Vertex colours travel with the tiles (coloured scans are the big ones): each tile's
+    // simplification weighs them, the pinned borders keep theirs, and the merge joins them.
+    let (positions, colors) = read_vertices(input, true)?;
     let cells = Cells::new(&positions, opts.tiles, opts.after);
     let faces = FileFaces::new(input, opts.block);
     let tile_of = |t: &[u32; 3]| cells.tile(t.map(|v| positions[v as usize]));
@@ -196,15 +198,26 @@ pub fn split(
             write!(
                 w,
                 "ply\nformat binary_little_endian 1.0\ncomment meshslim tile {i} of {}\n\
-                 element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+                 element vertex {}\nproperty float x\nproperty float y\nproperty float z\n{}\
                  element face {}\nproperty list uchar int vertex_indices\nend_header\n",
                 opts.tiles,
                 ids.len(),
+                if colors.is_some() {
+                    "property float red\nproperty float green\nproperty float blue\n\
+                     property float alpha\n"
+                } else {
+                    ""
+                },
                 tile_faces[i]
             )?;
             for &g in &ids {
                 for x in positions[g as usize] {
                     w.write_all(&x.to_le_bytes())?;
+                }
+                if let Some(c) = &colors {
+                    for x in c[g as usize] {
+                        w.write_all(&x.to_le_bytes())?;
+                    }
                 }
             }
             let mut body = std::fs::File::open(part(".faces.part"))?;
