@@ -47,16 +47,8 @@ pub(super) fn cluster_colors(
                 if !ft.set(&layout, p, [&v[0], &v[1], &v[2]]) {
                     continue;
                 }
-                let (e1, e2) = (
-                    [0, 1, 2].map(|k| p[1][k] - p[0][k]),
-                    [0, 1, 2].map(|k| p[2][k] - p[0][k]),
-                );
-                let c = [
-                    e1[1] * e2[2] - e1[2] * e2[1],
-                    e1[2] * e2[0] - e1[0] * e2[2],
-                    e1[0] * e2[1] - e1[1] * e2[0],
-                ];
-                let area = 0.5 * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+                let [p0, p1, p2] = p.map(glam::DVec3::from_array);
+                let area = 0.5 * (p1 - p0).cross(p2 - p0).length();
                 for &i in t {
                     let k = b.vertex_cluster[i as usize] as usize;
                     ft.add_to(&mut sums[k * stride..(k + 1) * stride], area);

@@ -6,6 +6,7 @@ use super::prepare::Mobility;
 use super::queue::key;
 use super::state::{DEAD, State};
 use super::vec::{cross, dot, norm, sub};
+use crate::quadric::Quadric;
 use crate::quadric::attributes::{Attributes, hold, reduce_pair};
 
 /// Attribute vertices of a survivor counted in its collapse cost: a seam vertex has two sides,
@@ -15,6 +16,33 @@ const GROUPS: usize = 4;
 /// A survivor's attribute vertices (the first `.1` of `.0`) and the removed vertex's
 /// `(from, to)` pairs onto them.
 type SurvivorSides = ([u32; GROUPS], usize, [(u32, u32); 2]);
+
+/// Where two free vertices `a` and `b` meet under `q`: its minimum, or where it is ill
+/// conditioned the cheapest of the two ends and the midpoint. The survivor is the endpoint
+/// nearer the new position (with attributes riding along, its values fit best). Returns
+/// (survivor, removed, position, error).
+#[inline(always)]
+fn meet(
+    q: &Quadric,
+    (a, pa): (u32, [f64; 3]),
+    (b, pb): (u32, [f64; 3]),
+) -> (u32, u32, [f64; 3], f64) {
+    let (pos, err) = match q.optimum() {
+        Some(p) => (p, q.eval(p)),
+        None => {
+            let mid = [0, 1, 2].map(|i| 0.5 * (pa[i] + pb[i]));
+            [pa, pb, mid].into_iter().map(|p| (p, q.eval(p))).fold(
+                (mid, f64::INFINITY),
+                |best, c| if c.1 < best.1 { c } else { best },
+            )
+        }
+    };
+    if dot(sub(pos, pa), sub(pos, pa)) <= dot(sub(pos, pb), sub(pos, pb)) {
+        (a, b, pos, err)
+    } else {
+        (b, a, pos, err)
+    }
+}
 
 /// Quality of a triangle as |cross| / longest edge²: 0 for a needle or sliver, √3/2 ≈ 0.866 for
 /// an equilateral triangle (the measure vcglib's quadric collapse uses, so its threshold of 0.3
@@ -90,24 +118,7 @@ impl<'a> State<'a> {
                 at.sums_of(self.p.first_attr[k]),
                 at.sums_of(self.p.first_attr[r]),
             );
-            let (pa, pb) = (self.p.pos[k], self.p.pos[r]);
-            let (pos, err) = match rq.optimum() {
-                Some(p) => (p, rq.eval(p)),
-                None => {
-                    let mid = [0, 1, 2].map(|i| 0.5 * (pa[i] + pb[i]));
-                    [pa, pb, mid].into_iter().map(|p| (p, rq.eval(p))).fold(
-                        (mid, f64::INFINITY),
-                        |best, c| if c.1 < best.1 { c } else { best },
-                    )
-                }
-            };
-            let (keep, remove) =
-                if dot(sub(pos, pa), sub(pos, pa)) <= dot(sub(pos, pb), sub(pos, pb)) {
-                    (keep, remove)
-                } else {
-                    (remove, keep)
-                };
-            return Some((keep, remove, pos, err));
+            return Some(meet(&rq, (keep, self.p.pos[k]), (remove, self.p.pos[r])));
         }
         // A survivor that stays put (a border, a seam, a pin) keeps its values too: a seam's
         // UVs sit on its chart's boundary, and moving them would open the seam in the texture.
@@ -182,26 +193,7 @@ impl<'a> State<'a> {
         let (pa, pb) = (self.p.pos[a as usize], self.p.pos[b as usize]);
         use Mobility::{Free, LockedBorder, Pinned, Seam};
         match (ma, mb) {
-            (Free, Free) => {
-                let (pos, err) = match q.optimum() {
-                    Some(p) => (p, q.eval(p)),
-                    None => {
-                        let mid = [0, 1, 2].map(|i| 0.5 * (pa[i] + pb[i]));
-                        [pa, pb, mid].into_iter().map(|p| (p, q.eval(p))).fold(
-                            (mid, f64::INFINITY),
-                            |best, c| if c.1 < best.1 { c } else { best },
-                        )
-                    }
-                };
-                // The survivor is the endpoint nearer the new position: its attributes fit best.
-                let (keep, remove) =
-                    if dot(sub(pos, pa), sub(pos, pa)) <= dot(sub(pos, pb), sub(pos, pb)) {
-                        (a, b)
-                    } else {
-                        (b, a)
-                    };
-                Some((keep, remove, pos, err))
-            }
+            (Free, Free) => Some(meet(&q, (a, pa), (b, pb))),
             (Pinned | LockedBorder | Seam, Free) => Some((a, b, pa, q.eval(pa))),
             (Free, Pinned | LockedBorder | Seam) => Some((b, a, pb, q.eval(pb))),
             (Pinned, Pinned) => None,
