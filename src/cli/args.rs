@@ -147,3 +147,38 @@ impl AttributeArgs {
         }
     }
 }
+
+/// How `compare` and `bench` sample the distance and the appearance.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SamplingArgs {
+    /// Points sampled on the faces in each direction [default: at least one per face of the
+    /// denser mesh and ten per face of the coarser one]
+    #[arg(short = 'n', long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub samples: Option<u64>,
+
+    /// Seed of the sample positions: the same seed gives the same figures
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    pub seed: u64,
+
+    /// A PNG or JPEG the meshes' UVs look up: adds the texture colour's deviation (RGB
+    /// distance in 0..1 units at the interpolated UVs) to the appearance figures (for 'bench',
+    /// a texture-error column)
+    #[arg(long, value_name = "IMAGE")]
+    pub texture: Option<PathBuf>,
+}
+
+impl SamplingArgs {
+    /// The metrics' options, the texture read.
+    pub fn options(&self) -> anyhow::Result<crate::metrics::CompareOptions> {
+        Ok(crate::metrics::CompareOptions {
+            samples: self.samples.map(|n| n as usize),
+            seed: self.seed,
+            texture: self
+                .texture
+                .as_deref()
+                .map(super::files::load_texture)
+                .transpose()?,
+            ..Default::default()
+        })
+    }
+}

@@ -61,19 +61,8 @@ pub struct BenchArgs {
     #[arg(long, value_name = "FILE.svg|FILE.png")]
     pub plot: Option<PathBuf>,
 
-    /// Points sampled on the faces in each direction for the error [default: as 'meshslim
-    /// compare']
-    #[arg(short = 'n', long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
-    pub samples: Option<u64>,
-
-    /// Seed of the error's sample positions
-    #[arg(long, value_name = "S", default_value_t = 1)]
-    pub seed: u64,
-
-    /// A PNG or JPEG the meshes' UVs look up: adds a texture-error column (the texture's colour
-    /// at the interpolated UVs, as 'meshslim compare --texture')
-    #[arg(long, value_name = "IMAGE")]
-    pub texture: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    pub sampling: super::args::SamplingArgs,
 }
 
 fn parse_bench_ratio(s: &str) -> std::result::Result<f64, String> {
@@ -151,16 +140,7 @@ pub(super) fn run_bench(args: BenchArgs) -> Result<ExitCode> {
             args.backends
         },
         repeat: args.repeat as usize,
-        compare: crate::metrics::CompareOptions {
-            samples: args.samples.map(|n| n as usize),
-            seed: args.seed,
-            texture: args
-                .texture
-                .as_deref()
-                .map(super::files::load_texture)
-                .transpose()?,
-            ..Default::default()
-        },
+        compare: args.sampling.options()?,
     };
     let report = progress
         .bar("benchmarking", |set| {

@@ -34,19 +34,8 @@ pub struct CompareArgs {
     #[arg(value_name = "B", value_parser = parse_input_arg)]
     pub b: Input,
 
-    /// Points sampled on the faces in each direction [default: at least one per face of the
-    /// denser mesh and ten per face of the coarser one]
-    #[arg(short = 'n', long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
-    pub samples: Option<u64>,
-
-    /// Seed of the sample positions: the same seed gives the same figures
-    #[arg(long, value_name = "S", default_value_t = 1)]
-    pub seed: u64,
-
-    /// A PNG or JPEG both meshes' UVs look up: adds the texture colour's deviation (RGB
-    /// distance in 0..1 units at the interpolated UVs) to the appearance figures
-    #[arg(long, value_name = "IMAGE")]
-    pub texture: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    pub sampling: super::args::SamplingArgs,
 
     /// Print one JSON object with every figure on stdout
     #[arg(long)]
@@ -59,16 +48,7 @@ pub(super) fn run_compare(args: CompareArgs) -> Result<ExitCode> {
     let a = load(&args.a, &progress)?;
     let b = load(&args.b, &progress)?;
     let load_s = t.elapsed().as_secs_f64();
-    let opts = crate::metrics::CompareOptions {
-        samples: args.samples.map(|n| n as usize),
-        seed: args.seed,
-        texture: args
-            .texture
-            .as_deref()
-            .map(super::files::load_texture)
-            .transpose()?,
-        ..Default::default()
-    };
+    let opts = args.sampling.options()?;
     let t = Instant::now();
     let c = progress
         .spinner("measuring".to_string(), || {
