@@ -166,19 +166,3 @@ pub struct SamplingArgs {
     #[arg(long, value_name = "IMAGE")]
     pub texture: Option<PathBuf>,
 }
-
-impl SamplingArgs {
-    /// The metrics' options, the texture read.
-    pub fn options(&self) -> anyhow::Result<crate::metrics::CompareOptions> {
-        Ok(crate::metrics::CompareOptions {
-            samples: self.samples.map(|n| n as usize),
-            seed: self.seed,
-            texture: self
-                .texture
-                .as_deref()
-                .map(super::files::load_texture)
-                .transpose()?,
-            ..Default::default()
-        })
-    }
-}

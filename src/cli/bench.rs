@@ -140,7 +140,7 @@ pub(super) fn run_bench(args: BenchArgs) -> Result<ExitCode> {
             args.backends
         },
         repeat: args.repeat as usize,
-        compare: args.sampling.options()?,
+        compare: super::files::compare_options(&args.sampling)?,
     };
     let report = progress
         .bar("benchmarking", |set| {

@@ -48,7 +48,7 @@ pub(super) fn run_compare(args: CompareArgs) -> Result<ExitCode> {
     let a = load(&args.a, &progress)?;
     let b = load(&args.b, &progress)?;
     let load_s = t.elapsed().as_secs_f64();
-    let opts = args.sampling.options()?;
+    let opts = super::files::compare_options(&args.sampling)?;
     let t = Instant::now();
     let c = progress
         .spinner("measuring".to_string(), || {

@@ -89,3 +89,15 @@ pub(super) fn load_texture(path: &Path) -> Result<std::sync::Arc<crate::metrics:
         rgb,
     }))
 }
+
+/// The metrics' options `compare` and `bench` were given, the texture read.
+pub(super) fn compare_options(
+    s: &super::args::SamplingArgs,
+) -> Result<crate::metrics::CompareOptions> {
+    Ok(crate::metrics::CompareOptions {
+        samples: s.samples.map(|n| n as usize),
+        seed: s.seed,
+        texture: s.texture.as_deref().map(load_texture).transpose()?,
+        ..Default::default()
+    })
+}
