@@ -33,9 +33,9 @@ struct Params {
     quality_threshold: f32,
     border_weight: f32,
     max_error2: f32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    attributes: u32,
+    color_weight: f32,
+    _pad: u32,
 }
 
 struct ScanParams {

@@ -97,7 +97,7 @@ fn run(
     match backend {
         Backend::Cpu => crate::greedy::simplify_greedy(mesh, opts, progress),
         Backend::CpuParallel => crate::cpu::simplify_upload(
-            &crate::parallel::Upload::pinned(mesh, &opts.pin),
+            &crate::parallel::Upload::pinned(mesh, &opts.pin).attributes(&opts.attributes),
             mesh,
             opts,
             progress,

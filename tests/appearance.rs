@@ -1,12 +1,13 @@
-//! Appearance attributes in the quadric (`cpu` backend): colours and UVs weighed in the
-//! collapse cost and solved for the survivors, on generated, painted meshes.
+//! Appearance attributes in the quadric (the `cpu` greedy and the rounds of `cpu-parallel`):
+//! colours and UVs weighed in the collapse cost and solved for the survivors, on generated,
+//! painted meshes.
 
 mod common;
 
 use common::*;
 use meshslim::mesh::{self, Mesh};
 use meshslim::metrics::{CompareOptions, compare};
-use meshslim::options::AttributeWeights;
+use meshslim::options::{AttributeWeights, Backend};
 use meshslim::{Error, SimplifyOptions, simplify};
 
 fn painted(mut m: Mesh) -> Mesh {
@@ -21,28 +22,37 @@ fn errors(m: &Mesh, out: &Mesh) -> (f64, f64) {
     (colour, c.distance.two_sided.mean_rel)
 }
 
-fn run(m: &Mesh, ratio: f64, weights: AttributeWeights) -> Mesh {
+fn run_on(backend: Backend, m: &Mesh, ratio: f64, weights: AttributeWeights) -> Mesh {
     let mut opts = SimplifyOptions::with_ratio(m.triangles.len(), ratio).unwrap();
     opts.attributes = weights;
+    opts.backend = backend;
     let (out, report) = simplify(m, &opts).unwrap();
-    check_invariants("painted", m, &out, &report);
+    check_invariants(&format!("painted on {backend:?}"), m, &out, &report);
     out
 }
 
+/// The backends whose collapses weigh appearance: the greedy and the rounds.
+const BACKENDS: [Backend; 2] = [Backend::Cpu, Backend::CpuParallel];
+
 /// On a painted sphere, small (one sequential queue) and large (the partitioned levels), the
-/// colour weight cuts the colour error several times over at a small geometric price; every
-/// solved colour stays in 0..1; the same input gives the same output twice.
+/// colour weight cuts the colour error several times over at a small geometric price, on the
+/// greedy and on the rounds; every solved colour stays in 0..1; the same input gives the same
+/// output twice.
 #[test]
 fn the_colour_weight_keeps_the_painting() {
-    for (name, m) in [
+    for (name, m, b) in [
         ("icosphere 20k", painted(mesh::noisy_sphere(5, 0.002, 7))),
         (
             "displaced 130k",
             painted(mesh::displaced_sphere(130_000, 3)),
         ),
-    ] {
-        let off = run(&m, 0.1, AttributeWeights::OFF);
-        let on = run(&m, 0.1, AttributeWeights::default());
+    ]
+    .into_iter()
+    .flat_map(|(name, m)| BACKENDS.map(|b| (name, m.clone(), b)))
+    {
+        let name = format!("{name} on {b:?}");
+        let off = run_on(b, &m, 0.1, AttributeWeights::OFF);
+        let on = run_on(b, &m, 0.1, AttributeWeights::default());
         assert_eq!(off.triangles.len(), on.triangles.len(), "{name}");
         let (c_off, d_off) = errors(&m, &off);
         let (c_on, d_on) = errors(&m, &on);
@@ -58,7 +68,11 @@ fn the_colour_weight_keeps_the_painting() {
             assert!(c.iter().all(|x| (0.0..=1.0).contains(x)), "{name}: {c:?}");
             assert_eq!(c[3], 1.0, "{name}: alpha was 1 everywhere");
         }
-        assert_eq!(on, run(&m, 0.1, AttributeWeights::default()), "{name}");
+        assert_eq!(
+            on,
+            run_on(b, &m, 0.1, AttributeWeights::default()),
+            "{name}"
+        );
     }
 }
 
@@ -68,12 +82,14 @@ fn the_colour_weight_keeps_the_painting() {
 fn zero_weights_and_attribute_free_meshes_take_the_geometric_path() {
     let plain = mesh::noisy_sphere(4, 0.003, 2);
     let coloured = painted(plain.clone());
-    let a = run(&plain, 0.1, AttributeWeights::default());
-    let b = run(&plain, 0.1, AttributeWeights::OFF);
-    assert_eq!(a, b);
-    let mut c = run(&coloured, 0.1, AttributeWeights::OFF);
-    assert!(c.colors.take().is_some());
-    assert_eq!(c, a);
+    for backend in BACKENDS {
+        let a = run_on(backend, &plain, 0.1, AttributeWeights::default());
+        let b = run_on(backend, &plain, 0.1, AttributeWeights::OFF);
+        assert_eq!(a, b, "{backend:?}");
+        let mut c = run_on(backend, &coloured, 0.1, AttributeWeights::OFF);
+        assert!(c.colors.take().is_some());
+        assert_eq!(c, a, "{backend:?}");
+    }
 }
 
 /// UVs are solved too: on a torus whose UV seam splits its vertices, every output UV lies
@@ -90,18 +106,29 @@ fn uvs_are_solved_within_their_range_and_seams_hold() {
                 [hi[0].max(t[0]), hi[1].max(t[1])],
             )
         });
-    let mut opts = SimplifyOptions::with_ratio(m.triangles.len(), 0.1).unwrap();
-    opts.attributes = AttributeWeights {
-        uv: 1.0,
-        ..AttributeWeights::OFF
-    };
-    let (out, report) = simplify(&m, &opts).unwrap();
-    check_seamed_torus("uv weight 1", &m, &out, &report);
-    for t in out.uvs.as_ref().unwrap() {
-        assert!(
-            (0..2).all(|k| t[k] >= lo[k] && t[k] <= hi[k]),
-            "{t:?} outside {lo:?}..{hi:?}"
-        );
+    for backend in BACKENDS {
+        let mut opts = SimplifyOptions::with_ratio(m.triangles.len(), 0.1).unwrap();
+        opts.attributes = AttributeWeights {
+            uv: 1.0,
+            ..AttributeWeights::OFF
+        };
+        opts.backend = backend;
+        let (out, report) = simplify(&m, &opts).unwrap();
+        check_seamed_torus(&format!("uv weight 1 on {backend:?}"), &m, &out, &report);
+        let moved = out
+            .uvs
+            .as_ref()
+            .unwrap()
+            .iter()
+            .filter(|t| !uvs.contains(t))
+            .count();
+        assert!(moved > 0, "{backend:?}: no UV was solved");
+        for t in out.uvs.as_ref().unwrap() {
+            assert!(
+                (0..2).all(|k| t[k] >= lo[k] && t[k] <= hi[k]),
+                "{backend:?}: {t:?} outside {lo:?}..{hi:?}"
+            );
+        }
     }
 }
 

@@ -2,8 +2,10 @@
 // picks the round's ceiling from. The faces that move (the costly half of an edge's evaluation)
 // wait for edge_costs, which checks only the edges under the ceiling; the topological checks
 // wait for validate. Seam vertices follow the greedy reference's rules (onto_seam, seam_slide);
-// collapse makes the attribute map again from the same faces. Relies on the current CSR face
-// lists and on the seam corners' attribute vertices in face_extra.
+// collapse makes the attribute map again from the same faces. With appearance channels, two
+// free vertices meet where the quadric reduced by their merged attribute sums is least, and a
+// survivor that stays put is charged with its values held (the greedy's placement). Relies on
+// the current CSR face lists and on the seam corners' attribute vertices in face_extra.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;        // per vertex
@@ -15,10 +17,13 @@
 @group(0) @binding(7) var<storage, read> edges: array<vec2<u32>>;            // per edge
 @group(0) @binding(8) var<storage, read> edge_offsets: array<u32>;           // per vertex + 1
 @group(0) @binding(9) var<storage, read> face_extra: array<FaceExtra>;      // per face
-@group(0) @binding(10) var<storage, read_write> candidates: array<EdgeCandidate>; // per edge
-@group(0) @binding(11) var<storage, read_write> edge_state: array<u32>;      // per edge
-@group(0) @binding(12) var<storage, read_write> histogram: array<atomic<u32>>; // HIST_BINS
-@group(0) @binding(13) var<storage, read_write> counters: array<atomic<u32>, 16>;
+@group(0) @binding(10) var<storage, read> vertex_attr: array<u32>;          // per vertex
+@group(0) @binding(11) var<storage, read> attr_values: array<f32>;          // per attribute vertex × m
+@group(0) @binding(12) var<storage, read> attr_sums: array<f32>;            // per attribute vertex × (4m + 1)
+@group(0) @binding(13) var<storage, read_write> candidates: array<EdgeCandidate>; // per edge
+@group(0) @binding(14) var<storage, read_write> edge_state: array<u32>;      // per edge
+@group(0) @binding(15) var<storage, read_write> histogram: array<atomic<u32>>; // HIST_BINS
+@group(0) @binding(16) var<storage, read_write> counters: array<atomic<u32>, 16>;
 
 const VERDICT_INVALID: u32 = 0u;
 const VERDICT_OVER: u32 = 1u;
@@ -83,6 +88,44 @@ fn seam_slide(r: u32, k: u32) -> vec4<u32> {
     return none;
 }
 
+// The quadric q (measured from o) of a survivor k that stays put, with each of its attribute
+// vertices held at its values against its own sums and those of the removed vertex r's side
+// that joins it (map: r's (from, to) pairs as the seam rules gave them; for a free r, its one
+// attribute vertex onto k's on the edge). k's attribute vertices: a seam vertex's corners',
+// each once; any other's one.
+fn held(q: Quadric, k: u32, r: u32, map: vec4<u32>, o: vec3<f32>) -> Quadric {
+    let tk = o - positions[k].xyz;
+    let tr = o - positions[r].xyz;
+    var m = map;
+    if ((flags[r] & FLAG_SEAM) == 0u) {
+        m = vec4<u32>(vertex_attr[r], vertex_attr[k], NO_ATTR, NO_ATTR);
+        if ((flags[k] & FLAG_SEAM) != 0u) { m.y = map.y; }
+    }
+    var h = q;
+    if ((flags[k] & FLAG_SEAM) == 0u) {
+        let kv = vertex_attr[k];
+        h = attr_hold(h, kv, tk, kv);
+        return attr_hold(h, m.x, tr, kv);
+    }
+    let lo = offsets[k];
+    let hi = offsets[k + 1u];
+    for (var i = lo; i < hi; i = i + 1u) {
+        let kv = corner_attr(vertex_faces[i], k);
+        var seen = false;
+        for (var j = lo; j < i; j = j + 1u) {
+            if (corner_attr(vertex_faces[j], k) == kv) { seen = true; break; }
+        }
+        if (seen) { continue; }
+        h = attr_hold(h, kv, tk, kv);
+        if (m.y == kv) {
+            h = attr_hold(h, m.x, tr, kv);
+        } else if (m.w == kv) {
+            h = attr_hold(h, m.z, tr, kv);
+        }
+    }
+    return h;
+}
+
 fn evaluate(a: u32, b: u32) -> Verdict {
     let fla = flags[a];
     let flb = flags[b];
@@ -92,7 +135,8 @@ fn evaluate(a: u32, b: u32) -> Verdict {
     let pa = positions[a].xyz;
     let pb = positions[b].xyz;
     let dab = pb - pa;
-    let q = quadric_add(quadrics[a], quadric_shift(quadrics[b], pa - pb));
+    var q = quadric_add(quadrics[a], quadric_shift(quadrics[b], pa - pb));
+    let weight = q.q2.z;
     var keep = a;
     var remove = b;
     var y = vec3<f32>(0.0);
@@ -116,6 +160,11 @@ fn evaluate(a: u32, b: u32) -> Verdict {
         remove = a;
         y = dab;
     } else {
+        // Two free vertices: with appearance channels, each has one attribute vertex, and the
+        // position and the values come from one solve of the reduced quadric.
+        if (attr_m() != 0u) {
+            q = attr_reduce_pair(q, vertex_attr[a], vec3<f32>(0.0), vertex_attr[b], pa - pb);
+        }
         let opt = quadric_optimum(q);
         if (opt.ok) {
             y = opt.y;
@@ -139,13 +188,15 @@ fn evaluate(a: u32, b: u32) -> Verdict {
         attr_map = onto_seam(keep, remove);
         if (attr_map.y == NO_ATTR) { return invalid(); }
     }
+    if (attr_m() != 0u && (fixed_a || fixed_b)) {
+        q = held(q, keep, remove, attr_map, pa);
+    }
     let error = quadric_eval(q, y);
     // A survivor that keeps its position keeps it bit for bit (pa + (pb - pa) need not be pb):
     // a seam vertex marked moved would leave its other attribute vertices behind.
     var pos = pa + y;
     if ((flags[keep] & (FLAG_PINNED | FLAG_SEAM)) != 0u) { pos = positions[keep].xyz; }
 
-    let weight = q.q2.z;
     var err2 = 0.0;
     if (weight > 0.0) { err2 = error / weight; }
     if (!(is_finite(error) && is_finite(err2) && is_finite(pos.x) && is_finite(pos.y) && is_finite(pos.z))) {

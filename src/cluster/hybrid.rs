@@ -156,7 +156,10 @@ pub(crate) fn hybrid_upload(
     let (up, built_error) = if intermediate as f64 >= HYBRID_SKIP * mesh.triangles.len() as f64
         || opts.target_faces == 0
     {
-        (crate::parallel::Upload::new(mesh), 0.0)
+        (
+            crate::parallel::Upload::new(mesh).attributes(&opts.attributes),
+            0.0,
+        )
     } else {
         let mut pts = Points::new(mesh);
         let mut work = prepare(&mut pts, &opts, true)?;
@@ -168,7 +171,8 @@ pub(crate) fn hybrid_upload(
         let (clustered, quadrics) = output(mesh, work.pts, &built, opts.attributes.color > 0.0);
         let frame = (work.pts.center, work.pts.scale);
         (
-            crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics),
+            crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics)
+                .attributes(&opts.attributes),
             max_error(&built),
         )
     };

@@ -156,7 +156,8 @@ pub fn simplify_file_in_blocks(
     // The hybrid's rounds, in memory on the clustered mesh, from the clusters' quadrics.
     progress(0.5);
     report.intermediate_faces = Some(clustered.triangles.len());
-    let up = crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics);
+    let up = crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics)
+        .attributes(&opts.attributes);
     let opts = &SimplifyOptions {
         target_faces,
         backend: if opts.backend == Backend::Gpu {

@@ -10,6 +10,9 @@ pub const COMMON: &str = include_str!("../../shaders/common.inc.wgsl");
 pub const MESH: &str = include_str!("../../shaders/mesh.inc.wgsl");
 /// Corner attribute accessors, for the rounds' stages that also bind `face_extra`.
 pub const SEAMS: &str = include_str!("../../shaders/rounds/seams.inc.wgsl");
+/// The rounds' appearance channels: their layout, sums and values, for the stages that bind
+/// `attr_values` and `attr_sums`.
+pub const ATTRIBUTES: &str = include_str!("../../shaders/rounds/attributes.inc.wgsl");
 /// The clustering stages' structs and constants, for the stages that bind `ClusterParams` or
 /// `RadixParams`.
 pub const CLUSTER: &str = include_str!("../../shaders/cluster/cluster.inc.wgsl");
@@ -26,6 +29,7 @@ const INCLUDES: &[(&str, &str)] = &[
     ("common.inc", COMMON),
     ("mesh.inc", MESH),
     ("rounds/seams.inc", SEAMS),
+    ("rounds/attributes.inc", ATTRIBUTES),
     ("cluster/cluster.inc", CLUSTER),
     ("cluster/floating.inc", FLOATING),
     ("cluster/floating_cells.inc", FLOATING_CELLS),
@@ -71,9 +75,13 @@ pub const SOURCES: &[Shader] = &[
     stage!("core/face_planes", [COMMON]),
     stage!("rounds/vertex_flags", [COMMON, MESH]),
     stage!("rounds/vertex_quadrics", [COMMON, MESH, SEAMS]),
+    stage!(
+        "rounds/vertex_attributes",
+        [COMMON, MESH, SEAMS, ATTRIBUTES]
+    ),
     stage!("rounds/edges_count", [COMMON, MESH]),
     stage!("rounds/edges_fill", [COMMON]),
-    stage!("rounds/edge_errors", [COMMON, MESH, SEAMS]),
+    stage!("rounds/edge_errors", [COMMON, MESH, SEAMS, ATTRIBUTES]),
     stage!("rounds/live_list", [COMMON]),
     stage!("rounds/edge_costs", [COMMON, MESH]),
     stage!("rounds/cost_ceiling", [COMMON]),
@@ -85,7 +93,7 @@ pub const SOURCES: &[Shader] = &[
     stage!("rounds/trim_ceiling", [COMMON]),
     stage!("rounds/trim_mark", [COMMON]),
     stage!("rounds/trim_apply", [COMMON]),
-    stage!("rounds/collapse", [COMMON, MESH, SEAMS]),
+    stage!("rounds/collapse", [COMMON, MESH, SEAMS, ATTRIBUTES]),
     stage!("rounds/compact_mark", [COMMON]),
     stage!("rounds/compact_vertices", [COMMON]),
     stage!("rounds/compact_faces", [COMMON]),
@@ -131,11 +139,12 @@ pub fn stage_source(path: &str) -> Option<String> {
     shader(path).map(Shader::source)
 }
 
-/// The most storage buffers a stage binds (edge_errors), counted in every stage by a unit test:
-/// a new stage that binds more changes what a device must allow (`Kernels::new` checks each
-/// family's widest stage against the device).
+/// The most storage buffers a stage binds (edge_errors: 13, and 3 more since the rounds carry
+/// appearance channels), counted in every stage by a unit test: a new stage that binds more
+/// changes what a device must allow (`Kernels::new` checks each family's widest stage against
+/// the device; Vulkan drivers for desktop GPUs and lavapipe allow far more, Metal 31).
 #[cfg(test)]
-const MAX_STORAGE_BUFFERS: u32 = 13;
+const MAX_STORAGE_BUFFERS: u32 = 16;
 
 #[cfg(test)]
 mod tests {

@@ -7,6 +7,7 @@
 //! slide along its seam onto a seam neighbour (`collapse` makes the attribute map again from
 //! the same faces).
 
+use super::attributes::Channels;
 use super::common::*;
 use super::edge_costs::{CounterField, counter};
 use super::{corner_attr, face_of, faces_of};
@@ -82,6 +83,67 @@ impl Corners<'_> {
     }
 }
 
+/// The attribute state `placement` reads: per vertex its attribute vertex, per attribute vertex
+/// its values and sums.
+pub struct AttrState<'a> {
+    pub vertex_attr: &'a [u32],
+    pub values: &'a [f32],
+    pub sums: &'a [f32],
+}
+
+impl Corners<'_> {
+    /// Twin of `held` in shaders/rounds/edge_errors.wgsl: the quadric `q` (measured from `o`)
+    /// of survivor `k` that stays put, each of its attribute vertices held at its values against
+    /// its own sums and those of `r`'s side that joins it (`map`: r's (from, to) pairs from the
+    /// seam rules; for a free `r`, its one attribute vertex onto k's on the edge). k's attribute
+    /// vertices: a seam vertex's corners', each once; any other's one.
+    #[allow(clippy::too_many_arguments)]
+    fn held(
+        &self,
+        ch: &Channels,
+        at: &AttrState,
+        positions: &[[f32; 4]],
+        flags: &[u32],
+        q: &Quadric,
+        (k, r): (u32, u32),
+        map: [u32; 4],
+        o: V3,
+    ) -> Quadric {
+        let tk = sub(o, xyz(positions[k as usize]));
+        let tr = sub(o, xyz(positions[r as usize]));
+        let va = at.vertex_attr;
+        let mut m = map;
+        if flags[r as usize] & flag::SEAM == 0 {
+            m = [va[r as usize], va[k as usize], NO_ATTR, NO_ATTR];
+            if flags[k as usize] & flag::SEAM != 0 {
+                m[1] = map[1];
+            }
+        }
+        let hold = |h: &Quadric, x: u32, t: V3, v: u32| ch.hold(at.sums, at.values, h, x, t, v);
+        if flags[k as usize] & flag::SEAM == 0 {
+            let kv = va[k as usize];
+            let h = hold(q, kv, tk, kv);
+            return hold(&h, m[0], tr, kv);
+        }
+        let list = faces_of(self.offsets, self.vertex_faces, k);
+        let attr = |f: u32| corner_attr(self.indices, self.face_extra, f, k);
+        let mut h = *q;
+        for (i, &f) in list.iter().enumerate() {
+            let kv = attr(f);
+            if list[..i].iter().any(|&g| attr(g) == kv) {
+                continue;
+            }
+            h = hold(&h, kv, tk, kv);
+            if m[1] == kv {
+                h = hold(&h, m[0], tr, kv);
+            } else if m[3] == kv {
+                h = hold(&h, m[2], tr, kv);
+            }
+        }
+        h
+    }
+}
+
 /// The survivor, its new position and the quadric error (`cost_bits`; `pos.w` = error relative
 /// to the diagonal, squared). Two pinned ends, and seam vertices other than by the seam rules
 /// (`flag::SEAM`), are refused here; the faces that move are `edge_costs`' to check.
@@ -95,9 +157,11 @@ pub fn placement(
     offsets: &[u32],
     vertex_faces: &[u32],
     face_extra: &[FaceExtra],
+    at: &AttrState,
     a: u32,
     b: u32,
 ) -> Verdict {
+    let ch = Channels::of(params);
     let (fla, flb) = (flags[a as usize], flags[b as usize]);
     let corners = Corners {
         indices,
@@ -111,11 +175,13 @@ pub fn placement(
     let pb = xyz(positions[b as usize]);
     let dab = sub(pb, pa);
     // b's quadric moved to a's origin: x - pb = (x - pa) + (pa - pb).
-    let q = quadric_add(
+    let mut q = quadric_add(
         &quadrics[a as usize],
         &quadric_shift(&quadrics[b as usize], sub(pa, pb)),
     );
+    let weight = q.q[2][2];
     let mut slides = false;
+    let mut map = [NO_ATTR; 4];
     let (keep, remove, y) = if fixed(fla) && fixed(flb) {
         // Only a seam vertex sliding along its seam onto a seam neighbour; b first, as the
         // greedy tries.
@@ -123,9 +189,11 @@ pub fn placement(
             return Verdict::Invalid;
         }
         slides = true;
-        if corners.seam_slide(flags, b, a).is_some() {
+        if let Some(m) = corners.seam_slide(flags, b, a) {
+            map = m;
             (a, b, [0.0; 3])
-        } else if corners.seam_slide(flags, a, b).is_some() {
+        } else if let Some(m) = corners.seam_slide(flags, a, b) {
+            map = m;
             (b, a, dab)
         } else {
             return Verdict::Invalid;
@@ -135,6 +203,19 @@ pub fn placement(
     } else if fixed(flb) {
         (b, a, dab)
     } else {
+        // Two free vertices: with appearance channels, each has one attribute vertex, and the
+        // position and the values come from one solve of the reduced quadric.
+        if ch.m != 0 {
+            let va = at.vertex_attr;
+            q = ch.reduce_pair(
+                at.sums,
+                &q,
+                va[a as usize],
+                [0.0; 3],
+                va[b as usize],
+                sub(pa, pb),
+            );
+        }
         let y = match quadric_optimum(&q) {
             Some(y) => y,
             None => {
@@ -157,11 +238,14 @@ pub fn placement(
             (b, a, y)
         }
     };
-    if flags[keep as usize] & flag::SEAM != 0
-        && !slides
-        && corners.onto_seam(keep, remove).is_none()
-    {
-        return Verdict::Invalid;
+    if flags[keep as usize] & flag::SEAM != 0 && !slides {
+        match corners.onto_seam(keep, remove) {
+            Some(m) => map = m,
+            None => return Verdict::Invalid,
+        }
+    }
+    if ch.m != 0 && (fixed(fla) || fixed(flb)) {
+        q = corners.held(&ch, at, positions, flags, &q, (keep, remove), map, pa);
     }
     let error = quadric_eval(&q, y);
     // A survivor that keeps its position keeps it bit for bit (pa + (pb - pa) need not be pb):
@@ -172,7 +256,6 @@ pub fn placement(
         add(pa, y)
     };
 
-    let weight = q.q[2][2];
     let err2 = if weight > 0.0 { error / weight } else { 0.0 };
     if !(error.is_finite() && err2.is_finite() && pos.iter().all(|x| x.is_finite())) {
         return Verdict::Invalid;
@@ -202,6 +285,9 @@ pub fn edge_errors(
     edges: &[[u32; 2]],               // per edge
     edge_offsets: &[u32],             // per vertex + 1: the edge count at [vertex_count]
     face_extra: &[FaceExtra],         // per face
+    vertex_attr: &[u32],              // per vertex
+    attr_values: &[f32],              // per attribute vertex × m
+    attr_sums: &[f32],                // per attribute vertex × (4m + 1)
     candidates: &mut [EdgeCandidate], // per edge
     edge_state: &mut [u32],           // per edge
     histogram: &[AtomicU32],          // HIST_BINS, cleared
@@ -214,6 +300,11 @@ pub fn edge_errors(
     // a smooth scan falling in a few bins. On the 1M scan at 1% this stage took 1.03-1.13 s
     // with them, 0.45 s without.
     const CHUNK: usize = 1 << 14;
+    let at = AttrState {
+        vertex_attr,
+        values: attr_values,
+        sums: attr_sums,
+    };
     candidates[..ne]
         .par_chunks_mut(CHUNK)
         .zip(edge_state[..ne].par_chunks_mut(CHUNK))
@@ -232,6 +323,7 @@ pub fn edge_errors(
                     offsets,
                     vertex_faces,
                     face_extra,
+                    &at,
                     a,
                     b,
                 );

@@ -8,6 +8,7 @@
 //! comparison.
 
 pub mod adjacency;
+pub mod attributes;
 pub mod collapse;
 pub mod common;
 pub mod compact;
@@ -23,6 +24,7 @@ pub mod select;
 pub mod trim;
 mod twins;
 pub mod validate;
+pub mod vertex_attributes;
 pub mod vertex_flags;
 pub mod vertex_quadrics;
 
@@ -193,6 +195,9 @@ pub struct CpuRounds {
     pub block_sums: Vec<u32>,
     pub counters: Vec<u32>,
     pub draw: DrawArgs,
+    /// Per attribute vertex: weighted appearance values and attribute sums (empty without).
+    pub attr_values: Vec<f32>,
+    pub attr_sums: Vec<f32>,
     /// The indirect grids `dispatch_args` computes (three `(x, y, z, _)`), as the GPU's.
     pub dispatch: [u32; 12],
     out_positions: Vec<[f32; 4]>,
@@ -231,6 +236,8 @@ impl CpuRounds {
             indices: up.indices.clone(),
             face_normals: vec![[0.0; 4]; up.face_extra.len()],
             face_extra: up.face_extra.clone(),
+            attr_values: up.attr_values(),
+            attr_sums: vec![0.0; up.attr_sums_len()],
             selection_passes,
             ..Default::default()
         }
@@ -334,12 +341,18 @@ impl CpuRounds {
         self.run_steps(p, schedule::ADJACENCY)
     }
 
-    /// The first round's set-up: face normals, vertex flags ([`schedule::SETUP`]), and the
-    /// quadrics unless they were carried in ([`schedule::SETUP_QUADRICS`]).
+    /// The first round's set-up: face normals, vertex flags ([`schedule::SETUP`]), the
+    /// quadrics unless they were carried in ([`schedule::SETUP_QUADRICS`]), and the attribute
+    /// quadrics when the round carries appearance channels ([`schedule::SETUP_ATTRIBUTES`]).
     pub fn setup(&mut self, p: &Params) -> Result<()> {
-        self.run_steps(p, schedule::SETUP)?;
-        if !self.carried_quadrics {
-            self.run_steps(p, schedule::SETUP_QUADRICS)?;
+        for (when, steps) in [
+            (When::FirstRound, schedule::SETUP),
+            (When::FirstRoundQuadrics, schedule::SETUP_QUADRICS),
+            (When::FirstRoundAttributes, schedule::SETUP_ATTRIBUTES),
+        ] {
+            if when.runs_once(true, self.carried_quadrics, p) {
+                self.run_steps(p, steps)?;
+            }
         }
         Ok(())
     }
@@ -418,9 +431,7 @@ impl RoundRunner for CpuRounds {
         for &(when, steps) in schedule::ROUND {
             match when {
                 When::EachSelectionPass => self.passes(p, steps, selection)?,
-                w if w.runs_once(first, self.carried_quadrics, p.trim != 0) => {
-                    self.run_steps(p, steps)?
-                }
+                w if w.runs_once(first, self.carried_quadrics, p) => self.run_steps(p, steps)?,
                 _ => {}
             }
         }
@@ -440,6 +451,7 @@ impl RoundRunner for CpuRounds {
             vertex_attr: self.vertex_attr.clone(),
             indices: self.indices.clone(),
             face_extra: self.face_extra.clone(),
+            attr_values: self.attr_values.clone(),
         })
     }
 

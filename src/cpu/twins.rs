@@ -50,6 +50,20 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
             &mut s.quadrics,
         )
     }),
+    (&schedule::VERTEX_ATTRIBUTES, |s, p| {
+        vertex_attributes::vertex_attributes(
+            p,
+            &s.positions,
+            &s.indices,
+            &s.offsets,
+            &s.vertex_faces,
+            &s.face_normals,
+            &s.face_extra,
+            &s.attr_values,
+            &mut s.quadrics,
+            Scatter::new(&mut s.attr_sums),
+        )
+    }),
     (&schedule::EDGES_COUNT, |s, p| {
         let nv = counts(p).0;
         reset(&mut s.edge_offsets, nv + 1);
@@ -101,6 +115,9 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
             &s.edges,
             &s.edge_offsets,
             &s.face_extra,
+            &s.vertex_attr,
+            &s.attr_values,
+            &s.attr_sums,
             &mut s.candidates,
             &mut s.edge_state,
             atomics(&mut s.histogram),
@@ -229,11 +246,14 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
             &s.indices,
             &s.offsets,
             &s.vertex_faces,
+            &s.vertex_attr,
             Scatter::new(&mut s.positions),
             Scatter::new(&mut s.quadrics),
             Scatter::new(&mut s.flags),
             Scatter::new(&mut s.remap),
             Scatter::new(&mut s.face_extra),
+            Scatter::new(&mut s.attr_values),
+            Scatter::new(&mut s.attr_sums),
         )
     }),
     (&schedule::COMPACT_MARK, |s, p| {

@@ -58,7 +58,7 @@ pub fn simplify_with(
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
     let t = std::time::Instant::now();
-    let up = Upload::pinned(mesh, &opts.pin);
+    let up = Upload::pinned(mesh, &opts.pin).attributes(&opts.attributes);
     let prepare = t.elapsed().as_secs_f64();
     let (out, mut rep) = simplify_upload(ctx, sim, &up, mesh, opts, progress)?;
     if let Some(r) = rep.rounds.as_mut() {

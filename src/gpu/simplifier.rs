@@ -175,6 +175,12 @@ pub struct GpuRounds<'a> {
     neighbours: wgpu::Buffer,
     block_sums: wgpu::Buffer,
     counters: wgpu::Buffer,
+    /// Per attribute vertex: weighted appearance values and attribute sums (a word each when
+    /// the rounds carry none: bound, never read).
+    attr_values: wgpu::Buffer,
+    attr_sums: wgpu::Buffer,
+    /// Numbers in `attr_values`, for the read-back.
+    attr_len: u64,
     readback: wgpu::Buffer,
     queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
     /// Stage of each timestamp pair recorded this round.
@@ -298,6 +304,12 @@ impl<'a> GpuRounds<'a> {
             neighbours: mk("neighbours", nf * 24, SU)?,
             block_sums: mk("block_sums", blocks * 4, SU)?,
             counters: mk("counters", COUNTERS_BYTES, SU)?,
+            attr_values: match &up.attrs {
+                Some(a) => init("attr_values", bytemuck::cast_slice(&a.values), SU)?,
+                None => mk("attr_values", 4, SU)?,
+            },
+            attr_sums: mk("attr_sums", (up.attr_sums_len().max(1) * 4) as u64, SU)?,
+            attr_len: up.attrs.as_ref().map_or(0, |a| a.values.len() as u64),
             readback: mk(
                 "readback",
                 COUNTERS_BYTES + QUERY_CAP as u64 * 8,
@@ -498,7 +510,7 @@ impl RoundRunner for GpuRounds<'_> {
                         self.record(&mut enc, p, steps);
                     }
                 }
-                w if w.runs_once(first, self.carried_quadrics, p.trim != 0) => {
+                w if w.runs_once(first, self.carried_quadrics, p) => {
                     self.record(&mut enc, p, steps)
                 }
                 _ => {}
@@ -557,6 +569,9 @@ impl RoundRunner for GpuRounds<'_> {
             vertex_attr: bytemuck::pod_collect_to_vec(&self.read(&h.vertex_attr, nv * 4)?),
             indices: bytemuck::pod_collect_to_vec(&self.read(&h.indices, nf * 12)?),
             face_extra: bytemuck::pod_collect_to_vec(&self.read(&h.face_extra, nf * 16)?),
+            attr_values: bytemuck::pod_collect_to_vec(
+                &self.read(&self.attr_values, self.attr_len * 4)?,
+            ),
         };
         self.transfer_seconds += t.elapsed().as_secs_f64();
         Ok(d)
@@ -620,6 +635,8 @@ impl Runner<Buf, schedule::Grid, Count, RoundStep> for GpuRounds<'_> {
             Buf::Counters => &self.counters,
             Buf::Dispatch => &self.dispatch,
             Buf::DrawArgs => &self.draw_args,
+            Buf::AttrValues => &self.attr_values,
+            Buf::AttrSums => &self.attr_sums,
         }
     }
 

@@ -76,7 +76,30 @@ pub struct Params {
     pub border_weight: f32,
     /// Largest allowed squared collapse error (relative to the diagonal); f32::MAX if none.
     pub max_error2: f32,
-    pub _pad: [u32; 3],
+    /// The appearance channels the rounds carry ([`attr_layout`]): 0 for none.
+    pub attributes: u32,
+    /// The colour channels' weight: a solved colour is clamped to `0..color_weight`, the
+    /// weighted value of 0..1.
+    pub color_weight: f32,
+    pub _pad: u32,
+}
+
+/// [`Params::attributes`]: `m` channels in all (bits 0-3), the first `colors` of them a colour
+/// (bits 4-7), then two UV channels when bit 8 is set, then the normal's three. Twin of
+/// `attr_*` in shaders/rounds/attributes.inc.wgsl.
+pub mod attr_layout {
+    pub fn pack(m: u32, colors: u32, uv: bool) -> u32 {
+        m | (colors << 4) | ((uv as u32) << 8)
+    }
+    pub fn channels(a: u32) -> u32 {
+        a & 0xf
+    }
+    pub fn colors(a: u32) -> u32 {
+        (a >> 4) & 0xf
+    }
+    pub fn uv(a: u32) -> bool {
+        (a >> 8) & 1 != 0
+    }
 }
 
 /// Prefix-sum size, a uniform (one buffer per scan site). Keep in sync with shaders/common.inc.wgsl.

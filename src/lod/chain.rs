@@ -94,7 +94,7 @@ pub fn lod_chain(
             if backend == Backend::Cpu {
                 crate::greedy::chain_greedy(mesh, opts, &targets, progress, &mut level)?;
             } else {
-                let up = Upload::pinned(mesh, &opts.pin);
+                let up = Upload::pinned(mesh, &opts.pin).attributes(&opts.attributes);
                 let o = SimplifyOptions { backend, ..first };
                 chain_rounds(&up, mesh, &o, &targets, 0.0, progress, &mut level)?;
             }

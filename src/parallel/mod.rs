@@ -2,7 +2,10 @@
 //! collapses each round aims for, when it trims to land on the target, why it stops, and how
 //! the result becomes a [`Mesh`] again. The backends only run the stages ([`RoundRunner`]).
 
+pub mod attributes;
 pub mod schedule;
+
+pub use attributes::RoundAttributes;
 
 use crate::error::Result;
 use crate::gpu::types::{Counters, FaceExtra, Params, flag};
@@ -73,6 +76,9 @@ pub struct Upload {
     /// Per class: the quadric carried in (the hybrid method's clusters), relative to the
     /// vertex; `None` computes them in the first round.
     pub quadrics: Option<Vec<crate::gpu::types::Quadric>>,
+    /// The appearance channels carried ([`Upload::attributes`]); `None`: none, and the rounds
+    /// run as without.
+    pub attrs: Option<RoundAttributes>,
 }
 
 /// The attribute vertex (of the welded input) of every corner of the rounds' faces: a seam
@@ -105,9 +111,27 @@ pub struct Download {
     pub vertex_attr: Vec<u32>,
     pub indices: Vec<u32>,
     pub face_extra: Vec<FaceExtra>,
+    /// Per attribute vertex: the weighted appearance values (empty without).
+    pub attr_values: Vec<f32>,
 }
 
 impl Upload {
+    /// This upload carrying the welded input's appearance channels that `w` weighs above zero.
+    pub fn attributes(mut self, w: &crate::options::AttributeWeights) -> Upload {
+        self.attrs = RoundAttributes::new(&self.welded, w);
+        self
+    }
+
+    /// The first round's values of the attribute vertices (empty without channels).
+    pub fn attr_values(&self) -> Vec<f32> {
+        self.attrs.as_ref().map_or(Vec::new(), |a| a.values.clone())
+    }
+
+    /// Numbers of the attribute sums (0 without channels).
+    pub fn attr_sums_len(&self) -> usize {
+        self.attrs.as_ref().map_or(0, |a| a.sums_len())
+    }
+
     pub fn new(input: &Mesh) -> Upload {
         Upload::pinned(input, &[])
     }
@@ -214,6 +238,7 @@ impl Upload {
             dropped_degenerate,
             seams,
             quadrics,
+            attrs: None,
         }
     }
 
@@ -223,7 +248,10 @@ impl Upload {
 
     /// The round parameters common to every round.
     pub fn base_params(&self, opts: &SimplifyOptions) -> Params {
+        let (attributes, color_weight) = self.attrs.as_ref().map_or((0, 0.0), |a| a.params());
         Params {
+            attributes,
+            color_weight,
             vertex_count: self.positions.len() as u32,
             face_count: self.face_count() as u32,
             edge_capacity: 3 * self.face_count() as u32,
@@ -266,6 +294,14 @@ impl Upload {
             .face_groups
             .as_ref()
             .map(|g| (0..nf).map(|f| g[origin(f)]).collect());
+        let mut normals = normals;
+        if let Some(a) = &self.attrs {
+            if a.keeps_normals() {
+                out.normals = self.welded.normals.clone();
+            }
+            a.write(&d.attr_values, &mut out);
+            normals &= !a.keeps_normals();
+        }
         out.remove_unused_vertices();
         if normals {
             out.recompute_normals();

@@ -56,6 +56,11 @@ pub enum Buf {
     Counters,
     Dispatch,
     DrawArgs,
+    /// Per attribute vertex of the welded input: its weighted appearance values
+    /// ([`crate::gpu::types::attr_layout`]); never compacted, the faces' corners index it.
+    AttrValues,
+    /// Per attribute vertex: its attribute sums `G`, `D`, `W` relative to its vertex.
+    AttrSums,
 }
 
 /// A count a prefix sum runs over.
@@ -127,6 +132,12 @@ pub static VERTEX_QUADRICS: Stage = crate::stage!(Buf; vertex_quadrics in "round
     offsets: Read Offsets, vertex_faces: Read VertexFaces, face_normals: Read FaceNormals,
     face_extra: Read FaceExtra, quadrics: ReadWrite Quadrics);
 
+pub static VERTEX_ATTRIBUTES: Stage = crate::stage!(Buf; vertex_attributes in "rounds/vertex_attributes" over Each(Vertices);
+    params: Uniform Params, positions: Read Positions, indices: Read Indices,
+    offsets: Read Offsets, vertex_faces: Read VertexFaces, face_normals: Read FaceNormals,
+    face_extra: Read FaceExtra, attr_values: Read AttrValues, quadrics: ReadWrite Quadrics,
+    attr_sums: ReadWrite AttrSums);
+
 pub static EDGES_COUNT: Stage = crate::stage!(Buf; edges_count in "rounds/edges_count" over Each(Vertices);
     params: Uniform Params, indices: Read Indices, offsets: Read Offsets,
     vertex_faces: Read VertexFaces, edge_counts: ReadWrite EdgeOffsets, remap: ReadWrite Remap,
@@ -142,6 +153,7 @@ pub static EDGE_ERRORS: Stage = crate::stage!(Buf; edge_errors in "rounds/edge_e
     params: Uniform Params, positions: Read Positions, quadrics: Read Quadrics, flags: Read Flags,
     indices: Read Indices, offsets: Read Offsets, vertex_faces: Read VertexFaces,
     edges: Read Edges, edge_offsets: Read EdgeOffsets, face_extra: Read FaceExtra,
+    vertex_attr: Read VertexAttr, attr_values: Read AttrValues, attr_sums: Read AttrSums,
     candidates: ReadWrite Candidates, edge_state: ReadWrite EdgeState,
     histogram: ReadWrite Histogram, counters: ReadWrite Counters);
 pub static COST_CEILING: Stage = crate::stage!(Buf; cost_ceiling in "rounds/cost_ceiling" over One;
@@ -188,9 +200,10 @@ pub static TRIM_APPLY: Stage = crate::stage!(Buf; trim_apply in "rounds/trim_app
 pub static COLLAPSE: Stage = crate::stage!(Buf; collapse in "rounds/collapse" over PerEdge;
     params: Uniform Params, candidates: Read Candidates, edge_state: Read EdgeState,
     edge_offsets: Read EdgeOffsets, indices: Read Indices, offsets: Read Offsets,
-    vertex_faces: Read VertexFaces, positions: ReadWrite Positions,
-    quadrics: ReadWrite Quadrics, flags: ReadWrite Flags, remap: ReadWrite Remap,
-    face_extra: ReadWrite FaceExtra);
+    vertex_faces: Read VertexFaces, vertex_attr: Read VertexAttr,
+    positions: ReadWrite Positions, quadrics: ReadWrite Quadrics, flags: ReadWrite Flags,
+    remap: ReadWrite Remap, face_extra: ReadWrite FaceExtra, attr_values: ReadWrite AttrValues,
+    attr_sums: ReadWrite AttrSums);
 pub static COMPACT_MARK: Stage = crate::stage!(Buf; compact_mark in "rounds/compact_mark" over VerticesOrFaces;
     params: Uniform Params, indices: Read Indices, remap: Read Remap,
     vertex_keep: ReadWrite VertexKeep, face_keep: ReadWrite FaceKeep);
@@ -215,6 +228,7 @@ pub const STAGES: &[&[&Stage]] = &[SHARED_STAGES, OWN_STAGES];
 const OWN_STAGES: &[&Stage] = &[
     &VERTEX_FLAGS,
     &VERTEX_QUADRICS,
+    &VERTEX_ATTRIBUTES,
     &EDGES_COUNT,
     &EDGES_FILL,
     &DISPATCH_ARGS,
@@ -259,6 +273,9 @@ pub enum When {
     /// The first round, unless the quadrics were carried in (the hybrid method's clustering
     /// hands over each cluster's quadric of the original surface).
     FirstRoundQuadrics,
+    /// The first round, when the rounds carry appearance channels (`Params::attributes`):
+    /// after the quadrics, computed or carried in, since it adds to them.
+    FirstRoundAttributes,
     /// Repeated as the round's [`crate::parallel::Selection`] says.
     EachSelectionPass,
     /// When the round trims its winners to land on the target (`Params::trim`).
@@ -271,6 +288,8 @@ use crate::compute::schedule::Step::{Clear, Own, PrefixSum, Run};
 pub const SETUP: &[Step] = &[Run(&FACE_PLANES), Run(&VERTEX_FLAGS)];
 /// The input's vertex quadrics.
 pub const SETUP_QUADRICS: &[Step] = &[Run(&VERTEX_QUADRICS)];
+/// The input's attribute quadrics (Hoppe 1999) on top of them.
+pub const SETUP_ATTRIBUTES: &[Step] = &[Run(&VERTEX_ATTRIBUTES)];
 /// Unique edges, and the indirect grids over them.
 pub const EDGES: &[Step] = &[
     Run(&EDGES_COUNT),
@@ -331,14 +350,15 @@ pub const APPLY: &[Step] = &[
 ];
 
 impl When {
-    /// Whether a part runs once in this round: `first` round, quadrics `carried` in, the round
-    /// `trimming`. [`When::EachSelectionPass`] is the runner's to repeat, and says no here.
-    pub fn runs_once(self, first: bool, carried: bool, trimming: bool) -> bool {
+    /// Whether a part runs once in the round of `p`: the `first` round, quadrics `carried` in.
+    /// [`When::EachSelectionPass`] is the runner's to repeat, and says no here.
+    pub fn runs_once(self, first: bool, carried: bool, p: &Params) -> bool {
         match self {
             When::Always => true,
             When::FirstRound => first,
             When::FirstRoundQuadrics => first && !carried,
-            When::Trimming => trimming,
+            When::FirstRoundAttributes => first && p.attributes != 0,
+            When::Trimming => p.trim != 0,
             When::EachSelectionPass => false,
         }
     }
@@ -349,6 +369,7 @@ pub const ROUND: &[(When, &[Step])] = &[
     (When::Always, ADJACENCY),
     (When::FirstRound, SETUP),
     (When::FirstRoundQuadrics, SETUP_QUADRICS),
+    (When::FirstRoundAttributes, SETUP_ATTRIBUTES),
     (When::Always, EDGES),
     (When::Always, ERRORS),
     (When::Always, CEILING),

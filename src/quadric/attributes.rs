@@ -99,11 +99,11 @@ impl Layout {
         4 * self.m + 1
     }
 
-    fn uv_at(&self) -> usize {
+    pub(crate) fn uv_at(&self) -> usize {
         self.color
     }
 
-    fn normal_at(&self) -> usize {
+    pub(crate) fn normal_at(&self) -> usize {
         self.color + 2 * self.uv as usize
     }
 }
