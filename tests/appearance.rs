@@ -183,7 +183,7 @@ fn look(dir: &std::path::Path, a: &str, b: &str, extra: &[&str], key: &str) -> f
 /// From the command line: the default colour weight keeps a painting better than
 /// `--color-weight 0`; a negative weight is a usage error naming the option; `compare
 /// --texture` measures texture colour at the UVs (none against itself) and names a texture it
-/// cannot read.
+/// cannot read; an OBJ written from a textured OBJ without materials names its texture.
 #[test]
 fn the_command_line_weighs_colours_and_measures_textures() {
     let dir = tempfile::tempdir().unwrap();
@@ -225,6 +225,21 @@ fn the_command_line_weighs_colours_and_measures_textures() {
     );
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("nope.png"));
+
+    // The texture beside the input goes with a simplified OBJ: a material library of its own
+    // names it from the output's folder, and every face uses it.
+    std::fs::create_dir(d.join("out")).unwrap();
+    expect_code(
+        &meshslim(&["simplify", "torus.obj", "out/t.obj", "-q"], d),
+        0,
+    );
+    let mtl = std::fs::read_to_string(d.join("out/t.mtl")).unwrap();
+    assert!(mtl.lines().any(|l| l == "map_Kd ../t.png"), "{mtl}");
+    let back = meshslim::io::read(&d.join("out/t.obj")).unwrap();
+    assert_eq!(back.material_libs, ["t.mtl"]);
+    assert!(back.uvs.is_some());
+    assert!(back.face_materials.unwrap().iter().all(|&m| m == 0));
+    assert_eq!(back.materials.len(), 1);
 }
 
 /// Attributes that would poison the cost are refused when the file is read, naming the file

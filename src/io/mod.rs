@@ -17,6 +17,7 @@ pub mod ply;
 pub mod sink;
 pub mod stl;
 pub mod stream;
+pub mod texture;
 
 use std::io::{BufWriter, Write};
 use std::path::{Component, Path};
@@ -187,8 +188,17 @@ pub fn not_kept(mesh: &Mesh, format: Format) -> Vec<String> {
 /// material libraries named from the output's folder: `mtllib` names are relative to the OBJ
 /// that names them, so a simplified scan written to another folder would lose its colours and
 /// textures with the names kept verbatim.
+///
+/// An OBJ with UVs from an input without materials but with one texture beside it (a scan and
+/// its PNG) gets a material library of its own naming that texture ([`texture`]).
 pub fn write_from(path: &Path, mesh: &Mesh, input: &Path) -> Result<()> {
     let format = Format::from_path(path)?;
+    if format == Format::Obj
+        && let Some((textured, lib)) = texture::with_own_material(mesh, input, path)?
+    {
+        textured.validate()?;
+        return write_atomic(path, |w| obj::write_obj_libs(w, &textured, &[lib]));
+    }
     if format != Format::Obj || mesh.material_libs.is_empty() {
         return write_format(path, mesh, format, &WriteOptions::default());
     }

@@ -56,6 +56,7 @@ pub trait RoundRunner {
 
 /// The surface as the rounds see it: position classes (a seam's vertices share one), Morton
 /// ordered, normalized into the unit-diagonal box centred on the origin.
+#[derive(Clone)]
 pub struct Upload {
     /// The input after exact welding: its vertices are the attribute vertices written out.
     pub welded: Mesh,
@@ -120,6 +121,25 @@ impl Upload {
     pub fn attributes(mut self, w: &crate::options::AttributeWeights) -> Upload {
         self.attrs = RoundAttributes::new(&self.welded, w);
         self
+    }
+
+    /// Whether this upload carries the channels `w` asks for (a copy with
+    /// [`Upload::attributes`] otherwise).
+    pub fn carries(&self, w: &crate::options::AttributeWeights) -> bool {
+        let wanted = crate::quadric::attributes::Layout::new(&self.welded, w);
+        wanted.as_ref() == self.attrs.as_ref().map(|a| &a.layout)
+    }
+
+    /// The welded input's colours and UVs as the rounds left them (`d`'s solved values in place
+    /// of the input's), without geometry: what a renderer draws a result's corners with.
+    pub fn solved_appearance(&self, d: &Download) -> Mesh {
+        let mut m = self.welded.clone_without_geometry();
+        m.colors = self.welded.colors.clone();
+        m.uvs = self.welded.uvs.clone();
+        if let Some(a) = &self.attrs {
+            a.write(&d.attr_values, &mut m);
+        }
+        m
     }
 
     /// The first round's values of the attribute vertices (empty without channels).

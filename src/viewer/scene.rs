@@ -159,7 +159,8 @@ impl Model {
 
     pub fn from_mesh(name: String, mesh: Mesh) -> Result<Model> {
         let t = Instant::now();
-        let up = Upload::new(&mesh);
+        // With the default appearance weights, as the viewer simplifies.
+        let up = Upload::new(&mesh).attributes(&crate::options::AttributeWeights::default());
         if up.face_count() == 0 {
             return Err(Error::InvalidMesh(format!(
                 "{name}: nothing to draw, the mesh has no faces"
@@ -208,7 +209,7 @@ impl Model {
         let extras = Extras {
             error: Vec::new(),
             normals: vertex_normals(&up.positions, &up.indices),
-            uvs: corner_uvs(up, &corners),
+            uvs: corner_uvs(&up.welded, &corners),
             colors: corner_colors(&up.welded, corners.iter().copied()),
         };
         SceneMesh::new(device, gpu, up.positions.len(), up.face_count(), &extras)
@@ -245,8 +246,8 @@ impl Model {
 /// Each corner's UV: that of its attribute vertex (see [`corner_attributes`]), so a seam
 /// vertex shows each side's own. Counted from the image's bottom-left corner, as the shader
 /// samples them (glTF's are flipped here).
-fn corner_uvs(up: &Upload, corner_attr: &[u32]) -> Option<Vec<[f32; 2]>> {
-    let uv = up.welded.uvs_from(UvOrigin::BottomLeft)?;
+fn corner_uvs(welded: &Mesh, corner_attr: &[u32]) -> Option<Vec<[f32; 2]>> {
+    let uv = welded.uvs_from(UvOrigin::BottomLeft)?;
     Some(corner_attr.iter().map(|&a| uv[a as usize]).collect())
 }
 
@@ -289,40 +290,20 @@ fn find_texture(path: &Path, mesh: &Mesh) -> (Option<Image>, Option<String>) {
     }
     // No material names one: a mesh with UVs whose folder holds exactly one PNG or JPEG (a scan
     // and its texture, as ../shared/models/spot ships) takes that one.
-    if mesh.uvs.is_some() {
-        let pngs: Vec<PathBuf> = std::fs::read_dir(dir)
-            .into_iter()
-            .flatten()
-            .flatten()
-            .map(|e| e.path())
-            .filter(|p| is_texture_file(p))
-            // The viewer's own screenshots are not textures.
-            .filter(|p| {
-                !p.file_name()
-                    .is_some_and(|n| n.to_string_lossy().starts_with("meshslim-"))
-            })
-            .collect();
-        if let [only] = &pngs[..] {
-            return match read_texture(only) {
-                Ok(img) => (Some(img), None),
-                Err(e) => (None, Some(e.to_string())),
-            };
-        }
+    if mesh.uvs.is_some()
+        && let Some(only) = crate::io::texture::lone_texture_beside(path)
+    {
+        return match read_texture(&only) {
+            Ok(img) => (Some(img), None),
+            Err(e) => (None, Some(e.to_string())),
+        };
     }
     (None, None)
 }
 
-/// Texture file extensions the viewer reads (by content, through the `image` crate).
-const TEXTURE_EXTENSIONS: [&str; 3] = ["png", "jpg", "jpeg"];
-
-fn is_texture_file(p: &Path) -> bool {
-    p.extension()
-        .is_some_and(|e| TEXTURE_EXTENSIONS.iter().any(|x| e.eq_ignore_ascii_case(x)))
-}
-
 /// A PNG or JPEG file (scans ship their textures as either) as RGBA8.
 pub fn read_texture(path: &Path) -> Result<Image> {
-    if !is_texture_file(path) {
+    if !crate::io::texture::is_texture_file(path) {
         return Err(Error::InvalidOption(format!(
             "{}: only PNG and JPEG textures are read",
             path.display()
@@ -426,7 +407,15 @@ pub fn simplify(
             let sim = on
                 .rounds
                 .ok_or_else(|| Error::Gpu("the GPU backend is not available".into()))?;
-            let up = &model.up;
+            // The model's upload carries the default appearance weights; other weights, a
+            // copy carrying theirs.
+            let other;
+            let up = if model.up.carries(&opts.attributes) {
+                &*model.up
+            } else {
+                other = (*model.up).clone().attributes(&opts.attributes);
+                &other
+            };
             let mut rounds = GpuRounds::new(sim, up, SELECTION_PASSES)?;
             rounds.share_queue = share_queue;
             let report = RoundsReport {
@@ -447,8 +436,10 @@ pub fn simplify(
             let d = rounds.download()?;
             let indices = d.indices.clone();
             let corners = corner_attributes(&d.flags, &d.vertex_attr, &d.indices, &d.face_extra);
-            let uvs = corner_uvs(up, &corners);
-            let colors = corner_colors(&up.welded, corners.iter().copied());
+            // The colours and UVs the collapses solved.
+            let shown = up.solved_appearance(&d);
+            let uvs = corner_uvs(&shown, &corners);
+            let colors = corner_colors(&shown, corners.iter().copied());
             let gpu = rounds.into_mesh(up)?;
             (gpu, d.positions, indices, mesh, report, uvs, colors)
         }
