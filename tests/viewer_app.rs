@@ -613,8 +613,9 @@ fn manifests_open_into_the_lod_scene_and_the_front_plot() {
     );
 }
 
-/// A painted mesh opens in the vertex-colour mode; `1` shades it, `6` shows its colours again,
-/// and the two frames differ.
+/// A painted mesh opens in the vertex-colour mode, also with the command line's style unless
+/// its --mode says otherwise; `1` shades it, `6` shows its colours again, and the two frames
+/// differ.
 #[test]
 fn a_coloured_mesh_opens_in_colour_mode() {
     if gpu_context().is_none() {
@@ -637,4 +638,10 @@ fn a_coloured_mesh_opens_in_colour_mode() {
     h.key_press(egui::Key::Num6);
     h.step();
     assert_eq!(h.state().style.mode, Mode::Color);
+    // The command line's style keeps the mode the mesh picked unless --mode names one.
+    let style = h.state().style;
+    h.state_mut().set_style(style, None);
+    assert_eq!(h.state().style.mode, Mode::Color);
+    h.state_mut().set_style(style, Some(Mode::Shaded));
+    assert_eq!(h.state().style.mode, Mode::Shaded);
 }

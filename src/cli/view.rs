@@ -88,7 +88,8 @@ pub struct ViewArgs {
 
 pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     let progress = Progress::new(std::io::stderr().is_terminal());
-    // The window picks colour mode itself for a coloured mesh (and each file opened next).
+    // The window picks colour mode itself for a coloured mesh (and each file opened next)
+    // unless --mode says otherwise.
     let style = crate::viewer::Style {
         mode: args.mode.unwrap_or(crate::viewer::Mode::Shaded),
         smooth: args.smooth,
@@ -155,7 +156,7 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
             start,
             args.ratio.unwrap_or(0.1),
             args.method.method(),
-            style,
+            (style, args.mode),
             size,
             args.up,
         )

@@ -292,9 +292,14 @@ impl ViewerApp {
         }
     }
 
-    /// How the view draws (the command line's --mode, --smooth, --wireframe).
-    pub fn set_style(&mut self, style: Style) {
-        self.style = style;
+    /// How the view draws (the command line's --smooth, --wireframe, and --mode when it was
+    /// given: `None` keeps the mode the mesh picked, vertex colours for a painted one).
+    pub fn set_style(&mut self, style: Style, mode: Option<Mode>) {
+        let picked = self.style.mode;
+        self.style = Style {
+            mode: mode.unwrap_or(picked),
+            ..style
+        };
         if !self.mode_available(style.mode) {
             self.style.mode = Mode::Shaded;
         }

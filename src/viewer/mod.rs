@@ -141,13 +141,13 @@ pub fn screenshot_with(
     })
 }
 
-/// Opens the interactive window with `ratio` as the starting target, drawn in `style`, of
-/// `size` points (blocks until it is closed).
+/// Opens the interactive window with `ratio` as the starting target, drawn in `style` (in
+/// `mode` when given, else as the mesh picks), of `size` points (blocks until it is closed).
 pub fn run_window(
     start: Start,
     ratio: f64,
     method: crate::Method,
-    style: Style,
+    (style, mode): (Style, Option<Mode>),
     size: (u32, u32),
     up: Option<camera::Up>,
 ) -> Result<()> {
@@ -175,7 +175,7 @@ pub fn run_window(
             let mut app = ViewerApp::new(cc, start)?;
             app.set_ratio(ratio);
             app.set_method(method);
-            app.set_style(style);
+            app.set_style(style, mode);
             app.set_up(up);
             Ok(Box::new(app))
         }),
