@@ -165,7 +165,12 @@ fn evaluate(a: u32, b: u32) -> Verdict {
         if (attr_m() != 0u) {
             q = attr_reduce_pair(q, vertex_attr[a], vec3<f32>(0.0), vertex_attr[b], pa - pb);
         }
-        let opt = quadric_optimum(q);
+        var opt = quadric_optimum(q);
+        // With appearance channels the reduced quadric may hold a vertex only weakly along the
+        // surface: an optimum farther from the edge's midpoint than the edge is long would slide
+        // it over its neighbours, so the ends and the midpoint compete instead.
+        let off = opt.y - dab * 0.5;
+        if (attr_m() != 0u && !(dot(off, off) <= dot(dab, dab))) { opt.ok = false; }
         if (opt.ok) {
             y = opt.y;
         } else {

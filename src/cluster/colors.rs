@@ -87,3 +87,39 @@ pub(super) fn cluster_colors(
             .collect(),
     )
 }
+
+/// `hybrid` on a coloured mesh: inside a cell, an edge whose colour step costs more than the
+/// cell is wide does not join its ends into one cluster, so a cluster never straddles a sharp
+/// colour edge that the rounds after it could not bring back. At the colour weight `w` a step
+/// of `Δ` (RGBA distance) costs like a displacement of `w·Δ` diagonals (as in the collapse
+/// cost), and a cluster moves its members by up to a cell `h`: the step splits when `w·Δ > h`.
+/// Smooth gradients, whose steps between neighbours are small, stay joined.
+pub(super) struct ColourSplit<'m> {
+    pub colors: &'m [[f32; 4]],
+    pub weight: f32,
+}
+
+impl<'m> ColourSplit<'m> {
+    /// For `mesh`, when its colours are weighed.
+    pub(super) fn of(mesh: &'m Mesh, weight: f64) -> Option<ColourSplit<'m>> {
+        let colors = mesh.colors.as_deref().filter(|_| weight > 0.0)?;
+        Some(ColourSplit {
+            colors,
+            weight: weight as f32,
+        })
+    }
+
+    /// Whether points `a` and `b` (input vertices `attr[a]`, `attr[b]`) may join at cell size
+    /// `h` (unit-diagonal frame).
+    pub(super) fn joins<'s>(&'s self, attr: &'s [u32], h: f32) -> impl Fn(u32, u32) -> bool + 's {
+        let limit = (h / self.weight).powi(2);
+        move |a, b| {
+            let (p, q) = (
+                self.colors[attr[a as usize] as usize],
+                self.colors[attr[b as usize] as usize],
+            );
+            let d2: f32 = (0..4).map(|k| (p[k] - q[k]) * (p[k] - q[k])).sum();
+            d2 <= limit
+        }
+    }
+}

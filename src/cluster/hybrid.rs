@@ -69,8 +69,32 @@ fn pinched_clusters(b: &Built) -> Vec<u32> {
     bad
 }
 
+/// A cluster face turned more than 60° from the input face it came from counts as folded.
+const FOLD_COS: f32 = 0.5;
+
+/// The clusters of each face that turns away from the input face it came from (a cell can
+/// fold a sheet over; two clusters a colour step split in one cell can stand a face on edge),
+/// sorted: the rounds after may turn a face up to `max_normal_angle_deg` further, so a face
+/// left nearly on edge here could end up flipped.
+fn flipped_clusters(b: &Built, planes: &[[f32; 4]]) -> Vec<u32> {
+    use crate::cpu::common::{cross, dot, length, sub, xyz};
+    let mut bad: Vec<u32> = b
+        .faces
+        .par_iter()
+        .filter_map(|&(origin, t)| {
+            let p = t.map(|k| b.placed[k as usize].pos);
+            let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+            (dot(n, xyz(planes[origin as usize])) < FOLD_COS * length(n)).then_some(t)
+        })
+        .flatten_iter()
+        .collect();
+    bad.par_sort_unstable();
+    bad.dedup();
+    bad
+}
+
 /// The hybrid's clustering: to at least `intermediate` faces (the rounds then go to `target`),
-/// clusters that pinch a non-manifold edge taken apart until none is left.
+/// clusters that pinch a non-manifold edge or fold a face over taken apart until none is left.
 pub(super) fn cluster_repaired(
     work: &mut Work,
     intermediate: usize,
@@ -82,7 +106,12 @@ pub(super) fn cluster_repaired(
     // one cell can still pinch into a non-manifold edge: take the clusters on one apart (their
     // members each their own cluster) and build again, until none is left.
     for _ in 0..MAX_REPAIRS {
-        let bad = pinched_clusters(&built);
+        let mut bad = pinched_clusters(&built);
+        if let Some(g) = &work.gather {
+            bad.extend(flipped_clusters(&built, &g.planes));
+            bad.sort_unstable();
+            bad.dedup();
+        }
         if bad.is_empty() {
             break;
         }
@@ -163,6 +192,7 @@ pub(crate) fn hybrid_upload(
     } else {
         let mut pts = Points::new(mesh);
         let mut work = prepare(&mut pts, &opts, true)?;
+        work.colors = super::colors::ColourSplit::of(mesh, opts.attributes.color);
         let (grid, built) =
             cluster_repaired(&mut work, intermediate, opts.target_faces, &mut report)?;
         tally(&mut report, &built);
@@ -172,6 +202,11 @@ pub(crate) fn hybrid_upload(
         let frame = (work.pts.center, work.pts.scale);
         (
             crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics)
+                .reference_normals(|f| {
+                    let g = work.gather.as_ref().expect("the hybrid gathers");
+                    let pl = g.planes[built.faces[f].0 as usize];
+                    [pl[0], pl[1], pl[2]]
+                })
                 .attributes(&opts.attributes),
             max_error(&built),
         )

@@ -156,6 +156,8 @@ struct Work<'a, 'm> {
     locked: Vec<bool>,
     /// `--backend gpu`: the points on the device, each build run there by the same stages.
     gpu: Option<std::sync::Mutex<gpu::GpuClusterMesh<'a>>>,
+    /// `hybrid` on a coloured mesh: the colour step an edge may not cross inside a cell.
+    colors: Option<colors::ColourSplit<'m>>,
 }
 
 struct Gather {
@@ -184,10 +186,18 @@ impl Work<'_, '_> {
         drop(keys);
         let cells: Cells = stages::cell_ranges(&sorted, members);
         let (clusters, label) = if self.split {
-            let label = match &self.gather {
-                Some(_) => stages::cell_labels(&cells, &self.pts.faces, &self.pts.positions),
+            let label = match (&self.gather, &self.colors) {
+                (Some(_), Some(c)) => stages::cell_labels_where(
+                    &cells,
+                    &self.pts.faces,
+                    &self.pts.positions,
+                    c.joins(&self.pts.attr, grid.h),
+                ),
+                (Some(_), None) => {
+                    stages::cell_labels(&cells, &self.pts.faces, &self.pts.positions)
+                }
                 // Streamed: the union-find fed block by block.
-                None => {
+                (None, _) => {
                     let mut u = stages::CellUnion::new(cells.vertex_cell.len());
                     self.pts.blocks(&mut |_, faces| {
                         u.join_faces(&cells, faces);
@@ -615,6 +625,7 @@ fn prepare<'a, 'm>(
         border_weight: opts.border_weight as f32,
         locked,
         gpu: None,
+        colors: None,
     })
 }
 

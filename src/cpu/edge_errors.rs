@@ -216,7 +216,14 @@ pub fn placement(
                 sub(pa, pb),
             );
         }
-        let y = match quadric_optimum(&q) {
+        // With appearance channels the reduced quadric may hold a vertex only weakly along the
+        // surface: an optimum farther from the edge's midpoint than the edge is long would
+        // slide it over its neighbours, so the ends and the midpoint compete instead.
+        let near = |y: &V3| {
+            let off = sub(*y, scale(dab, 0.5));
+            ch.m == 0 || dot(off, off) <= dot(dab, dab)
+        };
+        let y = match quadric_optimum(&q).filter(near) {
             Some(y) => y,
             None => {
                 let mut best = [0.0f32; 3];

@@ -234,7 +234,10 @@ impl CpuRounds {
             flags: up.flags.clone(),
             vertex_attr: up.vertex_attr.clone(),
             indices: up.indices.clone(),
-            face_normals: vec![[0.0; 4]; up.face_extra.len()],
+            face_normals: up
+                .face_planes
+                .clone()
+                .unwrap_or_else(|| vec![[0.0; 4]; up.face_extra.len()]),
             face_extra: up.face_extra.clone(),
             attr_values: up.attr_values(),
             attr_sums: vec![0.0; up.attr_sums_len()],
@@ -341,7 +344,7 @@ impl CpuRounds {
         self.run_steps(p, schedule::ADJACENCY)
     }
 
-    /// The first round's set-up: face normals, vertex flags ([`schedule::SETUP`]), the
+    /// The first round's set-up: vertex flags ([`schedule::SETUP`]), the face planes and
     /// quadrics unless they were carried in ([`schedule::SETUP_QUADRICS`]), and the attribute
     /// quadrics when the round carries appearance channels ([`schedule::SETUP_ATTRIBUTES`]).
     pub fn setup(&mut self, p: &Params) -> Result<()> {

@@ -187,7 +187,8 @@ pub struct GpuRounds<'a> {
     query_stages: Vec<&'static str>,
     times: StageTimes,
     selection_passes: u32,
-    /// The upload brought the quadrics: the first round skips `SETUP_QUADRICS`.
+    /// The upload brought the face planes and quadrics: the first round skips
+    /// `SETUP_QUADRICS`.
     carried_quadrics: bool,
     /// Upload and download seconds.
     pub transfer_seconds: f64,
@@ -233,7 +234,10 @@ impl<'a> GpuRounds<'a> {
             flags: init("flags", bytemuck::cast_slice(&up.flags), SU)?,
             vertex_attr: init("vertex_attr", bytemuck::cast_slice(&up.vertex_attr), SU)?,
             indices: init("indices", bytemuck::cast_slice(&up.indices), mesh_usage)?,
-            face_normals: mk("face_normals", nf * 16, SU)?,
+            face_normals: match &up.face_planes {
+                Some(p) => init("face_normals", bytemuck::cast_slice(p), SU)?,
+                None => mk("face_normals", nf * 16, SU)?,
+            },
             face_extra: init("face_extra", bytemuck::cast_slice(&up.face_extra), SU)?,
         };
         let half1 = Half {

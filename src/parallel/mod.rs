@@ -77,6 +77,10 @@ pub struct Upload {
     /// Per class: the quadric carried in (the hybrid method's clusters), relative to the
     /// vertex; `None` computes them in the first round.
     pub quadrics: Option<Vec<crate::gpu::types::Quadric>>,
+    /// Per face: the first round's plane (unit normal, area), carried in with the quadrics: the
+    /// face's own, or with [`Upload::reference_normals`] the normal of the input face it came
+    /// from, which the flip test measures turning from.
+    pub face_planes: Option<Vec<[f32; 4]>>,
     /// The appearance channels carried ([`Upload::attributes`]); `None`: none, and the rounds
     /// run as without.
     pub attrs: Option<RoundAttributes>,
@@ -120,6 +124,22 @@ impl Upload {
     /// This upload carrying the welded input's appearance channels that `w` weighs above zero.
     pub fn attributes(mut self, w: &crate::options::AttributeWeights) -> Upload {
         self.attrs = RoundAttributes::new(&self.welded, w);
+        self
+    }
+
+    /// The carried face planes with each face's normal replaced by `normal(f)` of the face
+    /// `f` of the input it came from (the hybrid: the original's face under a cluster face),
+    /// so that the rounds' flip test measures turning from there; a face whose plane has no
+    /// area keeps it.
+    pub fn reference_normals(mut self, normal: impl Fn(usize) -> [f32; 3]) -> Upload {
+        if let Some(planes) = &mut self.face_planes {
+            for (pl, x) in planes.iter_mut().zip(&self.face_extra) {
+                if pl[3] > 0.0 {
+                    let n = normal(x.origin as usize);
+                    *pl = [n[0], n[1], n[2], pl[3]];
+                }
+            }
+        }
         self
     }
 
@@ -211,7 +231,7 @@ impl Upload {
                 }
             }
         }
-        let indices = s
+        let indices: Vec<u32> = s
             .faces
             .iter()
             .flat_map(|t| t.map(|v| dense[s.class[v as usize] as usize]))
@@ -239,6 +259,15 @@ impl Upload {
             }
             q
         });
+        let face_planes = quadrics.as_ref().map(|_| {
+            let p = Params {
+                face_count: s.faces.len() as u32,
+                ..Default::default()
+            };
+            let mut planes = vec![[0.0f32; 4]; s.faces.len()];
+            crate::cpu::face_planes::face_planes(&p, &positions, &indices, &mut planes);
+            planes
+        });
         let Surface {
             welded,
             center,
@@ -258,6 +287,7 @@ impl Upload {
             dropped_degenerate,
             seams,
             quadrics,
+            face_planes,
             attrs: None,
         }
     }

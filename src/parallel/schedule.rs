@@ -270,8 +270,9 @@ pub enum When {
     Always,
     /// The first round only: face planes and flags of the input.
     FirstRound,
-    /// The first round, unless the quadrics were carried in (the hybrid method's clustering
-    /// hands over each cluster's quadric of the original surface).
+    /// The first round, unless the face planes and quadrics were carried in (the hybrid
+    /// method's clustering hands over each cluster's quadric of the original surface, and
+    /// each face's normal of the original face under it).
     FirstRoundQuadrics,
     /// The first round, when the rounds carry appearance channels (`Params::attributes`):
     /// after the quadrics, computed or carried in, since it adds to them.
@@ -285,9 +286,9 @@ pub enum When {
 use crate::compute::schedule::Step::{Clear, Own, PrefixSum, Run};
 
 /// The first round's set-up.
-pub const SETUP: &[Step] = &[Run(&FACE_PLANES), Run(&VERTEX_FLAGS)];
-/// The input's vertex quadrics.
-pub const SETUP_QUADRICS: &[Step] = &[Run(&VERTEX_QUADRICS)];
+pub const SETUP: &[Step] = &[Run(&VERTEX_FLAGS)];
+/// The input's face planes and vertex quadrics.
+pub const SETUP_QUADRICS: &[Step] = &[Run(&FACE_PLANES), Run(&VERTEX_QUADRICS)];
 /// The input's attribute quadrics (Hoppe 1999) on top of them.
 pub const SETUP_ATTRIBUTES: &[Step] = &[Run(&VERTEX_ATTRIBUTES)];
 /// Unique edges, and the indirect grids over them.
