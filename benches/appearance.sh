@@ -6,12 +6,15 @@
 # diagonal) and the mean colour error (vertex colours; on spot the texture's colour at the UVs,
 # 'meshslim compare --texture'):
 #   - meshslim `cpu` at several --color-weight (painted) or --uv-weight (spot) values, the
-#     default among them;
+#     default among them, then the rounds (`cpu-parallel`, and `gpu` when BACKENDS names it)
+#     and `hybrid` at the default weights;
 #   - meshoptimizer's simplifyWithAttributes at weights 0.1, 0.3 and 1 ('meshslim bench'
 #     backends meshopt-attr-*), and plain simplify.
 # Uses ../shared/models (MESHSLIM_MODELS overrides); MESHSLIM=binary (target/release/meshslim).
 set -euo pipefail
 bin=${MESHSLIM:-target/release/meshslim}
+# The other runs at the default weights: "--backend B" or "--method M", comma-separated.
+IFS=, read -r -a others <<< "${BACKENDS:---backend cpu-parallel,--method hybrid}"
 paint=${PAINT:-target/release/examples/paint_scan}
 models=${MESHSLIM_MODELS:-../shared/models}
 out=${1:-$(mktemp -d)}
@@ -54,6 +57,12 @@ for name in horse igea; do
             read -r d c < <(figures "$painted" "$out/o.ply")
             printf '%-10s %5s %-22s %10s %8s\n' "$name" "$r" "cpu color-weight $w" "$d" "$c"
         done
+        for o in "${others[@]}"; do
+            # shellcheck disable=SC2086 # "--backend B": two words
+            "$bin" simplify "$painted" "$out/o.ply" --ratio "$r" $o --quiet
+            read -r d c < <(figures "$painted" "$out/o.ply")
+            printf '%-10s %5s %-22s %10s %8s\n' "$name" "$r" "${o#--* }" "$d" "$c"
+        done
     done
     peers "$painted" | while read -r r b d c; do
         printf '%-10s %5s %-22s %10s %8s\n' "$name" "$r" "$b" "$d" "$c"
@@ -67,6 +76,12 @@ if [ -f "$spot" ]; then
             "$bin" simplify "$spot" "$out/o.obj" --ratio "$r" --uv-weight "$w" --quiet
             read -r d c < <(figures "$spot" "$out/o.obj" --texture "$tex")
             printf '%-10s %5s %-22s %10s %8s\n' spot "$r" "cpu uv-weight $w" "$d" "$c"
+        done
+        for o in "${others[@]}"; do
+            # shellcheck disable=SC2086 # "--backend B": two words
+            "$bin" simplify "$spot" "$out/o.obj" --ratio "$r" $o --quiet
+            read -r d c < <(figures "$spot" "$out/o.obj" --texture "$tex")
+            printf '%-10s %5s %-22s %10s %8s\n' spot "$r" "${o#--* }" "$d" "$c"
         done
     done
     peers "$spot" --texture "$tex" | while read -r r b d c; do

@@ -72,19 +72,52 @@ fn pinched_clusters(b: &Built) -> Vec<u32> {
 /// A cluster face turned more than 60° from the input face it came from counts as folded.
 const FOLD_COS: f32 = 0.5;
 
-/// The clusters of each face that turns away from the input face it came from (a cell can
-/// fold a sheet over; two clusters a colour step split in one cell can stand a face on edge),
-/// sorted: the rounds after may turn a face up to `max_normal_angle_deg` further, so a face
-/// left nearly on edge here could end up flipped.
-fn flipped_clusters(b: &Built, planes: &[[f32; 4]]) -> Vec<u32> {
-    use crate::cpu::common::{cross, dot, length, sub, xyz};
+/// Per face of `b`: the unit normal of the input face it came from (its origin), read from the
+/// faces in blocks so that a streamed input gets them too. The rounds after the clustering
+/// measure turning from these, not from the clusters' faces.
+pub(super) fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
+    use crate::cpu::common::{cross, length, scale, sub, xyz};
+    let mut at: Vec<u32> = Vec::new();
+    for (k, &(origin, _)) in b.faces.iter().enumerate() {
+        let o = origin as usize;
+        if o >= at.len() {
+            at.resize(o + 1, u32::MAX);
+        }
+        at[o] = k as u32;
+    }
+    let mut normals = vec![[0.0f32; 3]; b.faces.len()];
+    let pos = &work.pts.positions;
+    work.pts.blocks(&mut |first, faces| {
+        for (i, t) in faces.iter().enumerate() {
+            let Some(&k) = at.get(first + i).filter(|&&k| k != u32::MAX) else {
+                continue;
+            };
+            let p = t.map(|v| xyz(pos[v as usize]));
+            let c = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+            let l = length(c);
+            if l > 0.0 {
+                normals[k as usize] = scale(c, 1.0 / l);
+            }
+        }
+        Ok(())
+    })?;
+    Ok(normals)
+}
+
+/// The clusters of each face turned more than 60° from the input face it came from (`normals`,
+/// [`origin_normals`]), sorted: a cell can fold a sheet over, and two clusters a colour step
+/// split in one cell can stand a face on edge; the rounds after may turn a face up to
+/// `max_normal_angle_deg` further, so a face left nearly on edge here could end up flipped.
+fn folded_clusters(b: &Built, normals: &[[f32; 3]]) -> Vec<u32> {
+    use crate::cpu::common::{cross, dot, length, sub};
     let mut bad: Vec<u32> = b
         .faces
         .par_iter()
-        .filter_map(|&(origin, t)| {
+        .zip(normals)
+        .filter_map(|(&(_, t), &o)| {
             let p = t.map(|k| b.placed[k as usize].pos);
             let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
-            (dot(n, xyz(planes[origin as usize])) < FOLD_COS * length(n)).then_some(t)
+            (dot(n, o) < FOLD_COS * length(n)).then_some(t)
         })
         .flatten_iter()
         .collect();
@@ -107,11 +140,9 @@ pub(super) fn cluster_repaired(
     // members each their own cluster) and build again, until none is left.
     for _ in 0..MAX_REPAIRS {
         let mut bad = pinched_clusters(&built);
-        if let Some(g) = &work.gather {
-            bad.extend(flipped_clusters(&built, &g.planes));
-            bad.sort_unstable();
-            bad.dedup();
-        }
+        bad.extend(folded_clusters(&built, &origin_normals(work, &built)?));
+        bad.sort_unstable();
+        bad.dedup();
         if bad.is_empty() {
             break;
         }
@@ -202,11 +233,7 @@ pub(crate) fn hybrid_upload(
         let frame = (work.pts.center, work.pts.scale);
         (
             crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics)
-                .reference_normals(|f| {
-                    let g = work.gather.as_ref().expect("the hybrid gathers");
-                    let pl = g.planes[built.faces[f].0 as usize];
-                    [pl[0], pl[1], pl[2]]
-                })
+                .reference_normals(&origin_normals(&work, &built)?)
                 .attributes(&opts.attributes),
             max_error(&built),
         )

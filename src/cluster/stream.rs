@@ -124,6 +124,11 @@ pub fn simplify_file_in_blocks(
     tally(&mut report, &built);
     report.cell_size = grid.h as f64;
     let (clustered, quadrics) = output(work.pts, &built, colors.as_deref());
+    let normals = if hybrid {
+        super::hybrid::origin_normals(&work, &built)?
+    } else {
+        Vec::new()
+    };
     let built_error = max_error(&built);
     let frame = (work.pts.center, work.pts.scale);
     drop(work);
@@ -157,6 +162,7 @@ pub fn simplify_file_in_blocks(
     progress(0.5);
     report.intermediate_faces = Some(clustered.triangles.len());
     let up = crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics)
+        .reference_normals(&normals)
         .attributes(&opts.attributes);
     let opts = &SimplifyOptions {
         target_faces,

@@ -127,16 +127,16 @@ impl Upload {
         self
     }
 
-    /// The carried face planes with each face's normal replaced by `normal(f)` of the face
+    /// The carried face planes with each face's normal replaced by `normals[f]` for the face
     /// `f` of the input it came from (the hybrid: the original's face under a cluster face),
     /// so that the rounds' flip test measures turning from there; a face whose plane has no
-    /// area keeps it.
-    pub fn reference_normals(mut self, normal: impl Fn(usize) -> [f32; 3]) -> Upload {
+    /// area, or whose given normal is zero, keeps its own.
+    pub fn reference_normals(mut self, normals: &[[f32; 3]]) -> Upload {
         if let Some(planes) = &mut self.face_planes {
             for (pl, x) in planes.iter_mut().zip(&self.face_extra) {
-                if pl[3] > 0.0 {
-                    let n = normal(x.origin as usize);
-                    *pl = [n[0], n[1], n[2], pl[3]];
+                match normals.get(x.origin as usize) {
+                    Some(&n) if pl[3] > 0.0 && n != [0.0; 3] => *pl = [n[0], n[1], n[2], pl[3]],
+                    _ => {}
                 }
             }
         }
