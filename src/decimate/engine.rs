@@ -8,6 +8,7 @@ use crate::greedy::state::VertFaces;
 use crate::greedy::triangle_quality;
 use crate::options::Removal;
 use crate::quadric::Quadric;
+use crate::quadric::attributes::{MAX_CHANNELS, hold};
 use glam::DVec3;
 
 /// Why a vertex was not removed.
@@ -279,7 +280,8 @@ impl Engine {
             // of the diagonal, the cheapest 1.57e-4 (greedy QEM: 1.04e-4).
             let mut cost = [0.0f64; super::fan::MAX_FAN + 1];
             for &i in &cands[..ncand] {
-                cost[i] = q.eval(self.at(self.fan.x[i]).to_array());
+                let to = [(self.fan.x[i], 1.0), (u32::MAX, 0.0), (u32::MAX, 0.0)];
+                cost[i] = self.held(&q, &to).eval(self.at(self.fan.x[i]).to_array());
             }
             if fill_up_to.is_some() {
                 cands[..ncand].sort_by(|&i, &j| cost[i].total_cmp(&cost[j]).then(i.cmp(&j)));
@@ -310,7 +312,7 @@ impl Engine {
                     (foot_plane, [a, b, (u32::MAX, 0.0)])
                 }
             };
-            let cost = q.eval(foot.to_array());
+            let cost = self.held(&q, &transfer).eval(foot.to_array());
             let mut plan = Plan {
                 cost,
                 error: rms(cost, &q),
@@ -328,7 +330,7 @@ impl Engine {
                     // 1.96e-4. The queue's key stays the average plane's (no filling needed);
                     // a removal that costs more than its key goes back in the queue.
                     let (foot, transfer) = self.nearest_on_new(pv);
-                    let cost = q.eval(foot.to_array());
+                    let cost = self.held(&q, &transfer).eval(foot.to_array());
                     plan = Plan {
                         cost,
                         error: rms(cost, &q),
@@ -363,6 +365,54 @@ impl Engine {
             }
         }
         (best.1, best.2)
+    }
+
+    /// The quadric `q` of the vertex last gathered with each of its attribute vertices held at
+    /// the values the surface replacing it has there: those of `transfer`'s loop vertices on
+    /// that side, weighed by their shares (a half-edge collapse's: its target's). Decimation
+    /// moves no vertex and solves no value, so appearance only charges the cost (Hoppe 1999's
+    /// held form, [`crate::quadric::attributes::hold`]): removing a vertex on a colour edge
+    /// costs what the edge's smearing does. `q` itself without attribute channels.
+    fn held(&self, q: &Quadric, transfer: &[(u32, f64); 3]) -> Quadric {
+        let Some(at) = &self.p.attrs else {
+            return *q;
+        };
+        let (fan, m) = (&self.fan, at.layout.m);
+        let nx = fan.x.len();
+        let mut h = *q;
+        let mut values = [0.0; MAX_CHANNELS];
+        for (i, corners) in fan.attr.iter().enumerate() {
+            let a = corners[0];
+            if fan.attr[..i].iter().any(|c| c[0] == a) {
+                continue;
+            }
+            // Each loop vertex's attribute vertex on a's side, from a face of that side.
+            let on_side = |x: u32| {
+                fan.attr.iter().enumerate().find_map(|(j, c)| match () {
+                    _ if c[0] != a => None,
+                    _ if fan.x[j] == x => Some(c[1]),
+                    _ if fan.x[(j + 1) % nx] == x => Some(c[2]),
+                    _ => None,
+                })
+            };
+            values[..m].fill(0.0);
+            let mut total = 0.0;
+            for &(x, w) in transfer {
+                if let (true, Some(ax)) = (x != u32::MAX && w > 0.0, on_side(x)) {
+                    for (o, &val) in values.iter_mut().zip(at.values(ax)) {
+                        *o += w * val;
+                    }
+                    total += w;
+                }
+            }
+            if total > 0.0 {
+                values[..m].iter_mut().for_each(|x| *x /= total);
+            } else {
+                values[..m].copy_from_slice(at.values(a));
+            }
+            h = hold(&h, &at.layout, at.sums_of(a), &values[..m]);
+        }
+        h
     }
 
     /// The two loop vertices nearest `p`, sharing a quadric in inverse proportion to their
@@ -552,6 +602,7 @@ impl Engine {
                 self.p.quadrics[x as usize].add(&s);
             }
         }
+        self.transfer_sums(&plan.transfer);
         self.alive[v as usize] = false;
         self.version[v as usize] = self.version[v as usize].wrapping_add(1);
         let mark = self.mark;
@@ -575,6 +626,40 @@ impl Engine {
         }
         self.extra = extra;
         self.fan.faces = old;
+    }
+
+    /// With attribute channels, the attribute sums of the vertex last gathered go where its
+    /// quadric goes (whose folded part they balance): each side's into the loop vertices'
+    /// attribute vertices on that side, by their shares.
+    fn transfer_sums(&mut self, transfer: &[(u32, f64); 3]) {
+        let Some(at) = &mut self.p.attrs else {
+            return;
+        };
+        let fan = &self.fan;
+        let (nx, stride) = (fan.x.len(), at.layout.stride());
+        for (i, corners) in fan.attr.iter().enumerate() {
+            let a = corners[0];
+            if fan.attr[..i].iter().any(|c| c[0] == a) {
+                continue;
+            }
+            for &(x, w) in transfer {
+                if x == u32::MAX || w <= 0.0 {
+                    continue;
+                }
+                let to = fan.attr.iter().enumerate().find_map(|(j, c)| match () {
+                    _ if c[0] != a => None,
+                    _ if fan.x[j] == x => Some(c[1]),
+                    _ if fan.x[(j + 1) % nx] == x => Some(c[2]),
+                    _ => None,
+                });
+                if let Some(to) = to.filter(|&to| to != a) {
+                    let (from, to) = (a as usize * stride, to as usize * stride);
+                    for k in 0..stride {
+                        at.sums[to + k] += w * at.sums[from + k];
+                    }
+                }
+            }
+        }
     }
 
     /// The class of the vertex last gathered.

@@ -75,7 +75,7 @@ impl Decimator {
     /// `feature_angle_deg`, `removal`, `lock_border`, `min_quality`, `max_normal_angle_deg`,
     /// `max_error`, `border_weight` and `pin` apply.
     pub fn new(mesh: &Mesh, opts: &SimplifyOptions) -> Decimator {
-        let p = Prepared::geometric(mesh, opts);
+        let p = Prepared::new(mesh, opts);
         let params = Params {
             removal: opts.removal,
             feature_cos: opts.feature_angle_deg.to_radians().cos(),

@@ -70,20 +70,8 @@ pub(crate) struct Prepared {
 impl Prepared {
     /// The set-up, with the attributes `opts.attributes` weighs in the quadrics.
     pub fn new(input: &Mesh, opts: &SimplifyOptions) -> Prepared {
-        Prepared::with_attributes(input, opts, true)
-    }
-
-    /// The set-up with geometric quadrics only, attributes riding along (decimation keeps its
-    /// vertices' own attributes).
-    pub fn geometric(input: &Mesh, opts: &SimplifyOptions) -> Prepared {
-        Prepared::with_attributes(input, opts, false)
-    }
-
-    fn with_attributes(input: &Mesh, opts: &SimplifyOptions, attributes: bool) -> Prepared {
         let surface = Surface::new(input);
-        let layout = attributes
-            .then(|| Layout::new(&surface.welded, &opts.attributes))
-            .flatten();
+        let layout = Layout::new(&surface.welded, &opts.attributes);
         let Surface {
             welded: mesh,
             class: topo,
