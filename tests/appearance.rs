@@ -313,57 +313,46 @@ fn clustering_fits_colours_over_the_cell() {
     assert_eq!(one, fitted);
 }
 
+/// `method` on `m` at 10% with the default weights and with every weight 0, the invariants
+/// checked: the colour error with the weight well under half of that without, the distance
+/// under three times. Returns the weighted output.
+fn keeps_the_painting(m: &Mesh, method: meshslim::Method) -> Mesh {
+    let run = |w: AttributeWeights| {
+        let mut o = SimplifyOptions::with_ratio(m.triangles.len(), 0.1).unwrap();
+        o.method = method;
+        o.attributes = w;
+        let (out, report) = simplify(m, &o).unwrap();
+        check_invariants(&format!("painted {method:?}"), m, &out, &report);
+        out
+    };
+    let on = run(AttributeWeights::default());
+    let (c_on, d_on) = errors(m, &on);
+    let (c_off, d_off) = errors(m, &run(AttributeWeights::OFF));
+    assert!(
+        c_on < 0.5 * c_off,
+        "{method:?}: colour error {c_on:.4} with the weight, {c_off:.4} without"
+    );
+    assert!(
+        d_on < 3.0 * d_off,
+        "{method:?}: distance {d_on:.3e} with the weight, {d_off:.3e} without"
+    );
+    on
+}
+
 /// `hybrid` weighs colours in both halves: its clustering keeps sharp colour steps out of its
-/// clusters and its rounds weigh and solve colours, so its colour error falls well below that
-/// of the same run with the colour weight 0, at the target and with the invariants.
+/// clusters and its rounds weigh and solve colours.
 #[test]
 fn the_hybrid_keeps_the_painting() {
     let m = painted(mesh::displaced_sphere(130_000, 5));
-    let hybrid = |w: AttributeWeights| {
-        let mut o = SimplifyOptions::with_ratio(m.triangles.len(), 0.1).unwrap();
-        o.method = meshslim::Method::Hybrid;
-        o.attributes = w;
-        let (out, report) = simplify(&m, &o).unwrap();
-        check_invariants("painted hybrid", &m, &out, &report);
-        out
-    };
-    let (c_on, d_on) = errors(&m, &hybrid(AttributeWeights::default()));
-    let (c_off, d_off) = errors(&m, &hybrid(AttributeWeights::OFF));
-    assert!(
-        c_on < 0.5 * c_off,
-        "colour error {c_on:.4} with the weight, {c_off:.4} without"
-    );
-    assert!(
-        d_on < 3.0 * d_off,
-        "distance {d_on:.3e} with the weight, {d_off:.3e} without"
-    );
+    keeps_the_painting(&m, meshslim::Method::Hybrid);
 }
 
 /// `decimate` keeps its vertices and their colours, so appearance only charges its cost: a
-/// vertex on a colour edge costs what removing it smears. Its colour error falls well below
-/// that of the same run with the colour weight 0, and every output colour is an input one.
+/// vertex on a colour edge costs what removing it smears. Every output colour is an input one.
 #[test]
 fn decimation_weighs_colours_in_its_cost() {
     let m = painted(mesh::noisy_sphere(5, 0.002, 7));
-    let decimate = |w: AttributeWeights| {
-        let mut o = SimplifyOptions::with_ratio(m.triangles.len(), 0.1).unwrap();
-        o.method = meshslim::Method::Decimate;
-        o.attributes = w;
-        let (out, report) = simplify(&m, &o).unwrap();
-        check_invariants("painted decimate", &m, &out, &report);
-        out
-    };
-    let on = decimate(AttributeWeights::default());
-    let (c_on, d_on) = errors(&m, &on);
-    let (c_off, d_off) = errors(&m, &decimate(AttributeWeights::OFF));
-    assert!(
-        c_on < 0.5 * c_off,
-        "colour error {c_on:.4} with the weight, {c_off:.4} without"
-    );
-    assert!(
-        d_on < 3.0 * d_off,
-        "distance {d_on:.3e} with the weight, {d_off:.3e} without"
-    );
+    let on = keeps_the_painting(&m, meshslim::Method::Decimate);
     let input = m.colors.as_ref().unwrap();
     for c in on.colors.as_ref().unwrap() {
         assert!(input.contains(c), "{c:?} is not an input colour");
