@@ -1,0 +1,150 @@
+"""meshslim: triangle-mesh simplification on the GPU and the CPU.
+
+Quadric edge collapse (a greedy f64 reference, ``backend="cpu"``, and rounds of parallel
+collapses on any Vulkan/Metal/DX12 GPU, ``backend="gpu"``, with their CPU twin
+``"cpu-parallel"``), vertex clustering (``method="cluster"``, ``"floating-cell"``, and
+``"hybrid"``, clustering then QEM) and vertex decimation (``"decimate"``). Colours and UVs are
+weighed in the cost, so a painted scan keeps its painting.
+
+>>> import meshslim
+>>> mesh = meshslim.read("scan.ply")
+>>> res = meshslim.simplify(mesh, ratio=0.01)
+>>> meshslim.write("scan-1.ply", res.mesh)
+>>> res = meshslim.simplify(V, F, ratio=0.1, colors=C)      # numpy arrays in and out
+>>> res.vertices, res.faces, res.colors, res.report["output_faces"]
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+from . import _meshslim
+from ._meshslim import Mesh, __version__
+
+__all__ = ["Mesh", "Result", "mesh", "read", "write", "simplify", "compare", "__version__"]
+
+METHODS = ("qem", "cluster", "floating-cell", "hybrid", "decimate")
+BACKENDS = ("cpu", "cpu-parallel", "gpu", "auto")
+
+
+def _array(name: str, a: Any, dtype: Any, cols: tuple) -> np.ndarray:
+    """`a` as a C-contiguous 2-D array of `dtype` (no copy when it already is one)."""
+    arr = np.asarray(a)
+    if arr.ndim != 2 or arr.shape[1] not in cols:
+        want = " or ".join(f"(n, {c})" for c in cols)
+        raise ValueError(f"{name}: expected an {want} array, got shape {arr.shape}")
+    if np.issubdtype(dtype, np.integer):
+        if not np.issubdtype(arr.dtype, np.integer):
+            raise ValueError(f"{name}: expected integer vertex indices, got {arr.dtype}")
+        if arr.size and arr.min() < 0:
+            row = int(np.argwhere(arr < 0)[0][0])
+            raise ValueError(f"{name}: row {row} has a negative index: {arr[row].tolist()}")
+        if arr.size and arr.max() > np.iinfo(np.uint32).max:
+            row = int(np.argwhere(arr > np.iinfo(np.uint32).max)[0][0])
+            raise ValueError(f"{name}: row {row} has an index beyond 2**32 - 1")
+    elif not (np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)):
+        raise ValueError(f"{name}: expected numbers, got {arr.dtype}")
+    return np.ascontiguousarray(arr, dtype=dtype)
+
+
+def mesh(vertices: Any, faces: Any, *, normals: Any = None, uvs: Any = None,
+         colors: Any = None) -> Mesh:
+    """A :class:`Mesh` from arrays: ``vertices`` (n, 3), ``faces`` (m, 3) vertex indices, and
+    optional per-vertex ``normals`` (n, 3), ``uvs`` (n, 2) and ``colors`` (n, 3) or (n, 4) in
+    0..1. Raises ``ValueError`` naming the argument and the first offending row."""
+    opt = lambda name, a, cols: None if a is None else _array(name, a, np.float32, cols)
+    return Mesh(
+        _array("vertices", vertices, np.float32, (3,)),
+        _array("faces", faces, np.uint32, (3,)),
+        normals=opt("normals", normals, (3,)),
+        uvs=opt("uvs", uvs, (2,)),
+        colors=opt("colors", colors, (3, 4)),
+    )
+
+
+class Result:
+    """What :func:`simplify` returns: the simplified ``mesh`` (also as ``vertices``, ``faces``,
+    ``normals``, ``uvs``, ``colors`` arrays) and its ``report``, the command line's report as a
+    dict (faces and vertices in and out, stop reason, error, timings of the backend)."""
+
+    def __init__(self, mesh: Mesh, report: dict):
+        self.mesh = mesh
+        self.report = report
+
+    vertices = property(lambda self: self.mesh.vertices)
+    faces = property(lambda self: self.mesh.faces)
+    normals = property(lambda self: self.mesh.normals)
+    uvs = property(lambda self: self.mesh.uvs)
+    colors = property(lambda self: self.mesh.colors)
+
+    def __repr__(self) -> str:
+        r = self.report
+        return (f"meshslim.Result({r['output_faces']} faces from {r['input_faces']}, "
+                f"stop: {r['stop_reason']})")
+
+
+def read(path: str) -> Mesh:
+    """Reads a mesh file: OBJ, PLY (ascii or binary), STL, glTF or GLB. Raises ``OSError`` when
+    the file cannot be read and ``ValueError`` when it does not parse (with the place)."""
+    return _meshslim.read(str(path))
+
+
+def write(path: str, mesh: Mesh) -> None:
+    """Writes ``mesh`` to ``path``, the format from its extension (.ply, .obj, .stl, .glb,
+    .gltf); the file appears whole or not at all."""
+    _meshslim.write(str(path), mesh)
+
+
+def simplify(mesh_or_vertices: Any, faces: Any = None, *, ratio: Optional[float] = None,
+             target_faces: Optional[int] = None, max_error: Optional[float] = None,
+             method: str = "qem", backend: str = "cpu", lock_border: bool = False,
+             colors: Any = None, uvs: Any = None, normals: Any = None,
+             color_weight: Optional[float] = None, uv_weight: Optional[float] = None,
+             normal_weight: Optional[float] = None,
+             progress: Optional[Callable[[float], Any]] = None) -> Result:
+    """Simplifies a mesh to ``ratio`` of its faces (default 0.1) or to ``target_faces``.
+
+    ``mesh_or_vertices``: a :class:`Mesh`, or an (n, 3) vertex array with ``faces`` (m, 3) and
+    optional ``colors``/``uvs``/``normals`` arrays. ``max_error``: stop before any collapse moves
+    the surface further than this (relative to the bounding-box diagonal).
+
+    ``method``: ``"qem"`` (quadric edge collapse, the best surface), ``"cluster"`` and
+    ``"floating-cell"`` (vertex clustering: fastest, may change topology), ``"hybrid"``
+    (clustering, then QEM: near QEM's quality faster), ``"decimate"`` (removes vertices, keeps
+    the rest unmoved). ``backend``: ``"cpu"`` (greedy, f64), ``"cpu-parallel"``, ``"gpu"`` (any
+    Vulkan/Metal/DX12 adapter), ``"auto"``. ``lock_border``: keep open borders exactly.
+
+    ``color_weight`` (default 0.04), ``uv_weight`` (0.3), ``normal_weight`` (0): how much a
+    change of colour, UV or normal counts against moving the surface (a difference of 1 costs
+    like ``weight`` bounding-box diagonals); 0 lets the attribute ride along.
+
+    ``progress``: called with the fraction done, from the simplifying thread. Ctrl+C cancels
+    (``KeyboardInterrupt``). Other Python threads run meanwhile (the GIL is released). Bad
+    arguments raise ``ValueError`` naming them.
+    """
+    if isinstance(mesh_or_vertices, Mesh):
+        if faces is not None or colors is not None or uvs is not None or normals is not None:
+            raise ValueError("faces, colors, uvs and normals go with a vertex array, not a Mesh")
+        m = mesh_or_vertices
+    else:
+        if faces is None:
+            raise ValueError("faces: needed with a vertex array")
+        m = mesh(mesh_or_vertices, faces, normals=normals, uvs=uvs, colors=colors)
+    if progress is not None and not callable(progress):
+        raise ValueError("progress: expected a callable taking the fraction done")
+    out, report = _meshslim.simplify(
+        m, ratio=ratio, target_faces=target_faces, max_error=max_error, method=method,
+        backend=backend, lock_border=lock_border, color_weight=color_weight,
+        uv_weight=uv_weight, normal_weight=normal_weight, progress=progress)
+    return Result(out, json.loads(report))
+
+
+def compare(a: Mesh, b: Mesh, *, samples: Optional[int] = None,
+            seed: Optional[int] = None) -> dict:
+    """Measures how far ``b`` is from ``a``: the two-sided Metro distance (absolute and
+    relative to the diagonal), colour and normal deviation, area, volume, triangle quality and
+    topology of each, as ``meshslim compare --json`` prints them."""
+    return json.loads(_meshslim.compare(a, b, samples=samples, seed=seed))

@@ -1,0 +1,93 @@
+"""Type stubs for meshslim: triangle-mesh simplification on the GPU and the CPU."""
+
+from typing import Any, Callable, Optional
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+METHODS: tuple
+BACKENDS: tuple
+
+class Mesh:
+    """A triangle mesh: positions, faces and the per-vertex attributes it has."""
+
+    def __init__(
+        self,
+        vertices: npt.NDArray[np.float32],
+        faces: npt.NDArray[np.uint32],
+        *,
+        normals: Optional[npt.NDArray[np.float32]] = ...,
+        uvs: Optional[npt.NDArray[np.float32]] = ...,
+        colors: Optional[npt.NDArray[np.float32]] = ...,
+    ) -> None: ...
+    @property
+    def vertices(self) -> npt.NDArray[np.float32]:
+        """Positions, (n, 3) float32."""
+    @property
+    def faces(self) -> npt.NDArray[np.uint32]:
+        """Triangles, (m, 3) uint32 vertex indices."""
+    @property
+    def normals(self) -> Optional[npt.NDArray[np.float32]]:
+        """Per-vertex normals, (n, 3), or None."""
+    @property
+    def uvs(self) -> Optional[npt.NDArray[np.float32]]:
+        """Per-vertex texture coordinates, (n, 2), or None."""
+    @property
+    def colors(self) -> Optional[npt.NDArray[np.float32]]:
+        """Per-vertex RGBA colours in 0..1, (n, 4), or None."""
+
+class Result:
+    """The simplified mesh and the report of the run."""
+
+    mesh: Mesh
+    report: dict
+    @property
+    def vertices(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def faces(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def normals(self) -> Optional[npt.NDArray[np.float32]]: ...
+    @property
+    def uvs(self) -> Optional[npt.NDArray[np.float32]]: ...
+    @property
+    def colors(self) -> Optional[npt.NDArray[np.float32]]: ...
+
+def mesh(
+    vertices: Any,
+    faces: Any,
+    *,
+    normals: Any = ...,
+    uvs: Any = ...,
+    colors: Any = ...,
+) -> Mesh:
+    """A Mesh from arrays; ValueError names the argument and the first offending row."""
+
+def read(path: str) -> Mesh:
+    """Reads OBJ, PLY, STL, glTF or GLB."""
+
+def write(path: str, mesh: Mesh) -> None:
+    """Writes the format the extension names."""
+
+def simplify(
+    mesh_or_vertices: Any,
+    faces: Any = ...,
+    *,
+    ratio: Optional[float] = ...,
+    target_faces: Optional[int] = ...,
+    max_error: Optional[float] = ...,
+    method: str = ...,
+    backend: str = ...,
+    lock_border: bool = ...,
+    colors: Any = ...,
+    uvs: Any = ...,
+    normals: Any = ...,
+    color_weight: Optional[float] = ...,
+    uv_weight: Optional[float] = ...,
+    normal_weight: Optional[float] = ...,
+    progress: Optional[Callable[[float], Any]] = ...,
+) -> Result:
+    """Simplifies to `ratio` of the faces (default 0.1) or to `target_faces`."""
+
+def compare(a: Mesh, b: Mesh, *, samples: Optional[int] = ..., seed: Optional[int] = ...) -> dict:
+    """Two-sided Metro distance, appearance, area, volume, quality and topology."""
