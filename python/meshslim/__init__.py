@@ -24,7 +24,8 @@ import numpy as np
 from . import _meshslim
 from ._meshslim import Mesh, __version__
 
-__all__ = ["Mesh", "Result", "mesh", "read", "write", "simplify", "compare", "__version__"]
+__all__ = ["Mesh", "Result", "mesh", "read", "write", "simplify", "lods", "remesh", "compare",
+           "__version__"]
 
 METHODS = ("qem", "cluster", "floating-cell", "hybrid", "decimate")
 BACKENDS = ("cpu", "cpu-parallel", "gpu", "auto")
@@ -81,9 +82,7 @@ class Result:
     colors = property(lambda self: self.mesh.colors)
 
     def __repr__(self) -> str:
-        r = self.report
-        return (f"meshslim.Result({r['output_faces']} faces from {r['input_faces']}, "
-                f"stop: {r['stop_reason']})")
+        return f"meshslim.Result({len(self.mesh.faces)} faces)"
 
 
 def read(path: str) -> Mesh:
@@ -139,6 +138,40 @@ def simplify(mesh_or_vertices: Any, faces: Any = None, *, ratio: Optional[float]
         m, ratio=ratio, target_faces=target_faces, max_error=max_error, method=method,
         backend=backend, lock_border=lock_border, color_weight=color_weight,
         uv_weight=uv_weight, normal_weight=normal_weight, progress=progress)
+    return Result(out, json.loads(report))
+
+
+def lods(mesh: Mesh, ratios: Any, *, method: str = "qem", backend: str = "cpu",
+         lock_border: bool = False, color_weight: Optional[float] = None,
+         uv_weight: Optional[float] = None, normal_weight: Optional[float] = None,
+         progress: Optional[Callable[[float], Any]] = None) -> list:
+    """Levels of detail at falling ``ratios`` (each in (0, 1]) of ``mesh``'s faces, made in one
+    run: each level goes on from the one before, so the chain costs about one simplification
+    to the coarsest. ``method`` is ``"qem"`` (any backend), ``"hybrid"`` or ``"decimate"``.
+    Returns a :class:`Result` per level; each report holds ``ratio``, ``target_faces``,
+    ``output_faces``, ``stop_reason``, ``max_error`` (the chain's largest so far, relative to
+    the diagonal), ``seconds`` (since the start) and ``backend``."""
+    if progress is not None and not callable(progress):
+        raise ValueError("progress: expected a callable taking the fraction done")
+    levels, backend_ran = _meshslim.lods(
+        mesh, [float(r) for r in ratios], method=method, backend=backend,
+        lock_border=lock_border, color_weight=color_weight, uv_weight=uv_weight,
+        normal_weight=normal_weight, progress=progress)
+    return [Result(m, dict(json.loads(facts), backend=backend_ran)) for m, facts in levels]
+
+
+def remesh(mesh: Mesh, *, edge_factor: Optional[float] = None,
+           edge_length: Optional[float] = None, target_faces: Optional[int] = None,
+           iterations: int = 5, feature_angle: float = 45.0,
+           lock_border: bool = False) -> Result:
+    """Isotropic remeshing (Botsch & Kobbelt 2004): near-equilateral triangles of one edge
+    length, ``edge_factor`` times the mean edge, an absolute ``edge_length``, or the length that
+    gives about ``target_faces`` (default: the mean edge); creases sharper than
+    ``feature_angle`` degrees and borders kept (``lock_border``: borders not touched at all).
+    The report holds the iterations' counts and timings."""
+    out, report = _meshslim.remesh(
+        mesh, edge_factor=edge_factor, edge_length=edge_length, target_faces=target_faces,
+        iterations=iterations, feature_angle=feature_angle, lock_border=lock_border)
     return Result(out, json.loads(report))
 
 

@@ -89,5 +89,31 @@ def simplify(
 ) -> Result:
     """Simplifies to `ratio` of the faces (default 0.1) or to `target_faces`."""
 
+def lods(
+    mesh: Mesh,
+    ratios: Any,
+    *,
+    method: str = ...,
+    backend: str = ...,
+    lock_border: bool = ...,
+    color_weight: Optional[float] = ...,
+    uv_weight: Optional[float] = ...,
+    normal_weight: Optional[float] = ...,
+    progress: Optional[Callable[[float], Any]] = ...,
+) -> list[Result]:
+    """Levels of detail at falling ratios, in one run."""
+
+def remesh(
+    mesh: Mesh,
+    *,
+    edge_factor: Optional[float] = ...,
+    edge_length: Optional[float] = ...,
+    target_faces: Optional[int] = ...,
+    iterations: int = ...,
+    feature_angle: float = ...,
+    lock_border: bool = ...,
+) -> Result:
+    """Isotropic remeshing to one edge length."""
+
 def compare(a: Mesh, b: Mesh, *, samples: Optional[int] = ..., seed: Optional[int] = ...) -> dict:
     """Two-sided Metro distance, appearance, area, volume, quality and topology."""

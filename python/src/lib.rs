@@ -242,6 +242,84 @@ fn pick<T: Copy>(what: &str, name: &str, all: &[T], of: impl Fn(T) -> &'static s
     })
 }
 
+/// Method, backend, border and appearance weights (`None`: the default) into `opts`.
+fn configure(
+    opts: &mut SimplifyOptions,
+    method: &str,
+    backend: &str,
+    lock_border: bool,
+    (color, uv, normal): (Option<f64>, Option<f64>, Option<f64>),
+) -> PyResult<()> {
+    opts.lock_border = lock_border;
+    opts.method = pick(
+        "method",
+        method,
+        &[
+            Method::Qem,
+            Method::Cluster,
+            Method::FloatingCell,
+            Method::Hybrid,
+            Method::Decimate,
+        ],
+        Method::name,
+    )?;
+    opts.backend = pick(
+        "backend",
+        backend,
+        &[
+            Backend::Cpu,
+            Backend::CpuParallel,
+            Backend::Gpu,
+            Backend::Auto,
+        ],
+        Backend::name,
+    )?;
+    let d = AttributeWeights::default();
+    opts.attributes = AttributeWeights {
+        color: color.unwrap_or(d.color),
+        uv: uv.unwrap_or(d.uv),
+        normal: normal.unwrap_or(d.normal),
+    };
+    Ok(())
+}
+
+/// Runs `work` without the GIL, with progress and Ctrl+C: the library calls back from its own
+/// thread; each call takes the GIL briefly, reports to `progress`, and checks for a pending
+/// signal. A signal (KeyboardInterrupt) or an exception from the callback cancels the run
+/// through `opts.cancel` and is raised once it has stopped.
+fn detached<T: Send>(
+    py: Python<'_>,
+    opts: &SimplifyOptions,
+    progress: Option<Py<PyAny>>,
+    work: impl FnOnce(&SimplifyOptions, &mut dyn FnMut(f32)) -> meshslim::Result<T> + Send,
+) -> PyResult<T> {
+    let cancel = opts.cancel.clone();
+    let mut stopped: Option<PyErr> = None;
+    let mut report_progress = |f: f32| {
+        if stopped.is_some() {
+            return;
+        }
+        Python::attach(|py| {
+            // The driver's fraction can pass 1 by a face's worth (a round lands one below its
+            // target); callers get 0..=1.
+            let f = f.clamp(0.0, 1.0);
+            let called = py.check_signals().and_then(|()| match &progress {
+                Some(cb) => cb.call1(py, (f,)).map(drop),
+                None => Ok(()),
+            });
+            if let Err(e) = called {
+                stopped = Some(e);
+                cancel.cancel();
+            }
+        })
+    };
+    let result = py.detach(|| work(opts, &mut report_progress));
+    if let Some(e) = stopped {
+        return Err(e);
+    }
+    result.map_err(raise)
+}
+
 /// Simplifies `mesh`; returns the result and the report as JSON (the wrapper makes it a dict).
 #[pyfunction]
 #[pyo3(signature = (mesh, *, ratio=None, target_faces=None, max_error=None, method="qem",
@@ -276,65 +354,101 @@ fn simplify(
             }
         };
         opts.max_error = max_error;
-        opts.lock_border = lock_border;
-        opts.method = pick(
-            "method",
-            method,
-            &[
-                Method::Qem,
-                Method::Cluster,
-                Method::FloatingCell,
-                Method::Hybrid,
-                Method::Decimate,
-            ],
-            Method::name,
-        )?;
-        opts.backend = pick(
-            "backend",
-            backend,
-            &[
-                Backend::Cpu,
-                Backend::CpuParallel,
-                Backend::Gpu,
-                Backend::Auto,
-            ],
-            Backend::name,
-        )?;
-        let d = AttributeWeights::default();
-        opts.attributes = AttributeWeights {
-            color: color_weight.unwrap_or(d.color),
-            uv: uv_weight.unwrap_or(d.uv),
-            normal: normal_weight.unwrap_or(d.normal),
-        };
-        let cancel = opts.cancel.clone();
-        // Progress and Ctrl+C: the simplifier calls back without the GIL; each call takes it
-        // briefly, reports, and checks for a pending signal. A signal (KeyboardInterrupt) or an
-        // exception from the callback cancels the run through the library's flag and is raised
-        // once it has stopped.
-        let mut stopped: Option<PyErr> = None;
-        let mut report_progress = |f: f32| {
-            if stopped.is_some() {
-                return;
-            }
-            Python::attach(|py| {
-                // The driver's fraction can pass 1 by a face's worth (a round lands one below
-                // its target); callers get 0..=1.
-                let f = f.clamp(0.0, 1.0);
-                let called = py.check_signals().and_then(|()| match &progress {
-                    Some(cb) => cb.call1(py, (f,)).map(drop),
-                    None => Ok(()),
+        let weights = (color_weight, uv_weight, normal_weight);
+        configure(&mut opts, method, backend, lock_border, weights)?;
+        let (out, report) = detached(py, &opts, progress, |opts, p| {
+            meshslim::simplify_with_progress(m, opts, p)
+        })?;
+        let json = serde_json::to_string(&report)
+            .map_err(|e| PyRuntimeError::new_err(format!("the report: {e}")))?;
+        Ok((PyMesh { inner: out }, json))
+    })
+}
+
+/// Levels of detail of `mesh` at falling `ratios`, in one run (each level goes on from the one
+/// before); returns each level's mesh and its facts as JSON, and the backend that ran them.
+#[pyfunction]
+#[pyo3(signature = (mesh, ratios, *, method="qem", backend="cpu", lock_border=false,
+    color_weight=None, uv_weight=None, normal_weight=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn lods(
+    py: Python<'_>,
+    mesh: &PyMesh,
+    ratios: Vec<f64>,
+    method: &str,
+    backend: &str,
+    lock_border: bool,
+    color_weight: Option<f64>,
+    uv_weight: Option<f64>,
+    normal_weight: Option<f64>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(Vec<(PyMesh, String)>, String)> {
+    guarded(|| {
+        let m = &mesh.inner;
+        let mut opts = SimplifyOptions::with_faces(0);
+        let weights = (color_weight, uv_weight, normal_weight);
+        configure(&mut opts, method, backend, lock_border, weights)?;
+        let (levels, ran) = detached(py, &opts, progress, |opts, p| {
+            meshslim::lod::lod_chain(m, opts, &ratios, p)
+        })?;
+        let levels = levels
+            .into_iter()
+            .map(|l| {
+                let facts = serde_json::json!({
+                    "ratio": l.ratio,
+                    "target_faces": l.target_faces,
+                    "output_faces": l.mesh.triangles.len(),
+                    "stop_reason": l.stop_reason,
+                    "max_error": l.max_error,
+                    "seconds": l.seconds,
                 });
-                if let Err(e) = called {
-                    stopped = Some(e);
-                    cancel.cancel();
-                }
+                (PyMesh { inner: l.mesh }, facts.to_string())
             })
+            .collect();
+        Ok((levels, ran.name().to_string()))
+    })
+}
+
+/// Isotropic remeshing (Botsch & Kobbelt 2004): near-equilateral triangles at one edge length
+/// (`edge_factor` × the mean edge, an `edge_length`, or the length that gives `target_faces`),
+/// creases over `feature_angle` degrees kept; returns the mesh and the report as JSON.
+#[pyfunction]
+#[pyo3(signature = (mesh, *, edge_factor=None, edge_length=None, target_faces=None,
+    iterations=5, feature_angle=45.0, lock_border=false))]
+#[allow(clippy::too_many_arguments)]
+fn remesh(
+    py: Python<'_>,
+    mesh: &PyMesh,
+    edge_factor: Option<f64>,
+    edge_length: Option<f64>,
+    target_faces: Option<usize>,
+    iterations: usize,
+    feature_angle: f64,
+    lock_border: bool,
+) -> PyResult<(PyMesh, String)> {
+    use meshslim::remesh::{EdgeTarget, RemeshOptions};
+    guarded(|| {
+        let target = match (edge_factor, edge_length, target_faces) {
+            (None, None, None) => EdgeTarget::MeanEdge,
+            (Some(f), None, None) => EdgeTarget::MeanEdgeTimes(f),
+            (None, Some(l), None) => EdgeTarget::Length(l),
+            (None, None, Some(n)) => EdgeTarget::Faces(n),
+            _ => {
+                return Err(PyValueError::new_err(
+                    "give one of edge_factor, edge_length and target_faces",
+                ));
+            }
         };
-        let result = py.detach(|| meshslim::simplify_with_progress(m, &opts, &mut report_progress));
-        if let Some(e) = stopped {
-            return Err(e);
-        }
-        let (out, report) = result.map_err(raise)?;
+        let opts = RemeshOptions {
+            target,
+            iterations,
+            feature_angle_deg: feature_angle,
+            lock_border,
+            ..Default::default()
+        };
+        let (out, report) = py
+            .detach(|| meshslim::remesh::remesh(&mesh.inner, &opts))
+            .map_err(raise)?;
         let json = serde_json::to_string(&report)
             .map_err(|e| PyRuntimeError::new_err(format!("the report: {e}")))?;
         Ok((PyMesh { inner: out }, json))
@@ -374,6 +488,8 @@ fn _meshslim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(write, m)?)?;
     m.add_function(wrap_pyfunction!(simplify, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(lods, m)?)?;
+    m.add_function(wrap_pyfunction!(remesh, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

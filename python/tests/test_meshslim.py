@@ -108,6 +108,30 @@ def test_compare_measures_the_distance():
     assert 0 < meshslim.compare(a, b)["distance"]["two_sided"]["mean_rel"] < 0.01
 
 
+def test_levels_of_detail_in_one_run():
+    V, F = torus()
+    levels = meshslim.lods(meshslim.mesh(V, F, colors=painted(V)), [0.5, 0.1, 0.02])
+    faces = [len(l.faces) for l in levels]
+    assert faces == sorted(faces, reverse=True)
+    for level, ratio in zip(levels, [0.5, 0.1, 0.02]):
+        assert level.report["ratio"] == ratio
+        assert len(level.faces) in (level.report["target_faces"], level.report["target_faces"] - 1)
+        assert level.colors is not None
+    assert levels[0].report["backend"] == "cpu"
+    with pytest.raises(ValueError, match="must fall"):
+        meshslim.lods(meshslim.mesh(V, F), [0.1, 0.5])
+
+
+def test_remesh_makes_better_triangles():
+    V, F = torus()
+    a = meshslim.mesh(V, F)
+    even = meshslim.remesh(a, edge_factor=2)
+    assert 0 < len(even.faces) < len(F)
+    assert meshslim.compare(a, even.mesh)["distance"]["two_sided"]["mean_rel"] < 0.01
+    with pytest.raises(ValueError, match="one of edge_factor"):
+        meshslim.remesh(a, edge_factor=2, target_faces=100)
+
+
 def test_progress_is_reported_and_its_exception_stops_the_run():
     V, F = torus()
     seen = []
