@@ -6,8 +6,11 @@ bytes as the command line), every method on the CPU, the GPU backend on the mach
     /tmp/venv/bin/python -m pytest python/tests
 """
 
+import _thread
 import os
 import subprocess
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -143,6 +146,40 @@ def test_progress_is_reported_and_its_exception_stops_the_run():
 
     with pytest.raises(ZeroDivisionError, match="from the callback"):
         meshslim.simplify(V, F, ratio=0.05, backend="cpu-parallel", progress=boom)
+
+
+def test_other_threads_run_and_ctrl_c_cancels():
+    V, F = torus(400, 200)  # 160,000 faces: long enough to look at
+    ticks = []
+    done = threading.Event()
+
+    def count():
+        while not done.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.001)
+
+    counter = threading.Thread(target=count)
+    counter.start()
+    start = time.perf_counter()
+    meshslim.simplify(V, F, ratio=0.01, backend="cpu-parallel")
+    end = time.perf_counter()
+    done.set()
+    counter.join()
+    # The GIL was released: the other thread kept ticking while the call ran.
+    assert sum(start < t < end for t in ticks) > 10
+
+    # Ctrl+C (a pending SIGINT) during the run cancels it at the next progress report and
+    # raises KeyboardInterrupt: the interrupt arrives at the first report, and no other follows.
+    seen = []
+
+    def interrupt_once(f):
+        seen.append(f)
+        if len(seen) == 1:
+            _thread.interrupt_main()
+
+    with pytest.raises(KeyboardInterrupt):
+        meshslim.simplify(V, F, ratio=0.001, backend="cpu-parallel", progress=interrupt_once)
+    assert len(seen) == 1 and seen[0] < 0.5
 
 
 def test_the_gpu_backend_runs_on_the_adapter():
