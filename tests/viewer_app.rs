@@ -645,3 +645,27 @@ fn a_coloured_mesh_opens_in_colour_mode() {
     h.state_mut().set_style(style, Some(Mode::Shaded));
     assert_eq!(h.state().style.mode, Mode::Shaded);
 }
+
+/// On a software adapter (lavapipe here) the window starts on cpu-parallel, as the library's
+/// `auto` would, and its panel says why; gpu stays one click away.
+#[test]
+fn the_window_starts_on_the_cores_over_a_software_adapter() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let h = harness(
+        Model::from_mesh("torus".into(), meshslim::mesh::torus(1.0, 0.35, 48, 24)).unwrap(),
+    );
+    let s = h.state();
+    assert!(s.has_gpu_backend(), "{}", s.status);
+    if s.adapter().to_lowercase().contains("llvmpipe") {
+        assert_eq!(s.backend, Backend::CpuParallel);
+        assert!(
+            s.backend_why.contains("software rasterizer"),
+            "{}",
+            s.backend_why
+        );
+    } else {
+        assert_eq!(s.backend, Backend::Gpu, "{}", s.backend_why);
+    }
+}

@@ -16,7 +16,8 @@ use crate::lod::manifest::{self, ManifestKind};
 
 pub(super) const VIEW_AFTER_HELP: &str = "\
 In the window: left drag orbits, right or middle drag pans, the wheel zooms, G flies (W A S D),
-F frames the mesh, 1-4 switch shaded / normals / heatmap / texture, X wireframe, B side by side,
+F frames the mesh, 1-6 switch shaded / normals / heatmap / texture / quality / colour, X wireframe,
+B side by side,
 Enter simplifies to the target, Esc cancels, Ctrl+O opens, Ctrl+S saves, P takes a screenshot;
 F1 lists them all. Simplification runs beside the drawing: the window keeps drawing (frame time
 in the side panel) and the run can be cancelled.
@@ -59,7 +60,7 @@ pub struct ViewArgs {
     pub ratio: Option<f64>,
 
     /// The algorithm for --ratio (and the window's starting choice): qem, cluster,
-    /// floating-cell or hybrid, as `meshslim simplify --method`
+    /// floating-cell, hybrid or decimate, as `meshslim simplify --method`
     #[arg(long, value_enum, default_value_t = super::simplify::MethodArg::Qem)]
     pub method: super::simplify::MethodArg,
 

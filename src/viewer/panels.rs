@@ -179,6 +179,8 @@ impl ViewerApp {
                 });
             }
         });
+        // Which backend the window started on, and why (a software adapter is no GPU).
+        ui.small(format!("started on {}", self.backend_why));
         ui.horizontal(|ui| {
             let busy = self.job.is_some();
             if ui
