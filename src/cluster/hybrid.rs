@@ -75,7 +75,7 @@ const FOLD_COS: f32 = 0.5;
 /// Per face of `b`: the unit normal of the input face it came from (its origin), read from the
 /// faces in blocks so that a streamed input gets them too. The rounds after the clustering
 /// measure turning from these, not from the clusters' faces.
-pub(super) fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
+fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
     use crate::cpu::common::{cross, length, scale, sub, xyz};
     let mut at: Vec<u32> = Vec::new();
     for (k, &(origin, _)) in b.faces.iter().enumerate() {
@@ -128,19 +128,22 @@ fn folded_clusters(b: &Built, normals: &[[f32; 3]]) -> Vec<u32> {
 
 /// The hybrid's clustering: to at least `intermediate` faces (the rounds then go to `target`),
 /// clusters that pinch a non-manifold edge or fold a face over taken apart until none is left.
+/// Returns the grid, the build and its faces' input normals ([`origin_normals`]: the rounds'
+/// reference, read once per build since a streamed input reads its file for them).
 pub(super) fn cluster_repaired(
     work: &mut Work,
     intermediate: usize,
     target: usize,
     report: &mut ClusterReport,
-) -> Result<(Grid, Built)> {
+) -> Result<(Grid, Built, Vec<[f32; 3]>)> {
     let (grid, mut built, _) = cluster_to(work, intermediate, None, Some(target), report)?;
+    let mut normals = origin_normals(work, &built)?;
     // Splitting cells by connectivity keeps separate sheets apart, but a sheet folded inside
     // one cell can still pinch into a non-manifold edge: take the clusters on one apart (their
     // members each their own cluster) and build again, until none is left.
     for _ in 0..MAX_REPAIRS {
         let mut bad = pinched_clusters(&built);
-        bad.extend(folded_clusters(&built, &origin_normals(work, &built)?));
+        bad.extend(folded_clusters(&built, &normals));
         bad.sort_unstable();
         bad.dedup();
         if bad.is_empty() {
@@ -152,10 +155,11 @@ pub(super) fn cluster_repaired(
             }
         }
         built = work.build(&grid)?;
+        normals = origin_normals(work, &built)?;
         report.builds += 1;
         report.repaired_clusters += bad.len();
     }
-    Ok((grid, built))
+    Ok((grid, built, normals))
 }
 
 /// The rounds from `up` on `opts.backend` (cpu-parallel or gpu).
@@ -224,7 +228,7 @@ pub(crate) fn hybrid_upload(
         let mut pts = Points::new(mesh);
         let mut work = prepare(&mut pts, &opts, true)?;
         work.colors = super::colors::ColourSplit::of(mesh, opts.attributes.color);
-        let (grid, built) =
+        let (grid, built, normals) =
             cluster_repaired(&mut work, intermediate, opts.target_faces, &mut report)?;
         tally(&mut report, &built);
         report.cell_size = grid.h as f64;
@@ -233,7 +237,7 @@ pub(crate) fn hybrid_upload(
         let frame = (work.pts.center, work.pts.scale);
         (
             crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics)
-                .reference_normals(&origin_normals(&work, &built)?)
+                .reference_normals(&normals)
                 .attributes(&opts.attributes),
             max_error(&built),
         )

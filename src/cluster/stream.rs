@@ -113,22 +113,20 @@ pub fn simplify_file_in_blocks(
         };
         return super::hybrid::simplify_hybrid(&mesh, &opts, progress);
     }
-    let (grid, built, stop) = if hybrid {
-        let (grid, built) =
+    // The hybrid's faces' input normals come with its build (the rounds measure from them).
+    let (grid, built, stop, normals) = if hybrid {
+        let (grid, built, normals) =
             super::hybrid::cluster_repaired(&mut work, to, target_faces, &mut report)?;
-        (grid, built, StopReason::TargetReached)
+        (grid, built, StopReason::TargetReached, normals)
     } else {
-        cluster_to(&work, target_faces, opts.max_error, None, &mut report)?
+        let (grid, built, stop) =
+            cluster_to(&work, target_faces, opts.max_error, None, &mut report)?;
+        (grid, built, stop, Vec::new())
     };
     opts.cancel.check()?;
     tally(&mut report, &built);
     report.cell_size = grid.h as f64;
     let (clustered, quadrics) = output(work.pts, &built, colors.as_deref());
-    let normals = if hybrid {
-        super::hybrid::origin_normals(&work, &built)?
-    } else {
-        Vec::new()
-    };
     let built_error = max_error(&built);
     let frame = (work.pts.center, work.pts.scale);
     drop(work);

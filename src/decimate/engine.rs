@@ -378,27 +378,13 @@ impl Engine {
             return *q;
         };
         let (fan, m) = (&self.fan, at.layout.m);
-        let nx = fan.x.len();
         let mut h = *q;
         let mut values = [0.0; MAX_CHANNELS];
-        for (i, corners) in fan.attr.iter().enumerate() {
-            let a = corners[0];
-            if fan.attr[..i].iter().any(|c| c[0] == a) {
-                continue;
-            }
-            // Each loop vertex's attribute vertex on a's side, from a face of that side.
-            let on_side = |x: u32| {
-                fan.attr.iter().enumerate().find_map(|(j, c)| match () {
-                    _ if c[0] != a => None,
-                    _ if fan.x[j] == x => Some(c[1]),
-                    _ if fan.x[(j + 1) % nx] == x => Some(c[2]),
-                    _ => None,
-                })
-            };
+        for a in fan.centre_attrs() {
             values[..m].fill(0.0);
             let mut total = 0.0;
             for &(x, w) in transfer {
-                if let (true, Some(ax)) = (x != u32::MAX && w > 0.0, on_side(x)) {
+                if let (true, Some(ax)) = (x != u32::MAX && w > 0.0, fan.attr_on_side(a, x)) {
                     for (o, &val) in values.iter_mut().zip(at.values(ax)) {
                         *o += w * val;
                     }
@@ -635,23 +621,13 @@ impl Engine {
         let Some(at) = &mut self.p.attrs else {
             return;
         };
-        let fan = &self.fan;
-        let (nx, stride) = (fan.x.len(), at.layout.stride());
-        for (i, corners) in fan.attr.iter().enumerate() {
-            let a = corners[0];
-            if fan.attr[..i].iter().any(|c| c[0] == a) {
-                continue;
-            }
+        let (fan, stride) = (&self.fan, at.layout.stride());
+        for a in fan.centre_attrs() {
             for &(x, w) in transfer {
                 if x == u32::MAX || w <= 0.0 {
                     continue;
                 }
-                let to = fan.attr.iter().enumerate().find_map(|(j, c)| match () {
-                    _ if c[0] != a => None,
-                    _ if fan.x[j] == x => Some(c[1]),
-                    _ if fan.x[(j + 1) % nx] == x => Some(c[2]),
-                    _ => None,
-                });
+                let to = fan.attr_on_side(a, x);
                 if let Some(to) = to.filter(|&to| to != a) {
                     let (from, to) = (a as usize * stride, to as usize * stride);
                     for k in 0..stride {

@@ -93,6 +93,27 @@ pub(super) struct FanInput<'a> {
 }
 
 impl Fan {
+    /// The centre's attribute vertices, each once (a seam or feature vertex has one per side).
+    pub fn centre_attrs(&self) -> impl Iterator<Item = u32> + '_ {
+        self.attr
+            .iter()
+            .enumerate()
+            .filter(|&(i, c)| !self.attr[..i].iter().any(|d| d[0] == c[0]))
+            .map(|(_, c)| c[0])
+    }
+
+    /// Loop vertex `x`'s attribute vertex on the side where the centre uses `a`, from a face of
+    /// that side; `None` when no face of the side reaches `x`.
+    pub fn attr_on_side(&self, a: u32, x: u32) -> Option<u32> {
+        let nx = self.x.len();
+        self.attr.iter().enumerate().find_map(|(j, c)| match () {
+            _ if c[0] != a => None,
+            _ if self.x[j] == x => Some(c[1]),
+            _ if self.x[(j + 1) % nx] == x => Some(c[2]),
+            _ => None,
+        })
+    }
+
     /// Gathers the fan of `v` from its live `faces` and classifies it. `held` (a caller's pin)
     /// makes it complex.
     pub fn gather(&mut self, v: u32, faces: &[u32], held: bool, m: &FanInput) {
