@@ -2,15 +2,16 @@
 //! twin (src/cluster/twins.rs) on generated meshes, integers exactly and floats within 1e-4, and
 //! the whole GPU build against the CPU driver's. With CI=true a missing adapter fails.
 
+mod cluster_twins;
 mod common;
 
+use cluster_twins as twins;
 use common::{close, gpu_context, pod};
 use meshslim::Mesh;
 use meshslim::cluster::gpu::{GpuClusterMesh, GpuClusterer, Part};
 use meshslim::cluster::gpu_schedule::CBuf;
 use meshslim::cluster::grid::Grid;
 use meshslim::cluster::stages::{self, Placement};
-use meshslim::cluster::twins;
 use meshslim::cpu::common::quadric_eval;
 use meshslim::gpu::types::{ClusterPlaced, Quadric, SORT_BLOCK};
 
@@ -257,7 +258,7 @@ fn driver_build(
     faces: &[[u32; 3]],
     locked: &[bool],
     grid: &Grid,
-) -> twins::ClusterBuild {
+) -> meshslim::cluster::gpu::ClusterBuild {
     let keys = stages::cell_keys(grid, pos, locked);
     let (sorted, members) = stages::radix_sort(&keys);
     let cells = stages::cell_ranges(&sorted, members);
@@ -289,7 +290,7 @@ fn driver_build(
         out,
         stages::cluster_faces(faces, &clusters.vertex_cluster, clusters.len(), false)
     );
-    twins::ClusterBuild {
+    meshslim::cluster::gpu::ClusterBuild {
         placed,
         faces: out,
         clusters: clusters.len(),
@@ -330,7 +331,11 @@ fn the_gpu_build_equals_the_cpu_build() {
                 .read_buffer(CBuf::CellHead, 4 * (pos.len() as u64 + 1))
                 .unwrap());
             let mut want = vec![[0f32; 4]; n];
-            let c = twins::cluster_params(&grid, pos.len(), m.triangles.len());
+            let c = meshslim::cluster::gpu_schedule::cluster_params(
+                &grid,
+                pos.len(),
+                m.triangles.len(),
+            );
             twins::cluster_mesh(&c, &heads, &placed, &mut want);
             let got: Vec<[f32; 4]> =
                 pod(gpu.read_buffer(CBuf::MeshPositions, 16 * n as u64).unwrap());
@@ -350,7 +355,7 @@ fn the_gpu_build_equals_the_cpu_build() {
                 (twin.clusters, twin.cells),
                 "{label}: counts"
             );
-            let twins::ClusterBuild {
+            let meshslim::cluster::gpu::ClusterBuild {
                 placed,
                 faces,
                 vertex_cluster,

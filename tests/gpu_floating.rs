@@ -1,19 +1,22 @@
 //! `--method floating-cell` on the gpu backend (lavapipe in CI): every floating stage's buffers
-//! against its CPU twin (src/cluster/floating_twins.rs) fed the GPU's own inputs, so integers
+//! against its CPU twin (tests/cluster_twins/floating.rs) fed the GPU's own inputs, so integers
 //! must match exactly stage by stage and floats within 1e-4; the whole GPU build against the
 //! twins' chain; and `simplify` on the GPU against cpu-parallel. With CI=true a missing adapter
 //! fails.
 
+mod cluster_twins;
 mod common;
 
+use cluster_twins as twins;
+use cluster_twins::floating as ft;
 use common::{close, gpu_context};
 use meshslim::Mesh;
 use meshslim::cluster::floating::{self, UNCLAIMED};
 use meshslim::cluster::floating_gpu::FcPart;
-use meshslim::cluster::floating_twins::{self as ft, ROUND_SLOTS};
 use meshslim::cluster::gpu::{GpuClusterMesh, GpuClusterer, Part};
 use meshslim::cluster::gpu_schedule::CBuf;
-use meshslim::cluster::{stages, twins};
+use meshslim::cluster::gpu_schedule::ROUND_SLOTS;
+use meshslim::cluster::stages;
 use meshslim::gpu::types::{ClusterPlaced, Params, Quadric};
 
 /// Meshes, each with the nominal radii (unit-diagonal frame) to build at and whether to lock
@@ -174,7 +177,12 @@ fn each_floating_stage_matches_its_cpu_twin() {
             vals,
             "{name}: rank values"
         );
-        let (_, order) = sort_on_both(&mut gpu, name, ft::RANK_PASSES, nv);
+        let (_, order) = sort_on_both(
+            &mut gpu,
+            name,
+            meshslim::cluster::gpu_schedule::RANK_PASSES,
+            nv,
+        );
         gpu.run_fc_part(FcPart::Order).unwrap();
         assert_eq!(
             rd::<u32>(&gpu, CBuf::FcOrder, nv),
@@ -234,7 +242,7 @@ fn each_floating_stage_matches_its_cpu_twin() {
                     if slot == 0 {
                         gpu.run_fc_part(FcPart::Batch).unwrap();
                     }
-                    let f = ft::float_params(r, slot);
+                    let f = meshslim::cluster::gpu_schedule::float_params(r, slot);
                     let centre: Vec<u32> = rd(&gpu, CBuf::FcCentre, nv);
                     let mut decided: Vec<u32> = rd(&gpu, CBuf::FcDecided, nv);
                     let mut head: Vec<u32> = rd(&gpu, CBuf::FcHead, nv + 1);
@@ -301,7 +309,12 @@ fn each_floating_stage_matches_its_cpu_twin() {
             ft::fc_cluster_keys(&c, &centre, &head, &mut keys, &mut vals);
             assert_eq!(rd::<u32>(&gpu, CBuf::SortKeys, nv), keys, "{label}");
             assert_eq!(rd::<u32>(&gpu, CBuf::SortVals, nv), vals, "{label}");
-            let by_cluster = sort_on_both(&mut gpu, &label, ft::cluster_passes(nv), nv);
+            let by_cluster = sort_on_both(
+                &mut gpu,
+                &label,
+                meshslim::cluster::gpu_schedule::cluster_passes(nv),
+                nv,
+            );
             let clusters = cells_on_both(&mut gpu, &label, &by_cluster);
             assert_eq!(clusters as u32, head[nv], "{label}: a cluster per centre");
             let vertex_cluster: Vec<u32> = rd(&gpu, CBuf::VertexCell, nv);
@@ -316,7 +329,7 @@ fn each_floating_stage_matches_its_cpu_twin() {
             let mut quadric = vec![Quadric::default(); clusters];
             ft::fc_quadrics(
                 &c,
-                &ft::float_params(r, 0),
+                &meshslim::cluster::gpu_schedule::float_params(r, 0),
                 &pos,
                 indices,
                 &offsets,

@@ -7,7 +7,8 @@
 //! their claims never meet, and the rounds pick the centres the sequential greedy picks
 //! (tests/cluster.rs checks it). Each centre's radius is the nominal one spread by ±10%
 //! ([`radius`]); "within twice the radius" is then within the sum of the two radii. On the gpu
-//! backend the same rounds run as WGSL stages (`floating_gpu.rs`, twins in `floating_twins.rs`).
+//! backend the same rounds run as WGSL stages (`floating_gpu.rs`; their twins are test code,
+//! tests/cluster_twins/floating.rs).
 
 use super::grid::Grid;
 use super::stages::{self, Csr, Placed};

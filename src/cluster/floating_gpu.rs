@@ -1,15 +1,16 @@
 //! `--method floating-cell` on the gpu backend: one floating-cell build at a nominal radius as
 //! WGSL compute passes on a [`GpuClusterMesh`] (stages in `gpu_schedule.rs`, twins in
-//! `floating_twins.rs`). Once per mesh the grades and ranks, and the vertices sorted by rank;
+//! tests/cluster_twins/floating.rs). Once per mesh the grades and ranks, and the vertices sorted
+//! by rank;
 //! per build the hash grid's cells (by cell, then rank), rounds of `fc_decide` and `fc_claim`
 //! recorded [`ROUND_SLOTS`] at a time with one counter per round read back per batch, then the
 //! clusters numbered, sorted, placed and their faces found by the uniform grid's stages.
 
 use super::floating::hash_grid;
-use super::floating_twins::{RANK_PASSES, ROUND_SLOTS, cluster_passes, float_params};
-use super::gpu::{GpuClusterMesh, Part};
-use super::gpu_schedule::{self as sched, CBuf};
-use super::twins::{self, ClusterBuild};
+use super::gpu::{ClusterBuild, GpuClusterMesh, Part};
+use super::gpu_schedule::{
+    self as sched, CBuf, RANK_PASSES, ROUND_SLOTS, cluster_passes, float_params,
+};
 use crate::compute::gpu::ErrorScope;
 use crate::cpu::common::V3;
 use crate::error::{Error, Result};
@@ -85,7 +86,7 @@ impl GpuClusterMesh<'_> {
     /// Radix passes of the hash grid's keys (after [`Self::set_radius`]): locked vertices are
     /// keyed like the others, so no SINGLETON pass.
     pub fn hash_passes(&self) -> u32 {
-        twins::radix_passes(&self.cluster, false)
+        sched::radix_passes(&self.cluster, false)
     }
 
     fn record_fc(&mut self, enc: &mut wgpu::CommandEncoder, part: FcPart) {

@@ -1,14 +1,15 @@
 //! `--method cluster` on the gpu backend: one clustering build at a given grid as WGSL compute
-//! passes (described in `gpu_schedule.rs`, twinned in `twins.rs`): cell keys, a stable LSD radix
-//! sort of (key, vertex), the cells, one gathered quadric and placed vertex per cell, and the
+//! passes (described in `gpu_schedule.rs`, twinned in tests/cluster_twins): cell keys, a stable LSD
+//! radix sort of (key, vertex), the cells, one gathered quadric and placed vertex per cell, and the
 //! faces between three cells with exact repeats dropped. The mesh is uploaded once with its
-//! vertex→face lists and face planes ([`GpuClusterMesh::new`]); each build then records every
-//! pass in one command buffer and reads back two counts, then the result.
+//! vertex→face lists and face planes ([`GpuClusterMesh::new`]); each build then records every pass
+//! in one command buffer and reads back two counts, then the result.
 
 use crate::cluster::gpu_schedule::{self as sched, CBuf, CCount, CGrid, CStage, CStep};
 use crate::cluster::grid::Grid;
-use crate::cluster::twins::{self, ClusterBuild};
+use crate::cluster::stages::{Placed, Placement};
 use crate::compute::gpu::{ErrorScope, Groups, Kernels, Pipelines, Runner};
+use crate::cpu::common::xyz;
 use crate::error::{Error, Result};
 use crate::gpu::GpuMesh;
 use crate::gpu::context::{checked_buffer, checked_buffer_init};
@@ -67,10 +68,10 @@ pub fn shared() -> Result<&'static GpuClusterer> {
         .map_err(|e| Error::Gpu(e.trim_start_matches("GPU: ").to_string()))
 }
 
-/// One clustering of `positions` (normalized frame, w = 1) and `faces` at `grid`, on the
-/// shared device; `locked` vertices are clusters of their own. The same result as the CPU
-/// driver's build with its gather (`twins::run` is the stage-by-stage reference). For several
-/// builds of one mesh, make a [`GpuClusterMesh`] once and call its `build`.
+/// One clustering of `positions` (normalized frame, w = 1) and `faces` at `grid`, on the shared
+/// device; `locked` vertices are clusters of their own. The same result as the CPU driver's build
+/// with its gather (the twins' `run` in tests/cluster_twins is the stage-by-stage reference). For
+/// several builds of one mesh, make a [`GpuClusterMesh`] once and call its `build`.
 pub fn build_gpu(
     positions: &[[f32; 4]],
     faces: &[[u32; 3]],
@@ -228,7 +229,7 @@ impl<'a> GpuClusterMesh<'a> {
         };
         q.write_buffer(&bufs[&CBuf::Params], 0, bytemuck::bytes_of(&params));
         for (p, b) in radix.iter().enumerate() {
-            q.write_buffer(b, 0, bytemuck::bytes_of(&twins::radix_params(nv, p as u32)));
+            q.write_buffer(b, 0, bytemuck::bytes_of(&sched::radix_params(nv, p as u32)));
         }
         let mut m = GpuClusterMesh {
             sim,
@@ -260,7 +261,7 @@ impl<'a> GpuClusterMesh<'a> {
 
     /// Sets the grid of the next build (and rewinds the sort to `cell_keys`' half).
     pub fn set_grid(&mut self, grid: &Grid) {
-        self.cluster = twins::cluster_params(grid, self.nv, self.nf);
+        self.cluster = sched::cluster_params(grid, self.nv, self.nf);
         self.cur = 0;
         let c = &self.bufs[&CBuf::Cluster];
         self.sim
@@ -275,7 +276,7 @@ impl<'a> GpuClusterMesh<'a> {
 
     /// Radix passes the current grid's keys need.
     pub fn passes(&self) -> u32 {
-        twins::radix_passes(&self.cluster, self.any_locked)
+        sched::radix_passes(&self.cluster, self.any_locked)
     }
 
     /// Records `part` into `enc`.
@@ -532,5 +533,61 @@ impl crate::compute::gpu::Runner<CBuf, CGrid, CCount, std::convert::Infallible>
 
     fn prefix_sum(&self) -> [&'static CStage; 3] {
         sched::PREFIX_SUM
+    }
+}
+
+/// One clustering, as the CPU driver's build returns it: per cluster its vertex, the kept faces
+/// (input face id, clusters) in face order, each vertex's cluster, the counts.
+pub struct ClusterBuild {
+    pub placed: Vec<Placed>,
+    pub faces: Vec<(u32, [u32; 3])>,
+    pub vertex_cluster: Vec<u32>,
+    pub clusters: usize,
+    /// Cells: clusters are whole cells here, so the same as `clusters`.
+    pub cells: usize,
+}
+
+impl ClusterBuild {
+    /// From the buffers `cluster_quadrics` and `cluster_faces_compact` write.
+    pub fn from_buffers(
+        placed: &[ClusterPlaced],
+        quadrics: &[Quadric],
+        cluster_faces: &[u32],
+        face_origin: &[u32],
+        vertex_cell: Vec<u32>,
+    ) -> ClusterBuild {
+        assert_eq!(placed.len(), quadrics.len(), "a quadric per cluster");
+        assert_eq!(
+            cluster_faces.len(),
+            3 * face_origin.len(),
+            "three clusters a face"
+        );
+        let placed: Vec<Placed> = placed
+            .iter()
+            .zip(quadrics)
+            .map(|(p, q)| Placed {
+                pos: xyz(p.pos),
+                quadric: *q,
+                attr: p.attr,
+                how: match p.how {
+                    place::SINGLE => Placement::Single,
+                    place::SOLVE => Placement::Solve,
+                    place::MEMBER => Placement::Member,
+                    _ => Placement::Centroid,
+                },
+            })
+            .collect();
+        let faces = face_origin
+            .iter()
+            .zip(cluster_faces.chunks_exact(3))
+            .map(|(&f, t)| (f, [t[0], t[1], t[2]]))
+            .collect();
+        ClusterBuild {
+            clusters: placed.len(),
+            cells: placed.len(),
+            placed,
+            faces,
+            vertex_cluster: vertex_cell,
+        }
     }
 }

@@ -1,9 +1,9 @@
 //! The clustering build on the GPU, described once as the rounds are in
 //! `crate::parallel::schedule`: every stage's entry point, its bindings by WGSL variable name in
 //! binding order, the buffer each takes and the grid it runs over; and the parts of a build in
-//! order. The runner (`gpu.rs`) binds and dispatches from these, the CPU twins (`twins.rs`) are
-//! named after them, and `compute::tests` checks every description against its WGSL through
-//! naga. It is written in the compute core's vocabulary ([`crate::compute::schedule`]) on its
+//! order. The runner (`gpu.rs`) binds and dispatches from these, the CPU twins
+//! (tests/cluster_twins) are named after them, and `compute::tests` checks every description
+//! against its WGSL through naga. It is written in the compute core's vocabulary ([`crate::compute::schedule`]) on its
 //! own buffers; the prefix sum, adjacency and face-plane stages are the core's, expanded here.
 //!
 //! The floating cells (`fc_*`, Low & Tan 1997) reuse the build's parts: the radix sort orders
@@ -91,6 +91,8 @@ pub enum CGrid {
 /// A stage of the clustering build: entry point `entry` in `shaders/<shader>.wgsl`.
 pub type CStage = crate::compute::schedule::Stage<CBuf, CGrid>;
 
+use crate::cluster::grid::{Grid, SINGLETON};
+use crate::gpu::types::{ClusterParams, FloatParams, RadixParams, SORT_BLOCK};
 use CCount::{Faces, Vertices};
 use CGrid::{Each, SortBlocks};
 
@@ -286,6 +288,63 @@ const PARTS: &[&[CStep]] = &[
     FLOATING_CLUSTERS,
     FLOATING_QUADRICS,
 ];
+
+// The uniforms the runner writes (and the twins in tests/cluster_twins take).
+
+/// The uniform of a build at `grid`.
+pub fn cluster_params(grid: &Grid, vertices: usize, faces: usize) -> ClusterParams {
+    ClusterParams {
+        lo_h: [grid.lo[0], grid.lo[1], grid.lo[2], grid.h],
+        dims: [grid.dims[0], grid.dims[1], grid.dims[2], 0],
+        vertex_count: vertices as u32,
+        face_count: faces as u32,
+        inv_h: grid.inv_h,
+        _pad: 0,
+    }
+}
+
+/// Radix passes of 8 bits the largest possible key needs: the far corner's Morton key (Morton
+/// order grows with each coordinate), or SINGLETON when a vertex is locked.
+pub fn radix_passes(c: &ClusterParams, any_locked: bool) -> u32 {
+    let max = if any_locked {
+        SINGLETON
+    } else {
+        crate::mesh::morton::morton3(c.dims[0] - 1, c.dims[1] - 1, c.dims[2] - 1)
+    };
+    (32 - max.leading_zeros()).div_ceil(8)
+}
+
+/// The uniform of radix pass `pass` over `n` keys.
+pub fn radix_params(n: usize, pass: u32) -> RadixParams {
+    RadixParams {
+        n: n as u32,
+        blocks: (n as u32).div_ceil(SORT_BLOCK),
+        shift: 8 * pass,
+        _pad: 0,
+    }
+}
+
+/// Rounds recorded in one batch (`FloatParams::slot` < this): the host reads back one counter
+/// per round once per batch, and at most this many rounds less one run idle at the end. Horse
+/// (97k faces) takes 23 rounds at 10%, so three batches, three waits for the device.
+pub const ROUND_SLOTS: usize = 8;
+
+/// The uniform of round slot `slot` at nominal radius `r`.
+pub fn float_params(r: f32, slot: u32) -> FloatParams {
+    FloatParams {
+        r,
+        slot,
+        _pad: [0; 2],
+    }
+}
+
+/// Radix passes of the rank sort: 32-bit rank words.
+pub const RANK_PASSES: u32 = 4;
+
+/// Radix passes of the sort by cluster: the largest cluster number is below the vertex count.
+pub fn cluster_passes(vertices: usize) -> u32 {
+    (32 - (vertices.max(1) as u32 - 1).leading_zeros()).div_ceil(8)
+}
 
 /// The build's schedule against its WGSL, with the checks every family passes
 /// (`compute::tests`); a binding's variable names its buffer but for the roles listed here.

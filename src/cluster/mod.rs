@@ -11,18 +11,18 @@
 
 mod colors;
 pub mod floating;
-// `floating-cell` on the gpu backend: its stages' twins and its build on `gpu::GpuClusterMesh`.
+// `floating-cell` on the gpu backend: its build on `gpu::GpuClusterMesh`.
 pub mod floating_gpu;
-pub mod floating_twins;
-// `cluster` on the gpu backend: the build's stage descriptions, their CPU twins (the GPU's
-// gather order; the CPU driver scatters its quadrics instead) and the GPU driver.
+// `cluster` on the gpu backend: the build's stage descriptions and uniforms, and the GPU
+// driver. The stages' CPU twins (the GPU's gather order; the CPU driver, stages.rs, scatters
+// its quadrics instead) are test code, in tests/cluster_twins: the library has one
+// implementation of each stage for the CPU (stages.rs, floating.rs) and one in WGSL.
 pub mod gpu;
 pub mod gpu_schedule;
 pub mod grid;
 mod hybrid;
 pub mod stages;
 pub mod stream;
-pub mod twins;
 
 pub use floating::simplify_floating;
 pub(crate) use hybrid::hybrid_upload;

@@ -84,8 +84,8 @@ pub fn cell_keys(grid: &Grid, positions: &[[f32; 4]], locked: &[bool]) -> Vec<u3
 
 /// `radix_sort`: the vertex ids `0..n` ordered by key, stable (so by (key, id)): least
 /// significant digit first, as many passes as the largest key needs. The order is unique, so
-/// this is the GPU's result whatever the digit: the GPU sorts 8 bits a pass (twins.rs has its
-/// pass-for-pass twin), this 11 (2,048 counters stay in the L1 cache): 2 passes for the 1M
+/// this is the GPU's result whatever the digit: the GPU sorts 8 bits a pass (tests/cluster_twins
+/// has its pass-for-pass twin), this 11 (2,048 counters stay in the L1 cache): 2 passes for the 1M
 /// scan's 22-bit keys at 10%, where 8-bit digits took 3.
 pub fn radix_sort(keys: &[u32]) -> (Vec<u32>, Vec<u32>) {
     let max = keys.iter().copied().max().unwrap_or(0);

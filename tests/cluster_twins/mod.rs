@@ -1,27 +1,23 @@
 //! CPU twins of the clustering build's WGSL stages (`shaders/<stage>.wgsl`, described in
-//! `gpu_schedule.rs`), each taking the same buffers in the same order as slices and written as a
+//! src/cluster/gpu_schedule.rs), each taking the same buffers in the same order as slices and written as a
 //! loop over invocation ids. Integer buffers come out equal to the GPU's after every stage
 //! (the radix sort is stable, so each pass's output is unique; a bucket's fill order is the one
 //! thing left to timing, and the dedupe sorts it); floats agree to rounding. `run` chains them
 //! into the whole build: the reference the tests diff the GPU against stage by stage.
+//!
+//! Test code (tests/gpu_cluster.rs, tests/gpu_floating.rs): the library's CPU build is
+//! src/cluster/stages.rs, which scatters its quadrics where these gather them as the GPU does.
+#![allow(dead_code)]
 
-use crate::cluster::grid::{Grid, SINGLETON};
-use crate::cluster::stages::{self, Csr, Placed, Placement, Surface};
-use crate::cpu::common::xyz;
-use crate::cpu::prefix_sum::prefix_sum;
-use crate::gpu::types::{ClusterParams, ClusterPlaced, Quadric, RadixParams, SORT_BLOCK, place};
+pub mod floating;
 
-/// The uniform of a build at `grid`.
-pub fn cluster_params(grid: &Grid, vertices: usize, faces: usize) -> ClusterParams {
-    ClusterParams {
-        lo_h: [grid.lo[0], grid.lo[1], grid.lo[2], grid.h],
-        dims: [grid.dims[0], grid.dims[1], grid.dims[2], 0],
-        vertex_count: vertices as u32,
-        face_count: faces as u32,
-        inv_h: grid.inv_h,
-        _pad: 0,
-    }
-}
+use meshslim::cluster::gpu::ClusterBuild;
+use meshslim::cluster::gpu_schedule::{cluster_params, radix_params, radix_passes};
+use meshslim::cluster::grid::{Grid, SINGLETON};
+use meshslim::cluster::stages::{self, Csr, Placed, Placement, Surface};
+use meshslim::cpu::common::xyz;
+use meshslim::cpu::prefix_sum::prefix_sum;
+use meshslim::gpu::types::{ClusterParams, ClusterPlaced, Quadric, RadixParams, SORT_BLOCK, place};
 
 pub fn grid_of(c: &ClusterParams) -> Grid {
     Grid {
@@ -29,27 +25,6 @@ pub fn grid_of(c: &ClusterParams) -> Grid {
         h: c.lo_h[3],
         inv_h: c.inv_h,
         dims: [c.dims[0], c.dims[1], c.dims[2]],
-    }
-}
-
-/// Radix passes of 8 bits the largest possible key needs: the far corner's Morton key (Morton
-/// order grows with each coordinate), or SINGLETON when a vertex is locked.
-pub fn radix_passes(c: &ClusterParams, any_locked: bool) -> u32 {
-    let max = if any_locked {
-        SINGLETON
-    } else {
-        crate::mesh::morton::morton3(c.dims[0] - 1, c.dims[1] - 1, c.dims[2] - 1)
-    };
-    (32 - max.leading_zeros()).div_ceil(8)
-}
-
-/// The uniform of radix pass `pass` over `n` keys.
-pub fn radix_params(n: usize, pass: u32) -> RadixParams {
-    RadixParams {
-        n: n as u32,
-        blocks: (n as u32).div_ceil(SORT_BLOCK),
-        shift: 8 * pass,
-        _pad: 0,
     }
 }
 
@@ -331,76 +306,20 @@ pub fn cluster_mesh(
     }
 }
 
-/// One clustering, as the CPU driver's build returns it: per cluster its vertex, the kept faces
-/// (input face id, clusters) in face order, each vertex's cluster, the counts.
-pub struct ClusterBuild {
-    pub placed: Vec<Placed>,
-    pub faces: Vec<(u32, [u32; 3])>,
-    pub vertex_cluster: Vec<u32>,
-    pub clusters: usize,
-    /// Cells: clusters are whole cells here, so the same as `clusters`.
-    pub cells: usize,
-}
-
-impl ClusterBuild {
-    /// From the buffers `cluster_quadrics` and `cluster_faces_compact` write.
-    pub fn from_buffers(
-        placed: &[ClusterPlaced],
-        quadrics: &[Quadric],
-        cluster_faces: &[u32],
-        face_origin: &[u32],
-        vertex_cell: Vec<u32>,
-    ) -> ClusterBuild {
-        assert_eq!(placed.len(), quadrics.len(), "a quadric per cluster");
-        assert_eq!(
-            cluster_faces.len(),
-            3 * face_origin.len(),
-            "three clusters a face"
-        );
-        let placed: Vec<Placed> = placed
-            .iter()
-            .zip(quadrics)
-            .map(|(p, q)| Placed {
-                pos: xyz(p.pos),
-                quadric: *q,
-                attr: p.attr,
-                how: match p.how {
-                    place::SINGLE => Placement::Single,
-                    place::SOLVE => Placement::Solve,
-                    place::MEMBER => Placement::Member,
-                    _ => Placement::Centroid,
-                },
-            })
-            .collect();
-        let faces = face_origin
-            .iter()
-            .zip(cluster_faces.chunks_exact(3))
-            .map(|(&f, t)| (f, [t[0], t[1], t[2]]))
-            .collect();
-        ClusterBuild {
-            clusters: placed.len(),
-            cells: placed.len(),
-            placed,
-            faces,
-            vertex_cluster: vertex_cell,
-        }
-    }
-
-    /// [`Self::from_buffers`] over a twin build's faces part and the cells its vertices fall in.
-    pub fn from_twins(
-        placed: &[ClusterPlaced],
-        quadrics: &[Quadric],
-        cells: &CellsOut,
-        faces: &FacesOut,
-    ) -> ClusterBuild {
-        Self::from_buffers(
-            placed,
-            quadrics,
-            &faces.cluster_faces,
-            &faces.face_origin,
-            cells.vertex_cell.clone(),
-        )
-    }
+/// [`ClusterBuild::from_buffers`] over a twin build's faces part and the cells its vertices fall in.
+pub fn build_of(
+    placed: &[ClusterPlaced],
+    quadrics: &[Quadric],
+    cells: &CellsOut,
+    faces: &FacesOut,
+) -> ClusterBuild {
+    ClusterBuild::from_buffers(
+        placed,
+        quadrics,
+        &faces.cluster_faces,
+        &faces.face_origin,
+        cells.vertex_cell.clone(),
+    )
 }
 
 /// Every buffer of a build on the CPU, as each stage leaves it: what the tests diff.
@@ -583,7 +502,7 @@ pub fn run(positions: &[[f32; 4]], faces: &[[u32; 3]], locked: &[bool], grid: &G
 impl CpuBuild {
     /// The build's result, as the GPU's is read back.
     pub fn result(&self) -> ClusterBuild {
-        ClusterBuild::from_twins(
+        build_of(
             &self.cluster_placed,
             &self.cluster_quadric,
             &self.cells,

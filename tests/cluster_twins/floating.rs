@@ -1,39 +1,21 @@
 //! CPU twins of the floating cells' WGSL stages (`shaders/fc_*.wgsl`, described in
-//! `gpu_schedule.rs`), each taking the same buffers in the same order as slices and written as a
+//! src/cluster/gpu_schedule.rs), each taking the same buffers in the same order as slices and written as a
 //! loop over invocation ids; the radix sort, the cells and the faces are the uniform grid's
 //! (`twins.rs`). Fed the GPU's own inputs, every integer buffer comes out equal to the GPU's;
 //! the grades (a square root and divisions) agree to rounding, and an ulp can move a grade
 //! across a rank step, so the end-to-end comparison is the tests' business. `run` chains them
 //! into the whole build: equal, centre for centre, to the CPU driver's `floating::claim`.
 
-use super::floating::{UNCLAIMED, cells_around, grade, hash_grid, radius, rank};
-use super::grid::Grid;
-use super::stages::{self, Csr};
-use super::twins::{self, CellsOut, ClusterBuild, FacesOut, cluster_params, grid_of, placed_of};
-use crate::cpu::common::{V3, dot, sub, xyz};
-use crate::gpu::types::{ClusterParams, ClusterPlaced, FloatParams, Params, Quadric};
-
-/// Rounds recorded in one batch (`FloatParams::slot` < this): the host reads back one counter
-/// per round once per batch, and at most this many rounds less one run idle at the end. Horse
-/// (97k faces) takes 23 rounds at 10%, so three batches, three waits for the device.
-pub const ROUND_SLOTS: usize = 8;
-
-/// The uniform of round slot `slot` at nominal radius `r`.
-pub fn float_params(r: f32, slot: u32) -> FloatParams {
-    FloatParams {
-        r,
-        slot,
-        _pad: [0; 2],
-    }
-}
-
-/// Radix passes of the rank sort: 32-bit rank words.
-pub const RANK_PASSES: u32 = 4;
-
-/// Radix passes of the sort by cluster: the largest cluster number is below the vertex count.
-pub fn cluster_passes(vertices: usize) -> u32 {
-    (32 - (vertices.max(1) as u32 - 1).leading_zeros()).div_ceil(8)
-}
+use super::{self as twins, CellsOut, FacesOut, grid_of, placed_of};
+use meshslim::cluster::floating::{UNCLAIMED, cells_around, grade, hash_grid, radius, rank};
+use meshslim::cluster::gpu::ClusterBuild;
+use meshslim::cluster::gpu_schedule::{
+    RANK_PASSES, ROUND_SLOTS, cluster_params, cluster_passes, float_params,
+};
+use meshslim::cluster::grid::Grid;
+use meshslim::cluster::stages::{self, Csr};
+use meshslim::cpu::common::{V3, dot, sub, xyz};
+use meshslim::gpu::types::{ClusterParams, ClusterPlaced, FloatParams, Params, Quadric};
 
 /// Per vertex: [`floating::grade`] over its faces in CSR order.
 pub fn fc_grades(
@@ -380,7 +362,7 @@ pub fn run(
             head: head.clone(),
         });
     }
-    crate::cpu::prefix_sum::prefix_sum(nv as u32, &mut head, &mut Vec::new());
+    meshslim::cpu::prefix_sum::prefix_sum(nv as u32, &mut head, &mut Vec::new());
     let (mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv]);
     fc_cluster_keys(&c, &centre, &head, &mut keys, &mut vals);
     let cluster_sort = twins::sort(&keys, &vals, cluster_passes(nv));
@@ -433,7 +415,7 @@ pub fn run(
 impl FloatBuild {
     /// The build's result, as the GPU's is read back.
     pub fn result(&self) -> ClusterBuild {
-        ClusterBuild::from_twins(
+        super::build_of(
             &self.cluster_placed,
             &self.cluster_quadric,
             &self.clusters,
