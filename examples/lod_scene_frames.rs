@@ -21,7 +21,7 @@ fn main() {
         .wgpu_setup(meshslim::viewer::app::wgpu_setup())
         .build_eframe(|cc| ViewerApp::new(cc, Start::Nothing).expect("the viewer starts"));
     let finish = |h: &mut Harness<'static, ViewerApp>| {
-        while h.state().job.is_some() {
+        while h.state().jobs.busy() {
             h.step();
             std::thread::sleep(std::time::Duration::from_millis(20));
         }
@@ -29,7 +29,7 @@ fn main() {
     h.state_mut().open(path.clone());
     finish(&mut h);
     let is_pareto = path.to_string_lossy().ends_with(".pareto.json");
-    if h.state().lod.is_none() && !is_pareto {
+    if h.state().scene.lod.is_none() && !is_pareto {
         h.step();
         let t = Instant::now();
         h.state_mut().make_lod();
@@ -37,7 +37,7 @@ fn main() {
         println!("levels made in {:.2} s", t.elapsed().as_secs_f64());
     }
     if is_pareto {
-        let front = h.state().front.clone().expect("a front");
+        let front = h.state().scene.front.clone().expect("a front");
         for share in [0.5, 0.25, 0.1, 0.05] {
             let want = share * front.input_vertices as f64;
             let k = (0..front.members.len())
@@ -53,6 +53,7 @@ fn main() {
     }
     let st = h.state();
     let levels = st
+        .scene
         .lod
         .as_ref()
         .unwrap_or_else(|| panic!("no levels: {}", st.status));
@@ -61,10 +62,10 @@ fn main() {
         "{}: levels {} faces, from {}",
         path.display(),
         faces.join(" / "),
-        st.lod_source
+        st.scene.lod_source
     );
     for on in [true, false] {
-        h.state_mut().lod_on = on;
+        h.state_mut().view.lod_on = on;
         // Two frames to settle (the view's textures, the first pipelines).
         h.step();
         h.step();

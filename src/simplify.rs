@@ -1,11 +1,37 @@
 //! The entry point: check the input, pick the backend (`auto` included), run it, fall back from
 //! a failed GPU to `cpu-parallel` under `auto`, and explain a stop above the target.
 
+use crate::cluster::gpu::GpuClusterer;
 use crate::error::{Error, Result};
+use crate::gpu::{GpuRounds, GpuSimplifier};
 use crate::mesh::Mesh;
 pub use crate::options::{
     Backend, Blocked, Cancel, Method, SimplifyOptions, SimplifyReport, StopReason,
 };
+use crate::parallel::Upload;
+use std::borrow::Cow;
+
+/// Pipelines a caller made on a device of its own (a window's), for [`simplify_on`]: the `gpu`
+/// backend runs there, and its result stays there to be drawn from the buffers it wrote.
+#[derive(Clone, Copy, Default)]
+pub struct OnDevice<'a> {
+    pub rounds: Option<&'a GpuSimplifier>,
+    pub cluster: Option<&'a GpuClusterer>,
+    /// The input's upload, made once by the caller: `qem` on this device starts from it (with
+    /// the run's appearance weights, when it carries others).
+    pub upload: Option<&'a Upload>,
+    /// The device also draws a window: see [`GpuRounds::share_queue`].
+    pub share_queue: bool,
+}
+
+/// A `gpu` result left on the caller's device by [`simplify_on`].
+pub enum Kept<'a> {
+    /// The rounds after their last, the result in their buffers, and the upload they ran on.
+    /// (Boxed: the rounds and an owned upload are large beside a clustering's handles.)
+    Rounds(Box<(GpuRounds<'a>, Cow<'a, Upload>)>),
+    /// A clustering (`cluster`, `floating-cell`), drawable.
+    Cluster(crate::cluster::Drawn),
+}
 
 /// Simplifies `mesh` with the backend and targets in `opts`.
 pub fn simplify(mesh: &Mesh, opts: &SimplifyOptions) -> Result<(Mesh, SimplifyReport)> {
@@ -18,6 +44,19 @@ pub fn simplify_with_progress(
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
+    let (out, report, _) = simplify_on(OnDevice::default(), mesh, opts, progress)?;
+    Ok((out, report))
+}
+
+/// As [`simplify_with_progress`], the `gpu` backend on `on`'s device when it has the method's
+/// pipelines (else on the process's shared device), its result left there: the one method ×
+/// backend dispatch, for the command line, the library and the window alike.
+pub fn simplify_on<'a>(
+    on: OnDevice<'a>,
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport, Option<Kept<'a>>)> {
     opts.check()?;
     mesh.validate()?;
     if mesh.triangles.is_empty() {
@@ -42,23 +81,8 @@ pub fn simplify_with_progress(
             opts.method.name()
         )));
     }
-    match opts.method {
-        Method::Qem => {}
-        Method::Cluster => return crate::cluster::simplify_cluster(mesh, opts, progress),
-        Method::Hybrid => return crate::cluster::simplify_hybrid(mesh, opts, progress),
-        Method::FloatingCell => return crate::cluster::simplify_floating(mesh, opts, progress),
-        Method::Decimate => {
-            return match opts.backend {
-                Backend::Cpu | Backend::Auto => {
-                    crate::decimate::simplify_decimate(mesh, opts, progress)
-                }
-                b => Err(Error::InvalidOption(format!(
-                    "--method decimate runs on the CPU only (it removes one vertex at a time); \
-                     use --backend cpu or auto, not {}",
-                    b.name()
-                ))),
-            };
-        }
+    if opts.method != Method::Qem {
+        return run(on, mesh, opts, opts.backend, progress);
     }
     let (chosen, mut auto) = match opts.backend {
         Backend::Auto => {
@@ -67,43 +91,83 @@ pub fn simplify_with_progress(
         }
         b => (b, None),
     };
-    let mut result = run(mesh, opts, chosen, progress);
+    let mut result = run(on, mesh, opts, chosen, progress);
     if opts.backend == Backend::Auto
         && chosen == Backend::Gpu
         && let Err(e @ (Error::Gpu(_) | Error::BufferTooLarge { .. })) = &result
     {
         auto = Some(format!("the GPU failed ({e}); fell back to cpu-parallel"));
-        result = run(mesh, opts, Backend::CpuParallel, progress);
+        result = run(on, mesh, opts, Backend::CpuParallel, progress);
     }
-    let (out, mut report) = result?;
+    let (out, mut report, kept) = result?;
     report.auto = auto;
     if report.output_faces > opts.target_faces && report.stop_reason != StopReason::TargetReached {
         report.blocked = Some(crate::cpu::blocked_edges(&out, opts)?);
     }
-    Ok((out, report))
+    Ok((out, report, kept))
 }
 
-/// One backend on `mesh`, with `opts` but for the backend.
-fn run(
+/// One method on one backend (`Auto` left to the clustering methods, which choose their own),
+/// with `opts` but for the backend.
+fn run<'a>(
+    on: OnDevice<'a>,
     mesh: &Mesh,
     opts: &SimplifyOptions,
     backend: Backend,
     progress: &mut dyn FnMut(f32),
-) -> Result<(Mesh, SimplifyReport)> {
+) -> Result<(Mesh, SimplifyReport, Option<Kept<'a>>)> {
     let opts = &SimplifyOptions {
         backend,
         ..opts.clone()
     };
-    match backend {
-        Backend::Cpu => crate::greedy::simplify_greedy(mesh, opts, progress),
-        Backend::CpuParallel => crate::cpu::simplify_upload(
-            &crate::parallel::Upload::pinned(mesh, &opts.pin).attributes(&opts.attributes),
+    let none = |(m, r)| (m, r, None);
+    match (opts.method, backend) {
+        (Method::Cluster | Method::FloatingCell, Backend::Gpu) if on.cluster.is_some() => {
+            let c = on.cluster.expect("checked by the guard");
+            let (m, r, drawn) = crate::cluster::simplify_drawn(c, mesh, opts, progress)?;
+            Ok((m, r, Some(Kept::Cluster(drawn))))
+        }
+        (Method::Cluster, _) => crate::cluster::simplify_cluster(mesh, opts, progress).map(none),
+        (Method::Hybrid, _) => crate::cluster::simplify_hybrid(mesh, opts, progress).map(none),
+        (Method::FloatingCell, _) => {
+            crate::cluster::simplify_floating(mesh, opts, progress).map(none)
+        }
+        (Method::Decimate, Backend::Cpu | Backend::Auto) => {
+            crate::decimate::simplify_decimate(mesh, opts, progress).map(none)
+        }
+        (Method::Decimate, b) => Err(Error::InvalidOption(format!(
+            "--method decimate runs on the CPU only (it removes one vertex at a time); use \
+             --backend cpu or auto, not {}",
+            b.name()
+        ))),
+        (Method::Qem, Backend::Cpu) => {
+            crate::greedy::simplify_greedy(mesh, opts, progress).map(none)
+        }
+        (Method::Qem, Backend::CpuParallel) => crate::cpu::simplify_upload(
+            &Upload::pinned(mesh, &opts.pin).attributes(&opts.attributes),
             mesh,
             opts,
             progress,
-        ),
-        Backend::Gpu => crate::gpu::simplify_gpu(mesh, opts, progress),
-        Backend::Auto => Err(Error::Internal(
+        )
+        .map(none),
+        (Method::Qem, Backend::Gpu) => match on.rounds {
+            Some(sim) => {
+                let up = match on.upload {
+                    Some(u) if opts.pin.is_empty() && u.carries(&opts.attributes) => {
+                        Cow::Borrowed(u)
+                    }
+                    Some(u) if opts.pin.is_empty() => {
+                        Cow::Owned(u.clone().attributes(&opts.attributes))
+                    }
+                    _ => Cow::Owned(Upload::pinned(mesh, &opts.pin).attributes(&opts.attributes)),
+                };
+                let (m, r, rounds) =
+                    crate::gpu::run_rounds(sim, None, &up, mesh, opts, on.share_queue, progress)?;
+                Ok((m, r, Some(Kept::Rounds(Box::new((rounds, up))))))
+            }
+            None => crate::gpu::simplify_gpu(mesh, opts, progress).map(none),
+        },
+        (Method::Qem, Backend::Auto) => Err(Error::Internal(
             "Backend::Auto reached a backend unresolved".into(),
         )),
     }

@@ -302,3 +302,44 @@ fn shaders_are_in_family_folders() {
     let twice: Vec<_> = names.iter().filter(|(_, at)| at.len() > 1).collect();
     assert!(twice.is_empty(), "shader files sharing a name: {twice:?}");
 }
+
+/// One method × backend dispatch, the library's (`simplify::simplify_on`): the backends' entry
+/// points are called from src/simplify.rs alone, so the command line, the Python package and
+/// the window (which keeps a `gpu` result on its own device) all run what it chooses. And one
+/// owner per concern in the viewer: `ViewerApp` is implemented in app.rs (its state, set-up and
+/// frame) and actions.rs (what changes several owners at once) alone; the other viewer files
+/// own their own types (scene, view, camera, panel, jobs) and never name the app.
+#[test]
+fn one_dispatch_and_one_owner_per_viewer_concern() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    sources(&root.join("src"), &mut files);
+    let mut wrong = Vec::new();
+    for file in &files {
+        let rel = file
+            .strip_prefix(root.join("src"))
+            .unwrap()
+            .to_string_lossy();
+        let text = code(&std::fs::read_to_string(file).unwrap());
+        for entry in [
+            "simplify_greedy(",
+            "simplify_gpu(",
+            "simplify_drawn(",
+            "simplify_decimate(",
+        ] {
+            let calls = text
+                .match_indices(entry)
+                .filter(|(at, _)| !text[..*at].ends_with("fn "))
+                .count();
+            if calls > 0 && rel != "simplify.rs" {
+                wrong.push(format!("src/{rel} calls {entry}..) past the dispatch"));
+            }
+        }
+        let in_viewer = rel.starts_with("viewer/");
+        let owners = ["viewer/app.rs", "viewer/actions.rs", "viewer/mod.rs"];
+        if in_viewer && !owners.contains(&rel.as_ref()) && text.contains("ViewerApp") {
+            wrong.push(format!("src/{rel} names ViewerApp"));
+        }
+    }
+    assert!(wrong.is_empty(), "{wrong:#?}");
+}

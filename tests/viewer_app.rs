@@ -23,8 +23,8 @@ fn harness(model: Model) -> Harness<'static, ViewerApp> {
 
 /// Steps until the running job is done; returns how many frames were drawn meanwhile.
 fn finish_job(h: &mut Harness<'static, ViewerApp>) -> u64 {
-    let (t, f0) = (Instant::now(), h.state().frames);
-    while h.state().job.is_some() {
+    let (t, f0) = (Instant::now(), h.state().view.frames);
+    while h.state().jobs.running().is_some() {
         assert!(
             t.elapsed() < Duration::from_secs(300),
             "the job did not finish: {}",
@@ -32,12 +32,13 @@ fn finish_job(h: &mut Harness<'static, ViewerApp>) -> u64 {
         );
         h.step();
     }
-    h.state().frames - f0
+    h.state().view.frames - f0
 }
 
 /// The faces of the LOD scene's levels, the original first.
 fn level_faces(h: &Harness<'static, ViewerApp>) -> Vec<usize> {
     h.state()
+        .scene
         .lod
         .as_ref()
         .unwrap_or_else(|| panic!("no levels: {}", h.state().status))
@@ -98,7 +99,7 @@ fn simplifies_on_the_window_device_and_keeps_drawing() {
     let model = Model::from_mesh("noisy sphere".into(), mesh).unwrap();
     let mut h = harness(model);
     assert!(h.state().has_gpu_backend(), "{}", h.state().status);
-    h.state_mut().backend = Backend::Gpu;
+    h.state_mut().panel.backend = Backend::Gpu;
     h.state_mut().set_target_faces(3000);
     h.step();
     let before = h.render().expect("render");
@@ -106,15 +107,20 @@ fn simplifies_on_the_window_device_and_keeps_drawing() {
 
     h.get_by_label("Simplify").click();
     h.step();
-    assert!(h.state().job.is_some(), "a job runs: {}", h.state().status);
+    assert!(
+        h.state().jobs.running().is_some(),
+        "a job runs: {}",
+        h.state().status
+    );
     let frames = finish_job(&mut h);
     assert!(
         frames >= 2,
         "only {frames} frames drawn while simplifying: the UI was blocked"
     );
-    assert!(h.state().clock.smoothed > 0.0, "frame time measured");
+    assert!(h.state().view.clock.smoothed > 0.0, "frame time measured");
     let s = h
         .state()
+        .scene
         .simplified
         .as_ref()
         .unwrap_or_else(|| panic!("{}", h.state().status));
@@ -137,7 +143,7 @@ fn simplifies_on_the_window_device_and_keeps_drawing() {
 
     // Side by side: the original and the result, two panes of half the width.
     let (_, full) = h.state().pane_rgba(0).unwrap();
-    h.state_mut().side_by_side = true;
+    h.state_mut().view.side_by_side = true;
     h.step();
     let (left, size) = h.state().pane_rgba(0).unwrap();
     let (right, _) = h.state().pane_rgba(1).expect("a second pane");
@@ -156,15 +162,15 @@ fn modes_change_the_frame_and_keys_respect_text_fields() {
     // The 3D view's own pixels (the panels around it change every frame: the frame time).
     let mut frames = Vec::new();
     for mode in [Mode::Shaded, Mode::Normals] {
-        h.state_mut().style.mode = mode;
+        h.state_mut().view.style.mode = mode;
         h.step();
         frames.push(h.state().pane_rgba(0).unwrap().0);
     }
-    h.state_mut().style.mode = Mode::Shaded;
-    h.state_mut().style.wireframe = true;
+    h.state_mut().view.style.mode = Mode::Shaded;
+    h.state_mut().view.style.wireframe = true;
     h.step();
     frames.push(h.state().pane_rgba(0).unwrap().0);
-    h.state_mut().style.wireframe = false;
+    h.state_mut().view.style.wireframe = false;
     h.step();
     assert_eq!(
         h.state().pane_rgba(0).unwrap().0,
@@ -178,20 +184,20 @@ fn modes_change_the_frame_and_keys_respect_text_fields() {
     assert!(!h.state().mode_available(Mode::Color));
 
     // Keys act on the view…
-    assert!(!h.state().side_by_side);
+    assert!(!h.state().view.side_by_side);
     h.key_press(egui::Key::B);
     h.step();
-    assert!(h.state().side_by_side, "B toggles side by side");
-    let cam = h.state().camera;
+    assert!(h.state().view.side_by_side, "B toggles side by side");
+    let cam = h.state().eye.camera;
     h.key_press(egui::Key::G);
     h.step();
-    assert!(h.state().fly);
+    assert!(h.state().eye.fly);
     h.key_down(egui::Key::W);
     h.step();
     h.step();
     h.key_up(egui::Key::W);
     h.step();
-    assert_ne!(h.state().camera.target, cam.target, "W flies forward");
+    assert_ne!(h.state().eye.camera.target, cam.target, "W flies forward");
     // …but not while a text field has the keyboard.
     h.get_all_by_value("simplified.ply")
         .next()
@@ -201,7 +207,7 @@ fn modes_change_the_frame_and_keys_respect_text_fields() {
     h.key_press(egui::Key::B);
     h.step();
     assert!(
-        h.state().side_by_side,
+        h.state().view.side_by_side,
         "B typed into a field toggled the view"
     );
 }
@@ -216,14 +222,14 @@ fn cancel_stops_a_running_simplification() {
         let mesh = meshslim::mesh::noisy_sphere(7, 0.01, 2);
         let model = Model::from_mesh("sphere".into(), mesh).unwrap();
         let mut h = harness(model);
-        h.state_mut().backend = backend;
+        h.state_mut().panel.backend = backend;
         h.state_mut().set_target_faces(100);
         h.step();
         h.state_mut().simplify();
         h.step();
         h.get_by_label("Cancel").click();
         finish_job(&mut h);
-        assert!(h.state().simplified.is_none(), "{backend:?}");
+        assert!(h.state().scene.simplified.is_none(), "{backend:?}");
         assert!(
             h.state().status.contains("cancelled"),
             "{backend:?}: {}",
@@ -250,7 +256,7 @@ fn lod_levels_come_from_one_gpu_run_and_switch_by_size_on_screen() {
         let target = (input as f64 * r).round() as usize;
         assert!((target - 1..=target).contains(f), "{f} faces for ratio {r}");
     }
-    assert!(h.state().lod_scene);
+    assert!(h.state().view.lod_scene);
     h.step();
     let on = h.render().unwrap();
     assert!(drawn_share(&on) > 0.05, "the grid is drawn");
@@ -263,13 +269,13 @@ fn lod_levels_come_from_one_gpu_run_and_switch_by_size_on_screen() {
         "one level for the whole grid: {hist:?}"
     );
     let pixels_on = h.state().pane_rgba(0).unwrap().0;
-    h.state_mut().lod_on = false;
+    h.state_mut().view.lod_on = false;
     h.step();
     assert_eq!(h.state().lod_histogram()[0], 21 * 21, "LOD off: all full");
     let pixels_off = h.state().pane_rgba(0).unwrap().0;
     assert_ne!(pixels_on, pixels_off, "LOD off draws the same meshes");
     let st = h.state();
-    assert!(st.lod_frame[0].is_some() && st.lod_frame[1].is_some());
+    assert!(st.view.lod_frame[0].is_some() && st.view.lod_frame[1].is_some());
 }
 
 /// A file dropped on the window, as winit hands it to egui.
@@ -297,7 +303,7 @@ fn a_dropped_file_opens_and_the_result_saves_and_screenshots() {
         .with_size(egui::vec2(900.0, 600.0))
         .wgpu_setup(meshslim::viewer::app::wgpu_setup())
         .build_eframe(|cc| ViewerApp::new(cc, Start::Nothing).expect("the viewer starts"));
-    assert!(h.state().model.is_none());
+    assert!(h.state().scene.model.is_none());
     h.input_mut()
         .dropped_files
         .push(std::sync::Arc::new(Dropped(input.clone())));
@@ -305,6 +311,7 @@ fn a_dropped_file_opens_and_the_result_saves_and_screenshots() {
     finish_job(&mut h);
     let faces = h
         .state()
+        .scene
         .model
         .as_ref()
         .unwrap_or_else(|| panic!("{}", h.state().status))
@@ -312,22 +319,22 @@ fn a_dropped_file_opens_and_the_result_saves_and_screenshots() {
     assert_eq!(faces, 5120);
 
     h.state_mut().set_target_faces(500);
-    h.state_mut().backend = Backend::CpuParallel;
+    h.state_mut().panel.backend = Backend::CpuParallel;
     h.state_mut().simplify();
     finish_job(&mut h);
     // Saving over the input is refused; elsewhere it writes the result.
-    h.state_mut().save_path = input.display().to_string();
+    h.state_mut().panel.save_path = input.display().to_string();
     h.state_mut().save();
     assert!(h.state().status.contains("input"), "{}", h.state().status);
     assert_eq!(meshslim::io::read(&input).unwrap().triangles.len(), 5120);
     let out = dir.path().join("ball-500.obj");
-    h.state_mut().save_path = out.display().to_string();
+    h.state_mut().panel.save_path = out.display().to_string();
     h.state_mut().save();
     let saved = meshslim::io::read(&out).unwrap_or_else(|_| panic!("{}", h.state().status));
     assert!((499..=500).contains(&saved.triangles.len()));
 
     let png = dir.path().join("shot.png");
-    h.state_mut().shot_path = png.display().to_string();
+    h.state_mut().panel.shot_path = png.display().to_string();
     h.step();
     h.state_mut().screenshot();
     let img = resvg::tiny_skia::Pixmap::decode_png(
@@ -346,6 +353,30 @@ fn a_dropped_file_opens_and_the_result_saves_and_screenshots() {
         .count();
     // The 3D view only (no panels): the ball covers a good part of it.
     assert!(drawn as f64 / (img.width() * img.height()) as f64 > 0.05);
+
+    // Side by side, the screenshot is what the window shows: both panes, the original on the
+    // left and the result on the right (P after B once saved the original's pane alone).
+    h.state_mut().view.side_by_side = true;
+    h.step();
+    let (left, (lw, lh)) = h.state().pane_rgba(0).unwrap();
+    let (right, (rw, _)) = h.state().pane_rgba(1).unwrap();
+    h.state_mut().screenshot();
+    let both = resvg::tiny_skia::Pixmap::decode_png(&std::fs::read(&png).unwrap()).unwrap();
+    assert_eq!((both.width(), both.height()), (lw + rw, lh));
+    let row =
+        |px: &[u8], w: u32, y: u32| px[(4 * w * y) as usize..(4 * w * (y + 1)) as usize].to_vec();
+    let y = lh / 2;
+    let shot = row(both.data(), lw + rw, y);
+    assert_eq!(
+        shot[..(4 * lw) as usize],
+        row(&left, lw, y)[..],
+        "the left pane"
+    );
+    assert_eq!(
+        shot[(4 * lw) as usize..],
+        row(&right, rw, y)[..],
+        "the right pane"
+    );
 }
 
 /// `--method cluster` and `floating-cell` on the gpu backend run on the window's device and the
@@ -362,13 +393,13 @@ fn clustering_on_the_window_device_is_drawn_from_its_buffers() {
     let model = Model::from_mesh("noisy sphere".into(), mesh).unwrap();
     let mut h = harness(model);
     assert!(h.state().has_gpu_backend(), "{}", h.state().status);
-    h.state_mut().backend = Backend::Gpu;
+    h.state_mut().panel.backend = Backend::Gpu;
     h.state_mut().set_method(meshslim::Method::Hybrid);
-    assert_eq!(h.state().backend, Backend::CpuParallel);
+    assert_eq!(h.state().panel.backend, Backend::CpuParallel);
     for method in [meshslim::Method::Cluster, meshslim::Method::FloatingCell] {
-        h.state_mut().backend = Backend::Gpu;
+        h.state_mut().panel.backend = Backend::Gpu;
         h.state_mut().set_method(method);
-        assert_eq!(h.state().backend, Backend::Gpu);
+        assert_eq!(h.state().panel.backend, Backend::Gpu);
         h.state_mut().set_target_faces(2000);
         h.step();
         h.get_by_label("Simplify").click();
@@ -376,6 +407,7 @@ fn clustering_on_the_window_device_is_drawn_from_its_buffers() {
         finish_job(&mut h);
         let s = h
             .state()
+            .scene
             .simplified
             .as_ref()
             .unwrap_or_else(|| panic!("{}", h.state().status));
@@ -446,8 +478,8 @@ fn click_at(h: &mut Harness<'static, ViewerApp>, at: egui::Pos2, modifiers: egui
 /// Where member `k` of the front is drawn, checked to be on screen and to hit that member.
 fn front_point(h: &Harness<'static, ViewerApp>, k: usize) -> egui::Pos2 {
     let st = h.state();
-    let rect = st.front_rect.expect("the front's plot is drawn");
-    let front = st.front.as_ref().expect("a front");
+    let rect = st.panel.front_rect.expect("the front's plot is drawn");
+    let front = st.scene.front.as_ref().expect("a front");
     let at = front.member_at(rect, k).expect("a member");
     assert!(
         egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1000.0, 900.0)).contains(at),
@@ -502,11 +534,12 @@ fn manifests_open_into_the_lod_scene_and_the_front_plot() {
     }
     let st = h.state();
     let levels = st
+        .scene
         .lod
         .as_ref()
         .unwrap_or_else(|| panic!("no levels: {}", st.status));
     assert_eq!(levels.iter().map(|l| l.faces).collect::<Vec<_>>(), want);
-    assert!(st.lod_scene && st.lod_source.contains("lods"));
+    assert!(st.view.lod_scene && st.scene.lod_source.contains("lods"));
     h.step();
     let hist = h.state().lod_histogram();
     assert_eq!(hist.iter().sum::<usize>(), 21 * 21);
@@ -522,8 +555,12 @@ fn manifests_open_into_the_lod_scene_and_the_front_plot() {
     let members = manifest["front"].as_array().unwrap();
     {
         let st = h.state();
-        assert!(st.lod.is_none(), "the levels were of the model before");
+        assert!(
+            st.scene.lod.is_none(),
+            "the levels were of the model before"
+        );
         let front = st
+            .scene
             .front
             .as_ref()
             .unwrap_or_else(|| panic!("no front: {}", st.status));
@@ -545,6 +582,7 @@ fn manifests_open_into_the_lod_scene_and_the_front_plot() {
     finish_job(&mut h);
     let st = h.state();
     let shown = st
+        .scene
         .simplified
         .as_ref()
         .unwrap_or_else(|| panic!("nothing shown: {}", st.status));
@@ -552,9 +590,9 @@ fn manifests_open_into_the_lod_scene_and_the_front_plot() {
         shown.mesh.triangles.len() as u64,
         members[1]["faces"].as_u64().unwrap()
     );
-    assert_eq!(st.front.as_ref().unwrap().selected, Some(1));
+    assert_eq!(st.scene.front.as_ref().unwrap().selected, Some(1));
     assert!(shown.error.is_some_and(|(mean, _)| mean > 0.0));
-    h.state_mut().side_by_side = true;
+    h.state_mut().view.side_by_side = true;
     h.step();
     assert!(drawn_share(&h.render().unwrap()) > 0.05);
 
@@ -568,10 +606,13 @@ fn manifests_open_into_the_lod_scene_and_the_front_plot() {
         click_at(&mut h, at, ctrl);
     }
     assert_eq!(
-        h.state().front.as_ref().unwrap().chosen,
+        h.state().scene.front.as_ref().unwrap().chosen,
         [0, last].into_iter().collect()
     );
-    assert!(h.state().job.is_none(), "Ctrl+click only chooses");
+    assert!(
+        h.state().jobs.running().is_none(),
+        "Ctrl+click only chooses"
+    );
     h.get_by_label("LOD scene from 2 chosen").click();
     h.step();
     finish_job(&mut h);
@@ -583,13 +624,14 @@ fn manifests_open_into_the_lod_scene_and_the_front_plot() {
     );
 
     // The panel's Search runs the same NSGA-II on the open mesh, here and now.
-    h.state_mut().pareto.population = 10;
-    h.state_mut().pareto.generations = 2;
+    h.state_mut().panel.pareto.population = 10;
+    h.state_mut().panel.pareto.generations = 2;
     h.get_by_label("Search").click();
     h.step();
     finish_job(&mut h);
     let st = h.state();
     let front = st
+        .scene
         .front
         .as_ref()
         .unwrap_or_else(|| panic!("no front: {}", st.status));
@@ -625,11 +667,11 @@ fn a_coloured_mesh_opens_in_colour_mode() {
     meshslim::mesh::paint(&mut m);
     let mut h = harness(Model::from_mesh("painted torus".into(), m).unwrap());
     h.step();
-    assert_eq!(h.state().style.mode, Mode::Color);
+    assert_eq!(h.state().view.style.mode, Mode::Color);
     let coloured = h.state().pane_rgba(0).unwrap().0;
     h.key_press(egui::Key::Num1);
     h.step();
-    assert_eq!(h.state().style.mode, Mode::Shaded);
+    assert_eq!(h.state().view.style.mode, Mode::Shaded);
     assert_ne!(
         h.state().pane_rgba(0).unwrap().0,
         coloured,
@@ -637,13 +679,13 @@ fn a_coloured_mesh_opens_in_colour_mode() {
     );
     h.key_press(egui::Key::Num6);
     h.step();
-    assert_eq!(h.state().style.mode, Mode::Color);
+    assert_eq!(h.state().view.style.mode, Mode::Color);
     // The command line's style keeps the mode the mesh picked unless --mode names one.
-    let style = h.state().style;
+    let style = h.state().view.style;
     h.state_mut().set_style(style, None);
-    assert_eq!(h.state().style.mode, Mode::Color);
+    assert_eq!(h.state().view.style.mode, Mode::Color);
     h.state_mut().set_style(style, Some(Mode::Shaded));
-    assert_eq!(h.state().style.mode, Mode::Shaded);
+    assert_eq!(h.state().view.style.mode, Mode::Shaded);
 }
 
 /// On a software adapter (lavapipe here) the window starts on cpu-parallel, as the library's
@@ -659,13 +701,13 @@ fn the_window_starts_on_the_cores_over_a_software_adapter() {
     let s = h.state();
     assert!(s.has_gpu_backend(), "{}", s.status);
     if s.adapter().to_lowercase().contains("llvmpipe") {
-        assert_eq!(s.backend, Backend::CpuParallel);
+        assert_eq!(s.panel.backend, Backend::CpuParallel);
         assert!(
-            s.backend_why.contains("software rasterizer"),
+            s.panel.backend_why.contains("software rasterizer"),
             "{}",
-            s.backend_why
+            s.panel.backend_why
         );
     } else {
-        assert_eq!(s.backend, Backend::Gpu, "{}", s.backend_why);
+        assert_eq!(s.panel.backend, Backend::Gpu, "{}", s.panel.backend_why);
     }
 }

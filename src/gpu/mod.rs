@@ -77,9 +77,26 @@ pub fn simplify_upload(
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
+    let adapter = Some(ctx.adapter_name.clone());
+    let (out, rep, _) = run_rounds(sim, adapter, up, mesh, opts, false, progress)?;
+    Ok((out, rep))
+}
+
+/// The rounds on `up` with `sim`'s pipelines, the rounds given back with the result in their
+/// buffers (a window draws from them). `share_queue`: see [`GpuRounds::share_queue`].
+pub fn run_rounds<'a>(
+    sim: &'a GpuSimplifier,
+    adapter: Option<String>,
+    up: &Upload,
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    share_queue: bool,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport, GpuRounds<'a>)> {
     let mut rounds = GpuRounds::new(sim, up, SELECTION_PASSES)?;
+    rounds.share_queue = share_queue;
     let report = RoundsReport {
-        adapter: Some(ctx.adapter_name.clone()),
+        adapter,
         gpu_timestamps: sim.has_timestamps(),
         pipeline_seconds: sim.pipeline_seconds,
         ..Default::default()
@@ -89,5 +106,5 @@ pub fn simplify_upload(
         r.transfer_seconds = rounds.transfer_seconds;
         r.wait_seconds = rounds.wait_seconds;
     }
-    Ok((out, rep))
+    Ok((out, rep, rounds))
 }

@@ -1,6 +1,7 @@
 //! An orbit camera in the mesh's normalized frame (centred, unit bounding-box diagonal): a target,
 //! a distance and two angles. Orbiting keeps the distance; framing fits the bounding sphere.
 
+use eframe::egui;
 use glam::{Mat4, Vec3};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -202,6 +203,120 @@ impl Up {
             Up::Auto => return Camera::upright(extent),
         };
         rotation_onto_screen(across, up)
+    }
+}
+
+/// The window's camera concern: the orbit (or fly) camera, fly mode and its speed, and the axis
+/// drawn up for the model shown when the user chose one. Input on the 3D view moves it; the app
+/// sends it home when a model or the LOD scene comes.
+#[derive(Debug, Clone)]
+pub struct Eye {
+    pub camera: Camera,
+    pub fly: bool,
+    /// Fly speed in diagonals per second.
+    pub fly_speed: f32,
+    /// The axis drawn up for the model shown, when the user chose one; else its file's.
+    pub up: Option<Up>,
+    /// An axis chosen before any model was shown (the command line's `--up` for a file read
+    /// once the window is up): the first model takes it, later ones their own.
+    pub(super) up_for_next: Option<Up>,
+}
+
+impl Default for Eye {
+    fn default() -> Self {
+        Eye {
+            camera: Camera::default(),
+            fly: false,
+            fly_speed: 0.5,
+            up: None,
+            up_for_next: None,
+        }
+    }
+}
+
+impl Eye {
+    /// A model's first view: `up` (chosen, else its file's `file_up`) up, framed.
+    pub fn home(&mut self, file_up: Up, extent: Vec3, aspect: f32) {
+        self.camera = Camera {
+            model: self.up.unwrap_or(file_up).model(extent),
+            yaw: 0.35,
+            pitch: 0.2,
+            ..Camera::default()
+        };
+        self.fit(aspect);
+    }
+
+    /// Frames the normalized frame: centred, bounding-box diagonal 1, so a sphere of radius 0.5
+    /// holds it.
+    pub fn fit(&mut self, aspect: f32) {
+        self.camera.fit(Vec3::ZERO, 0.5, aspect);
+    }
+
+    /// The LOD scene's first view: low over one side of the grid, so that the nearest
+    /// instances are large on screen and the farthest small — every level has its turn.
+    pub fn lod_home(&mut self) {
+        let half = super::lod::LOD_GRID as f32 * super::lod::LOD_SPACING * 0.5;
+        // Low over the grid's edge, whatever the view's shape: the nearest instances in view
+        // (about 4 diagonals away) draw the original, the far side the coarsest level.
+        self.camera = Camera {
+            yaw: 0.6,
+            pitch: 0.15,
+            target: Vec3::ZERO,
+            distance: half * 1.05,
+            ..self.camera
+        };
+    }
+
+    /// Drags, wheel and pinch on the 3D view (`r`), and the fly keys when no text field has
+    /// the keyboard.
+    pub fn input(&mut self, ui: &egui::Ui, r: &egui::Response) {
+        let size = r.rect.size().max(egui::vec2(1.0, 1.0));
+        let d = r.drag_delta();
+        // Radians per point: a drag across the view turns about half a turn.
+        let turn = std::f32::consts::PI / size.y;
+        if r.dragged_by(egui::PointerButton::Primary) {
+            if self.fly {
+                self.camera.look(-d.x * turn * 0.5, -d.y * turn * 0.5);
+            } else {
+                self.camera.orbit(-d.x * turn, d.y * turn);
+            }
+        }
+        if r.dragged_by(egui::PointerButton::Secondary) || r.dragged_by(egui::PointerButton::Middle)
+        {
+            self.camera.pan(d.x / size.y, d.y / size.y);
+        }
+        if r.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                // Zoom scaled by distance: the same wheel step moves 10% closer at any range.
+                self.camera.zoom((-scroll * 0.002).exp());
+            }
+            let pinch = ui.input(|i| i.zoom_delta());
+            if pinch != 1.0 {
+                self.camera.zoom(1.0 / pinch);
+            }
+        }
+        // Keys only when no text field has the keyboard.
+        if !self.fly || ui.ctx().egui_wants_keyboard_input() {
+            return;
+        }
+        let (dt, held) = ui.input(|i| {
+            let k = |key| if i.key_down(key) { 1.0f32 } else { 0.0 };
+            (
+                i.stable_dt.min(0.1),
+                [
+                    k(egui::Key::W) - k(egui::Key::S),
+                    k(egui::Key::D) - k(egui::Key::A),
+                    k(egui::Key::E) - k(egui::Key::Q),
+                ],
+            )
+        });
+        if held != [0.0; 3] {
+            let step = self.fly_speed * dt;
+            self.camera
+                .fly(held[0] * step, held[1] * step, held[2] * step);
+            ui.ctx().request_repaint();
+        }
     }
 }
 

@@ -4,11 +4,13 @@
 //! wgpu, sharing eframe's device with the simplifier); `--screenshot` renders one frame offscreen
 //! to a PNG, which needs no window system (lavapipe included).
 
+mod actions;
 pub mod app;
 pub mod camera;
+pub mod device;
 mod file_browser;
 pub mod front;
-mod jobs;
+pub mod jobs;
 pub mod lod;
 pub mod panels;
 pub mod render;
@@ -78,13 +80,14 @@ pub fn screenshot_with(
         };
         let s = scene::simplify(
             &ctx.device,
-            scene::Pipelines {
+            crate::simplify::OnDevice {
                 rounds: Some(sim),
                 cluster: Some(crate::cluster::gpu::shared()?),
+                upload: None,
+                share_queue: false,
             },
             model,
             &opts,
-            false,
             &mut |_| {},
             &|_| {},
         )?;

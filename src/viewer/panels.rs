@@ -1,31 +1,146 @@
-//! The egui side panel (target, backend, view options, LOD scene, Pareto front, statistics,
-//! save and screenshot), the keyboard shortcuts, the help window and dropped files.
+//! The side panel (target, backend, view options, LOD scene, Pareto front, statistics, save
+//! and screenshot), the keyboard shortcuts, the help window and dropped files. The panel owns
+//! its settings; it reads the scene, the job and the device, toggles how the view draws, and
+//! asks for everything else as [`Action`]s, which the app carries out.
 
-use super::app::ViewerApp;
-use super::camera::Up;
+use super::camera::{Eye, Up};
+use super::device::Device;
 use super::file_browser::Browser;
 use super::front::FrontClick;
+use super::jobs::Jobs;
 use super::lod::LOD_GRID;
 use super::render::Mode;
+use super::scene::Scene;
+use super::views::View3d;
+use crate::Method;
 use crate::options::Backend;
 use eframe::egui;
+use std::path::PathBuf;
 
-impl ViewerApp {
+/// What the panel, the keys and dropped files ask the app to do.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    Open(PathBuf),
+    Simplify,
+    Cancel,
+    Save,
+    Screenshot,
+    MakeLod,
+    SearchFront,
+    /// Show member `k` of the front.
+    ShowMember(usize),
+    /// Choose member `k` for the LOD scene, or take it back.
+    ChooseMember(usize),
+    ClearChosen,
+    LodFromFront,
+    FrameToFit,
+    ResetView,
+    /// Draw the model with this axis up (None: its file's).
+    SetUp(Option<Up>),
+}
+
+/// What the panel reads of the other owners.
+pub(super) struct Seen<'a> {
+    pub scene: &'a Scene,
+    pub jobs: &'a Jobs,
+    pub gpu: &'a Device,
+}
+
+/// The panel's own settings: the target, the method and backend, the search, the paths.
+pub struct Panel {
+    pub ratio: f64,
+    pub(super) faces_text: String,
+    pub backend: Backend,
+    /// Why the window started on its backend (the panel says it): the library's `auto` choice,
+    /// on the window's own adapter.
+    pub backend_why: String,
+    /// The algorithm (the clustering methods run on the CPU).
+    pub method: Method,
+    /// The search the window runs.
+    pub pareto: crate::lod::ParetoOptions,
+    /// Where the front's plot was last drawn.
+    pub front_rect: Option<egui::Rect>,
+    pub save_path: String,
+    pub shot_path: String,
+    pub show_help: bool,
+    pub(super) browser: Option<Browser>,
+}
+
+impl Panel {
+    pub(super) fn new(backend: Backend, backend_why: String) -> Panel {
+        Panel {
+            ratio: 0.1,
+            faces_text: String::new(),
+            backend,
+            backend_why,
+            method: Method::Qem,
+            pareto: super::front::window_search(),
+            front_rect: None,
+            save_path: String::new(),
+            shot_path: "meshslim-view.png".into(),
+            show_help: false,
+            browser: None,
+        }
+    }
+
+    /// The face-count field for `ratio` of `input_faces`.
+    pub(super) fn set_ratio(&mut self, ratio: f64, input_faces: Option<usize>) {
+        self.ratio = ratio.clamp(0.001, 1.0);
+        if let Some(n) = input_faces {
+            self.faces_text = ((n as f64 * self.ratio).round() as usize)
+                .max(1)
+                .to_string();
+        }
+    }
+
+    /// Sets the algorithm; a method the gpu backend cannot draw moves it to `cpu-parallel`,
+    /// and decimate (sequential) to `cpu`.
+    pub(super) fn set_method(&mut self, method: Method, gpu: &Device) {
+        self.method = method;
+        if method == Method::Decimate {
+            self.backend = Backend::Cpu;
+        } else if !gpu.draws(method) && self.backend == Backend::Gpu {
+            self.backend = Backend::CpuParallel;
+        }
+    }
+
+    /// The target in faces, as the field holds it, or why it is not one.
+    pub(super) fn target(&self) -> std::result::Result<usize, String> {
+        match self.faces_text.trim().parse::<usize>() {
+            Ok(n) if n >= 1 => Ok(n),
+            _ => Err(format!(
+                "target faces {:?}: write a whole number of at least 1",
+                self.faces_text
+            )),
+        }
+    }
+
+    fn open_browser(&mut self, scene: &Scene) {
+        self.browser = Some(Browser::new(
+            scene.model.as_ref().and_then(|m| m.path.clone()),
+        ));
+    }
+
     /// Shortcuts, ignored while a text field has the keyboard.
-    pub(super) fn shortcuts(&mut self, ctx: &egui::Context) {
+    pub(super) fn shortcuts(
+        &mut self,
+        ctx: &egui::Context,
+        view: &mut View3d,
+        eye: &mut Eye,
+        seen: &Seen,
+    ) -> Vec<Action> {
+        let mut act = Vec::new();
         if ctx.egui_wants_keyboard_input() {
-            return;
+            return act;
         }
         use egui::{Key, Modifiers};
         let pressed = |k| ctx.input_mut(|i| i.consume_key(Modifiers::NONE, k));
         let command = |k| ctx.input_mut(|i| i.consume_key(Modifiers::COMMAND, k));
         if command(Key::O) {
-            self.browser = Some(Browser::new(
-                self.model.as_ref().and_then(|m| m.path.clone()),
-            ));
+            self.open_browser(seen.scene);
         }
         if command(Key::S) {
-            self.save();
+            act.push(Action::Save);
         }
         if pressed(Key::F1)
             || ctx.input_mut(|i| i.consume_key(Modifiers::SHIFT, Key::Questionmark))
@@ -37,57 +152,63 @@ impl ViewerApp {
             if self.show_help {
                 self.show_help = false;
             } else {
-                self.cancel();
+                act.push(Action::Cancel);
             }
         }
-        if pressed(Key::F) {
-            self.frame_to_fit();
-        }
-        if pressed(Key::R) {
-            self.reset_view();
+        let keys = [
+            (Key::F, Action::FrameToFit),
+            (Key::R, Action::ResetView),
+            (Key::P, Action::Screenshot),
+            (Key::Enter, Action::Simplify),
+        ];
+        for (k, a) in keys {
+            if pressed(k) {
+                act.push(a);
+            }
         }
         if pressed(Key::G) {
-            self.fly = !self.fly;
+            eye.fly = !eye.fly;
         }
         if pressed(Key::X) {
-            self.style.wireframe = !self.style.wireframe && self.renderer.has_wireframe();
+            view.style.wireframe = !view.style.wireframe && view.renderer.has_wireframe();
         }
         if pressed(Key::M) {
-            self.style.smooth = !self.style.smooth;
+            view.style.smooth = !view.style.smooth;
         }
         if pressed(Key::B) {
-            self.side_by_side = !self.side_by_side;
+            view.side_by_side = !view.side_by_side;
         }
         if pressed(Key::O) {
-            self.show_original = !self.show_original;
+            view.show_original = !view.show_original;
         }
-        if pressed(Key::L) && self.lod.is_some() {
-            self.lod_on = !self.lod_on;
+        if pressed(Key::L) && seen.scene.lod.is_some() {
+            view.lod_on = !view.lod_on;
         }
-        if pressed(Key::P) {
-            self.screenshot();
-        }
-        if pressed(Key::Enter) {
-            self.simplify();
-        }
-        for (k, mode) in [
+        let modes = [
             Key::Num1,
             Key::Num2,
             Key::Num3,
             Key::Num4,
             Key::Num5,
             Key::Num6,
-        ]
-        .into_iter()
-        .zip(Mode::ALL)
-        {
-            if pressed(k) && self.mode_available(mode) {
-                self.style.mode = mode;
+        ];
+        for (k, mode) in modes.into_iter().zip(Mode::ALL) {
+            if pressed(k) && view.mode_available(mode, seen.scene) {
+                view.style.mode = mode;
             }
         }
+        act
     }
 
-    pub(super) fn controls_ui(&mut self, ui: &mut egui::Ui) {
+    pub(super) fn controls_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        view: &mut View3d,
+        eye: &mut Eye,
+        seen: &Seen,
+    ) -> Vec<Action> {
+        let mut act = Vec::new();
+        let scene = seen.scene;
         ui.heading("meshslim");
         ui.horizontal(|ui| {
             if ui
@@ -95,134 +216,30 @@ impl ViewerApp {
                 .on_hover_text("Ctrl+O; or drop a file on the window")
                 .clicked()
             {
-                self.browser = Some(Browser::new(
-                    self.model.as_ref().and_then(|m| m.path.clone()),
-                ));
+                self.open_browser(scene);
             }
             if ui.button("Help").on_hover_text("F1").clicked() {
                 self.show_help = !self.show_help;
             }
         });
         ui.separator();
-        let input_faces = self.model.as_ref().map_or(0, |m| m.faces());
-        ui.label("Target");
-        let old_ratio = self.ratio;
-        ui.add(
-            egui::Slider::new(&mut self.ratio, 0.001..=1.0)
-                .logarithmic(true)
-                .text("ratio"),
-        );
-        if self.ratio != old_ratio && input_faces > 0 {
-            self.faces_text = ((input_faces as f64 * self.ratio).round() as usize)
-                .max(1)
-                .to_string();
-        }
-        ui.horizontal(|ui| {
-            let l = ui.label("faces");
-            let r = ui
-                .add(egui::TextEdit::singleline(&mut self.faces_text).desired_width(90.0))
-                .labelled_by(l.id);
-            if r.changed()
-                && let Ok(n) = self.faces_text.trim().parse::<usize>()
-                && input_faces > 0
-            {
-                self.ratio = (n as f64 / input_faces as f64).clamp(0.001, 1.0);
-            }
-        });
-        ui.horizontal(|ui| {
-            use crate::Method;
-            ui.label("method");
-            let methods = [
-                (
-                    Method::Qem,
-                    "edge collapse: best surface, exact target, topology kept",
-                ),
-                (
-                    Method::Cluster,
-                    "uniform grid: fastest, within 5%, topology may change",
-                ),
-                (
-                    Method::FloatingCell,
-                    "floating cells: keeps tips and corners, within 5%, topology may change",
-                ),
-                (
-                    Method::Hybrid,
-                    "grid to 2x the target + 20k faces, then edge collapse: near-qem quality, faster",
-                ),
-                (
-                    Method::Decimate,
-                    "vertex removal: keeps a subset of the input's vertices, unmoved; topology \
-                     kept; exact target (cpu)",
-                ),
-            ];
-            for (m, about) in methods {
-                ui.selectable_value(&mut self.method, m, m.name())
-                    .on_hover_text(about);
-            }
-            // hybrid runs on the CPU's cores here; decimate on one core (it is sequential).
-            if self.method == Method::Decimate {
-                self.backend = Backend::Cpu;
-            } else if !self.gpu_draws(self.method) && self.backend == Backend::Gpu {
-                self.backend = Backend::CpuParallel;
-            }
-        });
-        ui.horizontal(|ui| {
-            ui.label("backend");
-            for b in [Backend::Gpu, Backend::CpuParallel, Backend::Cpu] {
-                let enabled = if self.method == crate::Method::Decimate {
-                    b == Backend::Cpu
-                } else {
-                    b != Backend::Gpu || self.gpu_draws(self.method)
-                };
-                ui.add_enabled_ui(enabled, |ui| {
-                    ui.selectable_value(&mut self.backend, b, b.name());
-                });
-            }
-        });
-        // Which backend the window started on, and why (a software adapter is no GPU).
-        ui.small(format!("started on {}", self.backend_why));
-        ui.horizontal(|ui| {
-            let busy = self.job.is_some();
-            if ui
-                .add_enabled(!busy && self.model.is_some(), egui::Button::new("Simplify"))
-                .on_hover_text("Enter")
-                .clicked()
-            {
-                self.simplify();
-            }
-            if ui
-                .add_enabled(busy, egui::Button::new("Cancel"))
-                .on_hover_text("Esc")
-                .clicked()
-            {
-                self.cancel();
-            }
-        });
-        if let Some(j) = &self.job {
-            ui.add(egui::ProgressBar::new(j.progress()).text(format!(
-                "{} - {:.1} s",
-                match j.phase() {
-                    p if p.is_empty() => j.label.clone(),
-                    p => p,
-                },
-                j.started.elapsed().as_secs_f64()
-            )));
-        }
+        self.target_ui(ui, seen, &mut act);
         ui.separator();
         ui.label("View");
         ui.horizontal_wrapped(|ui| {
             for m in Mode::ALL {
-                let ok = self.mode_available(m);
+                let ok = view.mode_available(m, scene);
                 let r = ui.add_enabled(
                     ok,
-                    egui::Button::selectable(self.style.mode == m, m.label()),
+                    egui::Button::selectable(view.style.mode == m, m.label()),
                 );
                 if r.clicked() {
-                    self.style.mode = m;
+                    view.style.mode = m;
                 }
                 if !ok && m == Mode::Texture {
                     r.on_disabled_hover_text(
-                        self.texture_note
+                        scene
+                            .texture_note
                             .clone()
                             .unwrap_or_else(|| "the mesh has no UVs or no texture".into()),
                     );
@@ -231,18 +248,18 @@ impl ViewerApp {
                 }
             }
         });
-        ui.checkbox(&mut self.style.smooth, "smooth shading (M)");
-        ui.add_enabled_ui(self.renderer.has_wireframe(), |ui| {
-            ui.checkbox(&mut self.style.wireframe, "wireframe (X)")
+        ui.checkbox(&mut view.style.smooth, "smooth shading (M)");
+        ui.add_enabled_ui(view.renderer.has_wireframe(), |ui| {
+            ui.checkbox(&mut view.style.wireframe, "wireframe (X)")
                 .on_disabled_hover_text("this device cannot draw line polygons");
         });
-        ui.checkbox(&mut self.side_by_side, "side by side (B)");
-        ui.add_enabled_ui(self.simplified.is_some() && !self.side_by_side, |ui| {
-            ui.checkbox(&mut self.show_original, "show the original (O)");
+        ui.checkbox(&mut view.side_by_side, "side by side (B)");
+        ui.add_enabled_ui(scene.simplified.is_some() && !view.side_by_side, |ui| {
+            ui.checkbox(&mut view.show_original, "show the original (O)");
         });
         ui.horizontal(|ui| {
-            let file_up = self.model.as_ref().map_or(Up::Y, |m| m.up_axis);
-            let current = self.up.unwrap_or(file_up);
+            let file_up = scene.model.as_ref().map_or(Up::Y, |m| m.up_axis);
+            let current = eye.up.unwrap_or(file_up);
             let mut chosen = current;
             egui::ComboBox::from_label("up")
                 .selected_text(current.label())
@@ -252,101 +269,201 @@ impl ViewerApp {
                     }
                 })
                 .response
-                .on_hover_text("the mesh's axis drawn up (default: its file's convention)");
+                .on_hover_text("this mesh's axis drawn up (default: its file's convention)");
             if chosen != current {
-                self.set_up(Some(chosen));
+                act.push(Action::SetUp(Some(chosen)));
             }
         });
         ui.horizontal(|ui| {
             if ui.button("Fit").on_hover_text("F").clicked() {
-                self.frame_to_fit();
+                act.push(Action::FrameToFit);
             }
             if ui.button("Reset").on_hover_text("R").clicked() {
-                self.reset_view();
+                act.push(Action::ResetView);
             }
-            ui.checkbox(&mut self.fly, "fly (G)");
+            ui.checkbox(&mut eye.fly, "fly (G)");
         });
-        if self.fly {
+        if eye.fly {
             ui.add(
-                egui::Slider::new(&mut self.fly_speed, 0.05..=20.0)
+                egui::Slider::new(&mut eye.fly_speed, 0.05..=20.0)
                     .logarithmic(true)
                     .text("speed"),
             );
         }
         ui.separator();
-        ui.label("LOD scene");
-        ui.horizontal(|ui| {
-            let can = self.job.is_none() && self.model.is_some() && self.gpu.sim.is_some();
-            if ui
-                .add_enabled(can, egui::Button::new("Make levels"))
-                .clicked()
-            {
-                self.make_lod();
-            }
-            ui.add_enabled_ui(self.lod.is_some(), |ui| {
-                if ui
-                    .checkbox(&mut self.lod_scene, format!("{0}x{0} grid", LOD_GRID))
-                    .changed()
-                {
-                    self.reset_view();
-                }
-                ui.checkbox(&mut self.lod_on, "LOD (L)");
-            });
-        });
-        if let Some(levels) = &self.lod {
-            let f: Vec<String> = levels.iter().map(|l| l.faces.to_string()).collect();
-            ui.label(format!("levels: {} faces", f.join(" / ")));
-            ui.label(format!("from {}", self.lod_source));
-            let ms = |v: Option<f64>| {
-                v.map_or("-".into(), |s| {
-                    format!("{:.1} ms ({:.1} FPS)", s * 1e3, 1.0 / s)
-                })
-            };
-            ui.label(format!("LOD on: {}", ms(self.lod_frame[0])));
-            ui.label(format!("LOD off: {}", ms(self.lod_frame[1])));
-        }
+        self.lod_ui(ui, view, seen, &mut act);
         ui.separator();
-        self.front_ui(ui);
+        self.front_ui(ui, seen, &mut act);
         ui.separator();
-        self.stats_ui(ui);
+        stats_ui(ui, view, seen);
         ui.separator();
         ui.horizontal(|ui| {
             let l = ui.label("mesh");
             ui.add(egui::TextEdit::singleline(&mut self.save_path).desired_width(150.0))
                 .labelled_by(l.id);
             if ui
-                .add_enabled(self.simplified.is_some(), egui::Button::new("Save"))
+                .add_enabled(scene.simplified.is_some(), egui::Button::new("Save"))
                 .on_hover_text("Ctrl+S")
                 .clicked()
             {
-                self.save();
+                act.push(Action::Save);
             }
         });
         ui.horizontal(|ui| {
             let l = ui.label("PNG");
             ui.add(egui::TextEdit::singleline(&mut self.shot_path).desired_width(150.0))
                 .labelled_by(l.id);
-            if ui.button("Screenshot").on_hover_text("P").clicked() {
-                self.screenshot();
+            if ui
+                .button("Screenshot")
+                .on_hover_text("P: what the 3D view shows, both panes side by side")
+                .clicked()
+            {
+                act.push(Action::Screenshot);
             }
         });
+        act
+    }
+
+    /// The target (ratio and faces), the method and backend, Simplify and Cancel, the job's
+    /// progress.
+    fn target_ui(&mut self, ui: &mut egui::Ui, seen: &Seen, act: &mut Vec<Action>) {
+        let input_faces = seen.scene.model.as_ref().map(|m| m.faces());
+        ui.label("Target");
+        let old_ratio = self.ratio;
+        ui.add(
+            egui::Slider::new(&mut self.ratio, 0.001..=1.0)
+                .logarithmic(true)
+                .text("ratio"),
+        );
+        if self.ratio != old_ratio {
+            self.set_ratio(self.ratio, input_faces);
+        }
+        ui.horizontal(|ui| {
+            let l = ui.label("faces");
+            let r = ui
+                .add(egui::TextEdit::singleline(&mut self.faces_text).desired_width(90.0))
+                .labelled_by(l.id);
+            if r.changed()
+                && let Ok(n) = self.faces_text.trim().parse::<usize>()
+                && let Some(f) = input_faces.filter(|&f| f > 0)
+            {
+                self.ratio = (n as f64 / f as f64).clamp(0.001, 1.0);
+            }
+            // Enter in the field simplifies at once (it also gives the keyboard back).
+            if r.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)) {
+                act.push(Action::Simplify);
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.label("method");
+            let mut method = self.method;
+            for (m, about) in METHODS {
+                ui.selectable_value(&mut method, m, m.name())
+                    .on_hover_text(about);
+            }
+            // hybrid runs on the CPU's cores here; decimate on one core (it is sequential).
+            self.set_method(method, seen.gpu);
+        });
+        ui.horizontal(|ui| {
+            ui.label("backend");
+            for b in [Backend::Gpu, Backend::CpuParallel, Backend::Cpu] {
+                let enabled = if self.method == Method::Decimate {
+                    b == Backend::Cpu
+                } else {
+                    b != Backend::Gpu || seen.gpu.draws(self.method)
+                };
+                ui.add_enabled_ui(enabled, |ui| {
+                    ui.selectable_value(&mut self.backend, b, b.name());
+                });
+            }
+        });
+        // Which backend the window started on, and why (a software adapter is no GPU).
+        ui.small(format!("started on {}", self.backend_why));
+        let job = seen.jobs.running();
+        ui.horizontal(|ui| {
+            let simplify = egui::Button::new("Simplify");
+            if ui
+                .add_enabled(job.is_none() && input_faces.is_some(), simplify)
+                .on_hover_text("Enter")
+                .clicked()
+            {
+                act.push(Action::Simplify);
+            }
+            let cancel = egui::Button::new("Cancel");
+            if ui
+                .add_enabled(job.is_some(), cancel)
+                .on_hover_text("Esc")
+                .clicked()
+            {
+                act.push(Action::Cancel);
+            }
+        });
+        if let Some(j) = job {
+            ui.add(egui::ProgressBar::new(j.progress()).text(format!(
+                "{} - {:.1} s",
+                match j.phase() {
+                    p if p.is_empty() => j.label.clone(),
+                    p => p,
+                },
+                j.started.elapsed().as_secs_f64()
+            )));
+        }
+    }
+
+    /// The LOD scene's section: make the levels, show the grid, LOD on or off, frame times.
+    fn lod_ui(&mut self, ui: &mut egui::Ui, view: &mut View3d, seen: &Seen, act: &mut Vec<Action>) {
+        ui.label("LOD scene");
+        let scene = seen.scene;
+        ui.horizontal(|ui| {
+            let can = !seen.jobs.busy() && scene.model.is_some() && seen.gpu.sim.is_some();
+            if ui
+                .add_enabled(can, egui::Button::new("Make levels"))
+                .clicked()
+            {
+                act.push(Action::MakeLod);
+            }
+            ui.add_enabled_ui(scene.lod.is_some(), |ui| {
+                if ui
+                    .checkbox(&mut view.lod_scene, format!("{0}x{0} grid", LOD_GRID))
+                    .changed()
+                {
+                    act.push(Action::ResetView);
+                }
+                ui.checkbox(&mut view.lod_on, "LOD (L)");
+            });
+        });
+        if let Some(levels) = &scene.lod {
+            let f: Vec<String> = levels.iter().map(|l| l.faces.to_string()).collect();
+            ui.label(format!("levels: {} faces", f.join(" / ")));
+            ui.label(format!("from {}", scene.lod_source));
+            let ms = |v: Option<f64>| {
+                v.map_or("-".into(), |s| {
+                    format!("{:.1} ms ({:.1} FPS)", s * 1e3, 1.0 / s)
+                })
+            };
+            ui.label(format!("LOD on: {}", ms(view.lod_frame[0])));
+            ui.label(format!("LOD off: {}", ms(view.lod_frame[1])));
+        }
     }
 
     /// The side panel's front section: the search, the plot, the member shown and the LOD
     /// scene from the chosen ones.
-    pub(super) fn front_ui(&mut self, ui: &mut egui::Ui) {
+    fn front_ui(&mut self, ui: &mut egui::Ui, seen: &Seen, act: &mut Vec<Action>) {
         ui.label("Pareto front (vertex removal)");
+        let idle = !seen.jobs.busy();
         ui.horizontal(|ui| {
-            let can = self.job.is_none() && self.model.is_some();
             if ui
-                .add_enabled(can, egui::Button::new("Search"))
+                .add_enabled(
+                    idle && seen.scene.model.is_some(),
+                    egui::Button::new("Search"),
+                )
                 .on_hover_text(
                     "NSGA-II over which vertices to remove, as meshslim pareto: vertices \
                      against error; or open a .pareto.json it wrote",
                 )
                 .clicked()
             {
-                self.search_front();
+                act.push(Action::SearchFront);
             }
             ui.add(
                 egui::DragValue::new(&mut self.pareto.population)
@@ -359,7 +476,9 @@ impl ViewerApp {
                     .prefix("gen "),
             );
         });
-        let Some(front) = &self.front else { return };
+        let Some(front) = &seen.scene.front else {
+            return;
+        };
         let (click, rect) = front.plot_ui(ui);
         self.front_rect = Some(rect);
         ui.label(format!(
@@ -375,92 +494,25 @@ impl ViewerApp {
         }
         let chosen = front.chosen.len();
         ui.horizontal(|ui| {
-            let can = chosen > 0 && self.job.is_none();
+            let from = egui::Button::new(format!("LOD scene from {chosen} chosen"));
             if ui
-                .add_enabled(
-                    can,
-                    egui::Button::new(format!("LOD scene from {chosen} chosen")),
-                )
+                .add_enabled(chosen > 0 && idle, from)
                 .on_disabled_hover_text("Ctrl+click points of the front to choose them")
                 .clicked()
             {
-                self.lod_from_front();
+                act.push(Action::LodFromFront);
             }
             if ui
                 .add_enabled(chosen > 0, egui::Button::new("Clear"))
                 .clicked()
-                && let Some(f) = &mut self.front
             {
-                f.chosen.clear();
+                act.push(Action::ClearChosen);
             }
         });
         match click {
-            Some(FrontClick::Show(k)) => self.show_member(k),
-            Some(FrontClick::Choose(k)) => self.choose_member(k),
+            Some(FrontClick::Show(k)) => act.push(Action::ShowMember(k)),
+            Some(FrontClick::Choose(k)) => act.push(Action::ChooseMember(k)),
             None => {}
-        }
-    }
-
-    /// Chooses member `k` for the LOD scene, or takes it back.
-    pub fn choose_member(&mut self, k: usize) {
-        if let Some(f) = &mut self.front
-            && k < f.members.len()
-            && !f.chosen.remove(&k)
-        {
-            f.chosen.insert(k);
-        }
-    }
-
-    fn stats_ui(&self, ui: &mut egui::Ui) {
-        ui.label(format!("device: {}", self.gpu.adapter));
-        // The time between the last frames drawn: the window redraws on input, on its own a few
-        // times a second during a job, and continuously in the LOD scene and fly mode.
-        ui.label(format!(
-            "frames: {:.1} ms apart ({:.0} FPS)",
-            self.clock.smoothed * 1e3,
-            if self.clock.smoothed > 0.0 {
-                1.0 / self.clock.smoothed
-            } else {
-                0.0
-            }
-        ));
-        let Some(m) = &self.model else { return };
-        egui::Grid::new("stats").striped(true).show(ui, |ui| {
-            ui.label("");
-            ui.label("faces");
-            ui.label("vertices");
-            ui.end_row();
-            ui.label("before");
-            ui.label(m.faces().to_string());
-            ui.label(m.mesh.positions.len().to_string());
-            ui.end_row();
-            if let Some(s) = &self.simplified {
-                ui.label("after");
-                ui.label(s.report.output_faces.to_string());
-                ui.label(s.report.output_vertices.to_string());
-                ui.end_row();
-            }
-        });
-        let Some(s) = &self.simplified else { return };
-        match &s.made_by {
-            Some(m) => ui.label(m),
-            None => ui.label(format!(
-                "{}: {:.3} s, stop: {:?}",
-                s.report.backend.name(),
-                s.seconds,
-                s.report.stop_reason
-            )),
-        };
-        ui.label(error_text(s.error));
-        if let Some(r) = &s.report.rounds {
-            ui.label(format!("{} rounds; time per stage:", r.rounds));
-            egui::Grid::new("stages").striped(true).show(ui, |ui| {
-                for (name, secs) in &r.stage_seconds.0 {
-                    ui.label(name);
-                    ui.label(format!("{:.1} ms", secs * 1e3));
-                    ui.end_row();
-                }
-            });
         }
     }
 
@@ -480,12 +532,93 @@ impl ViewerApp {
             });
         self.show_help = open && self.show_help;
     }
+}
 
-    pub(super) fn dropped_files(&mut self, ctx: &egui::Context) {
-        let dropped = ctx.input(|i| i.raw.dropped_files.first().map(|f| f.path().to_path_buf()));
-        if let Some(p) = dropped {
-            self.open(p);
+/// A file dropped on the window, to open.
+pub(super) fn dropped_file(ctx: &egui::Context) -> Option<Action> {
+    ctx.input(|i| i.raw.dropped_files.first().map(|f| f.path().to_path_buf()))
+        .map(Action::Open)
+}
+
+/// The methods the panel offers, each with what it is for.
+const METHODS: [(Method, &str); 5] = [
+    (
+        Method::Qem,
+        "edge collapse: best surface, exact target, topology kept",
+    ),
+    (
+        Method::Cluster,
+        "uniform grid: fastest, within 5%, topology may change",
+    ),
+    (
+        Method::FloatingCell,
+        "floating cells: keeps tips and corners, within 5%, topology may change",
+    ),
+    (
+        Method::Hybrid,
+        "grid to 2x the target + 20k faces, then edge collapse: near-qem quality, faster",
+    ),
+    (
+        Method::Decimate,
+        "vertex removal: keeps a subset of the input's vertices, unmoved; topology kept; exact \
+         target (cpu)",
+    ),
+];
+
+/// The device, the frame time, the counts before and after, and the result's run.
+fn stats_ui(ui: &mut egui::Ui, view: &View3d, seen: &Seen) {
+    ui.label(format!("device: {}", seen.gpu.adapter));
+    // The time between the last frames drawn: the window redraws on input, on its own a few
+    // times a second during a job, and continuously in the LOD scene and fly mode; idle, the
+    // gap is the user's, not the renderer's.
+    let dt = view.clock.smoothed;
+    ui.label(if dt > 0.0 && dt < 1.0 {
+        format!("frames: {:.1} ms apart ({:.0} FPS)", dt * 1e3, 1.0 / dt)
+    } else {
+        "frames: drawn on input (idle)".into()
+    });
+    let Some(m) = &seen.scene.model else { return };
+    let simplified = seen.scene.simplified.as_ref();
+    egui::Grid::new("stats").striped(true).show(ui, |ui| {
+        ui.label("");
+        ui.label("faces");
+        ui.label("vertices");
+        ui.end_row();
+        ui.label("before");
+        ui.label(m.faces().to_string());
+        ui.label(m.mesh.positions.len().to_string());
+        ui.end_row();
+        if let Some(s) = simplified {
+            ui.label("after");
+            ui.label(s.report.output_faces.to_string());
+            ui.label(s.report.output_vertices.to_string());
+            ui.end_row();
         }
+    });
+    let Some(s) = simplified else { return };
+    match &s.made_by {
+        Some(m) => ui.label(m),
+        None => ui.label(format!(
+            "{}: {:.3} s, stop: {:?}",
+            s.report.backend.name(),
+            s.seconds,
+            s.report.stop_reason
+        )),
+    };
+    ui.label(error_text(s.error));
+    if let Some(r) = &s.report.rounds {
+        // Folded: a GPU run's ~30 stage rows would push Save and Screenshot out of sight.
+        egui::CollapsingHeader::new(format!("{} rounds: time per stage", r.rounds))
+            .default_open(false)
+            .show(ui, |ui| {
+                egui::Grid::new("stages").striped(true).show(ui, |ui| {
+                    for (name, secs) in &r.stage_seconds.0 {
+                        ui.label(name);
+                        ui.label(format!("{:.1} ms", secs * 1e3));
+                        ui.end_row();
+                    }
+                });
+            });
     }
 }
 
@@ -516,7 +649,10 @@ pub const HELP: &[(&str, &str)] = &[
     ("Esc", "cancel the running job (or close this)"),
     ("Ctrl+O", "open a mesh (or drop a file on the window)"),
     ("Ctrl+S", "save the simplified mesh"),
-    ("P", "screenshot of the 3D view to PNG"),
+    (
+        "P",
+        "screenshot of the 3D view (both panes side by side) to PNG",
+    ),
     ("F1", "this help"),
 ];
 

@@ -5,16 +5,14 @@
 use super::camera::Up;
 use super::front::Front;
 use super::render::{Extras, SceneMesh, pack_color, vertex_normals};
-use crate::cluster::gpu::GpuClusterer;
 use crate::error::{Error, Result};
 use crate::gpu::{GpuMesh, GpuRounds, GpuSimplifier};
 use crate::lod::manifest::{self, ManifestKind};
 use crate::mesh::{Mesh, UvOrigin};
 use crate::metrics::{CompareOptions, TriangleBvh, compare};
 use crate::options::{Backend, SimplifyOptions, SimplifyReport};
-use crate::parallel::{
-    Driver, RoundRunner, RoundsReport, SELECTION_PASSES, Upload, corner_attributes,
-};
+use crate::parallel::{Driver, RoundRunner, SELECTION_PASSES, Upload, corner_attributes};
+use crate::simplify::{Kept, OnDevice};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -54,6 +52,66 @@ pub struct Loaded {
     pub original: SceneMesh,
     pub levels: Option<Vec<SceneMesh>>,
     pub front: Option<Front>,
+}
+
+/// What the window shows — the model and its original drawn, its simplification, the LOD
+/// scene's levels, a Pareto front — and a count that changes whenever any of it does (the 3D
+/// view draws again only then).
+#[derive(Default)]
+pub struct Scene {
+    pub model: Option<Arc<Model>>,
+    pub original: Option<Arc<SceneMesh>>,
+    pub simplified: Option<Simplified>,
+    /// The LOD scene's levels, the original first.
+    pub lod: Option<Vec<SceneMesh>>,
+    /// Where the levels came from (shown in the panel).
+    pub lod_source: String,
+    /// A Pareto front of the model: searched here or read from a manifest.
+    pub front: Option<Front>,
+    /// Why the texture mode is off, when a texture was named but not usable.
+    pub texture_note: Option<String>,
+    /// Bumped whenever a mesh or texture to show changes.
+    pub(super) generation: u64,
+}
+
+impl Scene {
+    /// A new model replaces everything shown.
+    pub(super) fn set_model(&mut self, model: Model, original: SceneMesh) {
+        self.generation += 1;
+        self.texture_note = model.texture_note.clone();
+        self.model = Some(Arc::new(model));
+        self.original = Some(Arc::new(original));
+        self.simplified = None;
+        self.lod = None;
+        self.front = None;
+    }
+
+    pub(super) fn set_simplified(&mut self, s: Simplified) {
+        self.simplified = Some(s);
+        self.generation += 1;
+    }
+
+    pub(super) fn set_levels(&mut self, levels: Vec<SceneMesh>) {
+        self.lod = Some(levels);
+        self.generation += 1;
+    }
+
+    /// The texture changed (uploaded, or refused with `note`).
+    pub(super) fn texture_changed(&mut self, note: Option<String>) {
+        if note.is_some() {
+            self.texture_note = note;
+        }
+        self.generation += 1;
+    }
+
+    /// The mesh the single view draws: the result, or the original when asked or when there
+    /// is none.
+    pub fn shown(&self, show_original: bool) -> Option<&SceneMesh> {
+        match (&self.simplified, show_original) {
+            (Some(s), false) => Some(&s.scene),
+            _ => self.original.as_deref(),
+        }
+    }
 }
 
 /// Opens `path`: a mesh, or a manifest (`X.lods.json`, `X.pareto.json`) with the mesh it was
@@ -378,59 +436,28 @@ pub struct Simplified {
     pub made_by: Option<String>,
 }
 
-/// The pipelines made on the drawing device: the rounds' and `cluster`'s, each absent when
-/// the device could not make it.
-#[derive(Clone, Copy, Default)]
-pub struct Pipelines<'a> {
-    pub rounds: Option<&'a GpuSimplifier>,
-    pub cluster: Option<&'a GpuClusterer>,
-}
-
-/// Simplifies `model` with `opts.backend`. The `gpu` backend runs on `on`'s pipelines (the
-/// window's own device) and the result stays there: its [`GpuMesh`] is the rounds' buffers, or
-/// for `cluster` the build's. The CPU backends' results are uploaded once so that one renderer
-/// draws them all.
-/// `share_queue`: the device also draws a window (see [`GpuRounds::share_queue`]).
+/// Simplifies `model` by the library's one dispatch ([`crate::simplify::simplify_on`]): the
+/// `gpu` backend runs on `on`'s pipelines (the window's own device) and the result stays there:
+/// its [`GpuMesh`] is the rounds' buffers, or for `cluster` and `floating-cell` the build's.
+/// The CPU backends' results are uploaded once so that one renderer draws them all.
 pub fn simplify(
     device: &wgpu::Device,
-    on: Pipelines,
+    on: OnDevice,
     model: &Model,
     opts: &SimplifyOptions,
-    share_queue: bool,
     progress: &mut dyn FnMut(f32),
     phase: &dyn Fn(&str),
 ) -> Result<Simplified> {
     let t = Instant::now();
     phase(&format!("simplifying ({})", opts.backend.name()));
-    let (gpu, positions, indices, mesh, report, uvs, colors) = match opts.backend {
-        Backend::Gpu if opts.method == crate::Method::Qem => {
-            let sim = on
-                .rounds
-                .ok_or_else(|| Error::Gpu("the GPU backend is not available".into()))?;
-            // The model's upload carries the default appearance weights; other weights, a
-            // copy carrying theirs.
-            let other;
-            let up = if model.up.carries(&opts.attributes) {
-                &*model.up
-            } else {
-                other = (*model.up).clone().attributes(&opts.attributes);
-                &other
-            };
-            let mut rounds = GpuRounds::new(sim, up, SELECTION_PASSES)?;
-            rounds.share_queue = share_queue;
-            let report = RoundsReport {
-                gpu_timestamps: sim.has_timestamps(),
-                pipeline_seconds: sim.pipeline_seconds,
-                ..Default::default()
-            };
-            let (mesh, report) = crate::parallel::simplify_rounds(
-                &mut rounds,
-                up,
-                &model.mesh,
-                opts,
-                progress,
-                report,
-            )?;
+    let on = OnDevice {
+        upload: Some(&model.up),
+        ..on
+    };
+    let (mesh, report, kept) = crate::simplify::simplify_on(on, &model.mesh, opts, progress)?;
+    let (gpu, positions, indices, uvs, colors) = match kept {
+        Some(Kept::Rounds(kept)) => {
+            let (mut rounds, up) = *kept;
             // The per-vertex extras (heatmap, normals, UVs) are made from the result read
             // back; what is drawn is the rounds' own buffers.
             let d = rounds.download()?;
@@ -440,20 +467,10 @@ pub fn simplify(
             let shown = up.solved_appearance(&d);
             let uvs = corner_uvs(&shown, &corners);
             let colors = corner_colors(&shown, corners.iter().copied());
-            let gpu = rounds.into_mesh(up)?;
-            (gpu, d.positions, indices, mesh, report, uvs, colors)
+            let gpu = rounds.into_mesh(&up)?;
+            (gpu, d.positions, indices, uvs, colors)
         }
-        Backend::Gpu
-            if matches!(
-                opts.method,
-                crate::Method::Cluster | crate::Method::FloatingCell
-            ) =>
-        {
-            let c = on
-                .cluster
-                .ok_or_else(|| Error::Gpu("GPU clustering is not available".into()))?;
-            let (mesh, report, drawn) =
-                crate::cluster::simplify_drawn(c, &model.mesh, opts, progress)?;
+        Some(Kept::Cluster(drawn)) => {
             // The output's corners are the drawn faces' corners, in the same order.
             let uvs = mesh.uvs_from(UvOrigin::BottomLeft).map(|uv| {
                 mesh.triangles
@@ -463,14 +480,11 @@ pub fn simplify(
                     .collect()
             });
             let colors = corner_colors(&mesh, mesh.triangles.iter().flatten().copied());
-            let (gpu, positions, indices) = (drawn.gpu, drawn.positions, drawn.indices);
-            (gpu, positions, indices, mesh, report, uvs, colors)
+            (drawn.gpu, drawn.positions, drawn.indices, uvs, colors)
         }
-        _ => {
-            let (mesh, report) =
-                crate::simplify::simplify_with_progress(&model.mesh, opts, progress)?;
+        None => {
             let d = model.upload(device, &mesh)?;
-            (d.gpu, d.positions, d.indices, mesh, report, d.uvs, d.colors)
+            (d.gpu, d.positions, d.indices, d.uvs, d.colors)
         }
     };
     let seconds = t.elapsed().as_secs_f64();

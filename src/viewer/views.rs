@@ -1,39 +1,177 @@
-//! The 3D view: pane textures drawn only when what they show changed, the overlays on them
-//! (labels, the heatmap legend), the camera input, and the LOD scene's instances with the level
-//! each draws.
+//! The 3D view: its panes' textures, drawn only when what they show changed, the overlays on
+//! them (labels, the heatmap legend), the frame clock, and the LOD scene's instances with the
+//! level each draws. It reads the scene and moves the camera; it changes nothing else.
 
-use super::app::{DrawKey, View, ViewerApp};
-use super::camera::Camera;
+use super::camera::{Camera, Eye};
+use super::device::Device;
 use super::lod::{LOD_GRID, LOD_SPACING, lod_level};
-use super::render::{Mode, SceneMesh, Target};
-use crate::error::Result;
+use super::render::{Mode, Renderer, SceneMesh, Style, Target};
+use super::scene::Scene;
+use crate::error::{Error, Result};
 use eframe::egui;
 use glam::{Mat4, Vec3};
+use std::time::Instant;
 
-impl ViewerApp {
-    /// The LOD scene's first view: low over one side of the grid, so that the nearest
-    /// instances are large on screen and the farthest small — every level has its turn.
-    pub(super) fn lod_home(&self) -> Camera {
-        let half = LOD_GRID as f32 * LOD_SPACING * 0.5;
-        let mut c = Camera {
-            yaw: 0.6,
-            pitch: 0.15,
-            ..self.camera
-        };
-        // Low over the grid's edge, whatever the view's shape: the nearest instances in view
-        // (about 4 diagonals away) draw the original, the far side the coarsest level.
-        c.target = Vec3::ZERO;
-        c.distance = half * 1.05;
-        c
+/// What a drawn frame showed: the panes are drawn again only when it changes.
+#[derive(Debug, Clone, PartialEq)]
+struct DrawKey {
+    camera: Camera,
+    style: Style,
+    split: bool,
+    show_original: bool,
+    lod_on: bool,
+    sizes: Vec<(u32, u32)>,
+    generation: u64,
+}
+
+/// A texture the 3D view draws into and egui shows.
+struct Pane {
+    target: Target,
+    id: egui::TextureId,
+}
+
+/// Frame time, smoothed.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct FrameClock {
+    last: Option<Instant>,
+    /// Seconds per frame, exponentially smoothed.
+    pub smoothed: f64,
+}
+
+impl FrameClock {
+    fn tick(&mut self) {
+        let now = Instant::now();
+        if let Some(l) = self.last {
+            let dt = (now - l).as_secs_f64();
+            self.smoothed = if self.smoothed == 0.0 {
+                dt
+            } else {
+                0.9 * self.smoothed + 0.1 * dt
+            };
+        }
+        self.last = Some(now);
+    }
+}
+
+/// The 3D view's state: the renderer, how it draws (style, side by side, the LOD scene), its
+/// panes and what they last showed, and the frame counts the panel and the tests read.
+pub struct View3d {
+    pub(super) renderer: Renderer,
+    panes: Vec<Pane>,
+    drawn: Option<DrawKey>,
+    pub style: Style,
+    /// Original on the left, simplified on the right, one camera.
+    pub side_by_side: bool,
+    /// Draw the original even when a result exists.
+    pub show_original: bool,
+    pub lod_scene: bool,
+    pub lod_on: bool,
+    pub clock: FrameClock,
+    /// Smoothed frame seconds of the LOD scene with LOD on and off, as last measured.
+    pub lod_frame: [Option<f64>; 2],
+    /// Frames drawn since the start (the tests count them while a job runs).
+    pub frames: u64,
+    /// Times the 3D view was rendered (only when what it shows changed).
+    pub renders: u64,
+}
+
+impl View3d {
+    pub(super) fn new(renderer: Renderer) -> View3d {
+        View3d {
+            renderer,
+            panes: Vec::new(),
+            drawn: None,
+            style: Style::default(),
+            side_by_side: false,
+            show_original: false,
+            lod_scene: false,
+            lod_on: true,
+            clock: FrameClock::default(),
+            lod_frame: [None, None],
+            frames: 0,
+            renders: 0,
+        }
     }
 
-    /// How many instances of the LOD scene draw each level (with the current camera).
-    pub fn lod_histogram(&self) -> Vec<usize> {
-        let Some(levels) = &self.lod else {
+    /// A frame begins: the clock, the count, and the LOD scene's frame time with LOD on or off.
+    pub(super) fn tick(&mut self, scene: &Scene) {
+        self.clock.tick();
+        self.frames += 1;
+        if self.lod_shown(scene) {
+            self.lod_frame[if self.lod_on { 0 } else { 1 }] = Some(self.clock.smoothed);
+        }
+    }
+
+    /// The LOD scene is on and has levels.
+    pub fn lod_shown(&self, scene: &Scene) -> bool {
+        self.lod_scene && scene.lod.is_some()
+    }
+
+    /// A new model: framed again at the next frame, for the view's real shape; a new LOD
+    /// scene's frame times are measured anew.
+    pub(super) fn reframe(&mut self) {
+        self.drawn = None;
+        self.lod_frame = [None, None];
+    }
+
+    /// The first pane's width over its height (4:3 before the first frame).
+    pub fn aspect(&self) -> f32 {
+        self.panes.first().map_or(4.0 / 3.0, |v| {
+            v.target.size.0 as f32 / v.target.size.1 as f32
+        })
+    }
+
+    /// Whether `mode` can draw the scene: textures need UVs and a texture, colours colours.
+    pub fn mode_available(&self, mode: Mode, scene: &Scene) -> bool {
+        match mode {
+            Mode::Texture => {
+                self.renderer.has_texture() && scene.original.as_ref().is_some_and(|o| o.has_uvs)
+            }
+            Mode::Color => scene.original.as_ref().is_some_and(|o| o.has_colors),
+            _ => true,
+        }
+    }
+
+    /// The pixels of pane `k` as last drawn (RGBA8 rows) and its size.
+    pub fn pane_rgba(&self, gpu: &Device, k: usize) -> Result<(Vec<u8>, (u32, u32))> {
+        let v = self
+            .panes
+            .get(k)
+            .ok_or_else(|| Error::InvalidOption(format!("no pane {k} drawn")))?;
+        Ok((v.target.read_rgba(&gpu.device, &gpu.queue)?, v.target.size))
+    }
+
+    /// What the 3D view shows as one image (RGBA8 rows) and its size: the panes side by side.
+    pub fn rgba(&self, gpu: &Device) -> Result<(Vec<u8>, (u32, u32))> {
+        let panes = (0..self.panes.len().max(1))
+            .map(|k| self.pane_rgba(gpu, k))
+            .collect::<Result<Vec<_>>>()?;
+        if panes.len() == 1 {
+            return Ok(panes.into_iter().next().expect("one pane"));
+        }
+        let w: u32 = panes.iter().map(|p| p.1.0).sum();
+        let h = panes.iter().map(|p| p.1.1).max().unwrap_or(1);
+        // Opaque black where a pane is a pixel shorter than the other (rounding of the split).
+        let mut out = [0, 0, 0, 255].repeat((w * h) as usize);
+        let mut x0 = 0;
+        for (px, (pw, ph)) in &panes {
+            let row = 4 * *pw as usize;
+            for y in 0..*ph as usize {
+                let at = 4 * (y * w as usize + x0);
+                out[at..at + row].copy_from_slice(&px[y * row..(y + 1) * row]);
+            }
+            x0 += *pw as usize;
+        }
+        Ok((out, (w, h)))
+    }
+
+    /// How many instances of the LOD scene draw each level (with `camera`).
+    pub fn lod_histogram(&self, scene: &Scene, camera: &Camera) -> Vec<usize> {
+        let Some(levels) = &scene.lod else {
             return Vec::new();
         };
         let mut h = vec![0; levels.len()];
-        for (mesh, _) in self.lod_items(levels) {
+        for (mesh, _) in self.lod_items(levels, camera) {
             let k = levels
                 .iter()
                 .position(|l| std::ptr::eq(l, mesh))
@@ -45,11 +183,15 @@ impl ViewerApp {
 
     /// The scene's instances: (mesh, placement), each choosing its level by its size on screen
     /// when LOD is on.
-    fn lod_items<'a>(&self, levels: &'a [SceneMesh]) -> Vec<(&'a SceneMesh, Mat4)> {
-        let eye = self.camera.eye();
-        let view_px = self.views.first().map_or(600.0, |v| v.target.size.1 as f32);
+    fn lod_items<'a>(
+        &self,
+        levels: &'a [SceneMesh],
+        camera: &Camera,
+    ) -> Vec<(&'a SceneMesh, Mat4)> {
+        let eye = camera.eye();
+        let view_px = self.panes.first().map_or(600.0, |v| v.target.size.1 as f32);
         // Pixels per unit of length at distance 1.
-        let px_per_unit = view_px / (2.0 * (0.5 * self.camera.fov_y).tan());
+        let px_per_unit = view_px / (2.0 * (0.5 * camera.fov_y).tan());
         let n = LOD_GRID as f32;
         let full = levels[0].faces.max(1) as f64;
         let fractions: Vec<f64> = levels.iter().map(|l| l.faces as f64 / full).collect();
@@ -61,7 +203,7 @@ impl ViewerApp {
                     0.0,
                     (j as f32 - (n - 1.0) * 0.5) * LOD_SPACING,
                 );
-                let place = Mat4::from_translation(at) * self.camera.model;
+                let place = Mat4::from_translation(at) * camera.model;
                 let level = if self.lod_on {
                     // An instance's diagonal is 1: its height on screen in pixels.
                     let px = px_per_unit / eye.distance(at).max(1e-3);
@@ -75,14 +217,30 @@ impl ViewerApp {
         items
     }
 
-    /// Draws the 3D view(s) into `rect` and handles the camera input on it.
-    pub(super) fn view_ui(&mut self, ui: &mut egui::Ui) {
+    /// Frames what is shown: the LOD scene from its home, else the model to fit.
+    pub(super) fn frame_to_fit(&self, scene: &Scene, eye: &mut Eye) {
+        if self.lod_shown(scene) {
+            eye.lod_home();
+        } else {
+            eye.fit(self.aspect());
+        }
+    }
+
+    /// Draws the 3D view(s) into the rest of the window and moves `eye` by the input on it; an
+    /// error (a pane refused by the device) is given back for the status line.
+    pub(super) fn ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        gpu: &Device,
+        scene: &Scene,
+        eye: &mut Eye,
+    ) -> std::result::Result<(), String> {
         let rect = ui.available_rect_before_wrap();
         let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
-        self.camera_input(ui, &response);
+        eye.input(ui, &response);
         let ppp = ui.ctx().pixels_per_point();
-        let lod = self.lod_scene && self.lod.is_some();
-        let split = self.side_by_side && !lod && self.original.is_some();
+        let lod = self.lod_shown(scene);
+        let split = self.side_by_side && !lod && scene.original.is_some();
         let panes: Vec<egui::Rect> = if split {
             let (l, r) = rect.split_left_right_at_fraction(0.5);
             vec![
@@ -92,62 +250,57 @@ impl ViewerApp {
         } else {
             vec![rect]
         };
-        if let Err(e) = self.ensure_views(&panes, ppp) {
-            self.status = format!("cannot draw: {e}");
-            return;
-        }
+        self.ensure_panes(gpu, &panes, ppp)
+            .map_err(|e| format!("cannot draw: {e}"))?;
         // Going into or out of side by side halves or doubles each pane's width: frame the
         // mesh again for the new shape (a model's first frame too, now that the size is known).
         if self.drawn.as_ref().is_none_or(|d| d.split != split) && !lod {
-            self.frame_to_fit();
+            self.frame_to_fit(scene, eye);
         }
         // The 3D view is drawn again only when what it shows changed (the LOD scene always, it
         // measures frame rates): frames that only move the progress bar stay cheap, which on a
         // software rasterizer leaves the cores to a running simplification.
         let key = DrawKey {
-            camera: self.camera,
+            camera: eye.camera,
             style: self.style,
             split,
             show_original: self.show_original,
             lod_on: self.lod_on,
-            sizes: self.views.iter().map(|v| v.target.size).collect(),
-            generation: self.generation,
+            sizes: self.panes.iter().map(|v| v.target.size).collect(),
+            generation: scene.generation,
         };
-        if lod || self.drawn.as_ref() != Some(&key) {
-            self.draw_views(split, lod);
+        let drawn = if lod || self.drawn.as_ref() != Some(&key) {
+            let r = self.draw(gpu, scene, &eye.camera, split, lod);
             self.drawn = Some(key);
-        }
-        self.paint_views(ui, rect, &panes, split, lod);
+            r
+        } else {
+            Ok(())
+        };
+        self.paint(ui, rect, &panes, scene, (split, lod, eye.fly));
+        drawn.map_err(|e| e.to_string())
     }
 
     /// Renders the pane textures.
-    fn draw_views(&mut self, split: bool, lod: bool) {
+    fn draw(
+        &mut self,
+        gpu: &Device,
+        scene: &Scene,
+        camera: &Camera,
+        split: bool,
+        lod: bool,
+    ) -> Result<()> {
         self.renders += 1;
-        let original = self.original.clone();
         let shown: Vec<Option<&SceneMesh>> = if split {
-            vec![
-                original.as_deref(),
-                self.simplified
-                    .as_ref()
-                    .map(|s| &s.scene)
-                    .or(original.as_deref()),
-            ]
+            vec![scene.original.as_deref(), scene.shown(false)]
         } else {
-            let main = match (&self.simplified, self.show_original) {
-                (Some(s), false) => Some(&s.scene),
-                _ => original.as_deref(),
-            };
-            vec![main]
+            vec![scene.shown(self.show_original)]
         };
-        let lod_levels = self.lod.take();
         // A refused draw becomes the status line, not a panic in wgpu's default handler.
-        let scope = crate::compute::gpu::ErrorScope::push(&self.gpu.device);
+        let scope = crate::compute::gpu::ErrorScope::push(&gpu.device);
         for (k, mesh) in shown.iter().enumerate() {
-            let items: Vec<(&SceneMesh, Mat4)> = match (&lod_levels, lod) {
-                (Some(levels), true) => self.lod_items(levels),
-                _ => mesh
-                    .map(|m| vec![(m, self.camera.model)])
-                    .unwrap_or_default(),
+            let items: Vec<(&SceneMesh, Mat4)> = match (&scene.lod, lod) {
+                (Some(levels), true) => self.lod_items(levels, camera),
+                _ => mesh.map(|m| vec![(m, camera.model)]).unwrap_or_default(),
             };
             let mut style = self.style;
             if style.mode == Mode::Texture && !mesh.is_some_and(|m| m.has_uvs)
@@ -157,37 +310,34 @@ impl ViewerApp {
             }
             // One submission per pane: the renderer's uniforms are written through the queue,
             // and a second pane's writes would land before the first pane's draw otherwise.
-            let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
             self.renderer.draw(
-                &self.gpu.device,
-                &self.gpu.queue,
+                &gpu.device,
+                &gpu.queue,
                 &mut enc,
-                &self.views[k].target,
-                &self.camera,
+                &self.panes[k].target,
+                camera,
                 &style,
                 &items,
             );
-            self.gpu.queue.submit([enc.finish()]);
+            gpu.queue.submit([enc.finish()]);
         }
-        self.lod = lod_levels;
-        if let Err(e) = scope.check("drawing the view") {
-            self.status = e.to_string();
-        }
+        scope.check("drawing the view")
     }
 
     /// Shows the pane textures and the overlays (labels, legend).
-    fn paint_views(
+    fn paint(
         &self,
         ui: &egui::Ui,
         rect: egui::Rect,
         panes: &[egui::Rect],
-        split: bool,
-        lod: bool,
+        scene: &Scene,
+        (split, lod, fly): (bool, bool, bool),
     ) {
         let painter = ui.painter_at(rect);
         for (k, pane) in panes.iter().enumerate() {
             painter.image(
-                self.views[k].id,
+                self.panes[k].id,
                 *pane,
                 egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
                 egui::Color32::WHITE,
@@ -203,7 +353,7 @@ impl ViewerApp {
                 top_left,
                 "original",
             );
-            let right = if self.simplified.is_some() {
+            let right = if scene.simplified.is_some() {
                 "simplified"
             } else {
                 "original (not simplified yet)"
@@ -226,7 +376,7 @@ impl ViewerApp {
         if self.style.mode == Mode::Quality {
             legend(&painter, rect, ["0°", "60°"], "smallest angle of each face");
         }
-        if self.fly {
+        if fly {
             label(
                 rect.left_bottom() + egui::vec2(8.0, -8.0),
                 egui::Align2::LEFT_BOTTOM,
@@ -236,24 +386,24 @@ impl ViewerApp {
     }
 
     /// One texture per pane, of the pane's size in pixels, registered with egui.
-    fn ensure_views(&mut self, panes: &[egui::Rect], ppp: f32) -> Result<()> {
-        for v in self.views.drain(panes.len().min(self.views.len())..) {
-            self.gpu.egui_renderer.write().free_texture(&v.id);
+    fn ensure_panes(&mut self, gpu: &Device, panes: &[egui::Rect], ppp: f32) -> Result<()> {
+        for v in self.panes.drain(panes.len().min(self.panes.len())..) {
+            gpu.egui_renderer.write().free_texture(&v.id);
         }
         for (k, pane) in panes.iter().enumerate() {
             let size = (
                 ((pane.width() * ppp).round() as u32).max(1),
                 ((pane.height() * ppp).round() as u32).max(1),
             );
-            if self.views.get(k).is_some_and(|v| v.target.size == size) {
+            if self.panes.get(k).is_some_and(|v| v.target.size == size) {
                 continue;
             }
-            let target = Target::new(&self.gpu.device, size)?;
-            let mut r = self.gpu.egui_renderer.write();
-            let id = match self.views.get(k) {
+            let target = Target::new(&gpu.device, size)?;
+            let mut r = gpu.egui_renderer.write();
+            let id = match self.panes.get(k) {
                 Some(v) => {
                     r.update_egui_texture_from_wgpu_texture(
-                        &self.gpu.device,
+                        &gpu.device,
                         &target.color_view,
                         wgpu::FilterMode::Linear,
                         v.id,
@@ -261,71 +411,19 @@ impl ViewerApp {
                     v.id
                 }
                 None => r.register_native_texture(
-                    &self.gpu.device,
+                    &gpu.device,
                     &target.color_view,
                     wgpu::FilterMode::Linear,
                 ),
             };
-            let v = View { target, id };
-            if k < self.views.len() {
-                self.views[k] = v;
+            let v = Pane { target, id };
+            if k < self.panes.len() {
+                self.panes[k] = v;
             } else {
-                self.views.push(v);
+                self.panes.push(v);
             }
         }
         Ok(())
-    }
-
-    fn camera_input(&mut self, ui: &egui::Ui, r: &egui::Response) {
-        let size = r.rect.size().max(egui::vec2(1.0, 1.0));
-        let d = r.drag_delta();
-        // Radians per point: a drag across the view turns about half a turn.
-        let turn = std::f32::consts::PI / size.y;
-        if r.dragged_by(egui::PointerButton::Primary) {
-            if self.fly {
-                self.camera.look(-d.x * turn * 0.5, -d.y * turn * 0.5);
-            } else {
-                self.camera.orbit(-d.x * turn, d.y * turn);
-            }
-        }
-        if r.dragged_by(egui::PointerButton::Secondary) || r.dragged_by(egui::PointerButton::Middle)
-        {
-            self.camera.pan(d.x / size.y, d.y / size.y);
-        }
-        if r.hovered() {
-            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
-            if scroll != 0.0 {
-                // Zoom scaled by distance: the same wheel step moves 10% closer at any range.
-                self.camera.zoom((-scroll * 0.002).exp());
-            }
-            let pinch = ui.input(|i| i.zoom_delta());
-            if pinch != 1.0 {
-                self.camera.zoom(1.0 / pinch);
-            }
-        }
-        // Keys only when no text field has the keyboard.
-        if ui.ctx().egui_wants_keyboard_input() {
-            return;
-        }
-        if self.fly {
-            let (dt, held) = ui.input(|i| {
-                let k = |key| if i.key_down(key) { 1.0f32 } else { 0.0 };
-                (
-                    i.stable_dt.min(0.1),
-                    [
-                        k(egui::Key::W) - k(egui::Key::S),
-                        k(egui::Key::D) - k(egui::Key::A),
-                        k(egui::Key::E) - k(egui::Key::Q),
-                    ],
-                )
-            });
-            if held != [0.0; 3] {
-                let step = self.fly_speed * dt;
-                self.camera
-                    .fly(held[0] * step, held[1] * step, held[2] * step);
-                ui.ctx().request_repaint();
-            }
-        }
     }
 }
 
