@@ -317,6 +317,13 @@ fn a_dropped_file_opens_and_the_result_saves_and_screenshots() {
         .unwrap_or_else(|| panic!("{}", h.state().status))
         .faces();
     assert_eq!(faces, 5120);
+    // An axis chosen for one file is that file's: the next opens with its own.
+    h.state_mut().set_up(Some(meshslim::viewer::camera::Up::X));
+    assert_eq!(h.state().eye.up, Some(meshslim::viewer::camera::Up::X));
+    h.state_mut().open(input.clone());
+    finish_job(&mut h);
+    assert!(h.state().scene.model.is_some(), "{}", h.state().status);
+    assert_eq!(h.state().eye.up, None, "the chosen axis carried over");
 
     h.state_mut().set_target_faces(500);
     h.state_mut().panel.backend = Backend::CpuParallel;

@@ -369,7 +369,8 @@ impl ViewerApp {
         // An axis chosen for the previous file is not this one's: each file opens with its own
         // (or the command line's, for the first).
         self.eye.up = self.eye.up_for_next.take();
-        self.eye.home(m.up_axis, m.extent(), self.view.aspect());
+        self.eye
+            .home(m.up_axis, m.stood, m.extent(), self.view.aspect());
         self.panel.set_ratio(self.panel.ratio, Some(m.faces()));
         self.scene.front = None;
         self.panel.front_rect = None;
@@ -469,7 +470,8 @@ impl ViewerApp {
     /// The model's first view again (the LOD scene's, when it is shown), out of fly mode.
     pub fn reset_view(&mut self) {
         if let Some(m) = &self.scene.model {
-            self.eye.home(m.up_axis, m.extent(), self.view.aspect());
+            self.eye
+                .home(m.up_axis, m.stood, m.extent(), self.view.aspect());
         }
         if self.view.lod_shown(&self.scene) {
             self.eye.lod_home();

@@ -20,7 +20,6 @@ pub mod views;
 use crate::error::{Error, Result};
 use crate::options::{Backend, SimplifyOptions};
 pub use app::{Start, ViewerApp};
-use camera::Camera;
 pub use render::{Mode, Renderer, Style, encode_png};
 pub use scene::Model;
 
@@ -117,14 +116,11 @@ pub fn screenshot_with(
     {
         renderer.set_texture(&ctx.device, &ctx.queue, Some((&t.rgba, t.size)));
     }
-    let mut cam = Camera {
-        model: model.up_axis.model(model.extent()),
-        yaw: 0.35,
-        pitch: 0.2,
-        ..Camera::default()
-    };
-    // The normalized frame: centred, bounding-box diagonal 1, so a sphere of radius 0.5 holds it.
-    cam.fit(glam::Vec3::ZERO, 0.5, size.0 as f32 / size.1 as f32);
+    // The window's first view of the model.
+    let mut eye = camera::Eye::default();
+    let aspect = size.0 as f32 / size.1 as f32;
+    eye.home(model.up_axis, model.stood, model.extent(), aspect);
+    let cam = eye.camera;
     let items = [(&scene, cam.model)];
     let rgba = render::render_rgba(
         &ctx.device,

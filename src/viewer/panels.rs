@@ -329,6 +329,8 @@ impl Panel {
     fn target_ui(&mut self, ui: &mut egui::Ui, seen: &Seen, act: &mut Vec<Action>) {
         let input_faces = seen.scene.model.as_ref().map(|m| m.faces());
         ui.label("Target");
+        // Three decades of ratio want room: at egui's 100 points, 0.1 to 0.002 took 50.
+        ui.spacing_mut().slider_width = 190.0;
         let old_ratio = self.ratio;
         ui.add(
             egui::Slider::new(&mut self.ratio, 0.001..=1.0)
@@ -659,7 +661,9 @@ pub const HELP: &[(&str, &str)] = &[
 /// The two-sided error as the window shows it.
 pub(super) fn error_text(error: Option<(f64, f64)>) -> String {
     match error {
-        Some((mean, max)) => format!("mean error {mean:.2e}, max {max:.2e} of the diagonal"),
+        Some((mean, max)) => {
+            format!("two-sided distance: mean {mean:.2e}, max {max:.2e} of the diagonal")
+        }
         None => "no faces left to measure".into(),
     }
 }

@@ -40,8 +40,11 @@ pub struct Model {
     /// A texture that was named but could not be used, and why.
     pub texture_note: Option<String>,
     pub load_seconds: f64,
-    /// The axis drawn up: its file format's convention ([`Up::of_file`]), +Y when generated.
+    /// The axis drawn up: the side it rests on ([`super::camera::stands`]) where the format
+    /// fixes no up axis, else its file format's convention ([`Up::of_file`]); +Y when generated.
     pub up_axis: Up,
+    /// How it stands, read from its data: its up axis and the axis across the first view.
+    pub stood: Option<(Up, glam::Vec3)>,
 }
 
 /// What opening a file gives: the model and its original drawn, and from a manifest the levels
@@ -208,7 +211,16 @@ impl Model {
         };
         let mut m = Model::from_mesh(path.display().to_string(), mesh)?;
         m.path = Some(path.to_path_buf());
-        m.up_axis = Up::of_file(Some(path));
+        // glTF is +Y up by its specification; the other formats say nothing, so the data does.
+        let gltf = matches!(
+            crate::io::Format::from_path(path),
+            Ok(crate::io::Format::Gltf | crate::io::Format::Glb)
+        );
+        let convention = Up::of_file(Some(path));
+        m.stood = (!gltf)
+            .then(|| super::camera::stands(&m.mesh.positions, &m.mesh.triangles, convention))
+            .flatten();
+        m.up_axis = m.stood.map_or(convention, |(up, _)| up);
         m.texture = texture;
         m.texture_note = note;
         m.load_seconds = t.elapsed().as_secs_f64();
@@ -240,6 +252,7 @@ impl Model {
             texture_note: None,
             load_seconds: t.elapsed().as_secs_f64(),
             up_axis: Up::Y,
+            stood: None,
         })
     }
 

@@ -369,11 +369,14 @@ impl View3d {
             );
             label(rect.left_top() + egui::vec2(8.0, 6.0), top_left, &text);
         }
-        if self.style.mode == Mode::Heatmap {
+        // The ramp's top is the farthest vertex's distance to the original; the panel's max is
+        // the two-sided distance sampled over both surfaces, which can lie between vertices.
+        if self.style.mode == Mode::Heatmap && scene.original.is_some() {
             let top = format!("{:.2e}", self.style.error_scale);
-            legend(&painter, rect, [&top, "0"], "vertex distance / diagonal");
+            let caption = "each vertex's distance / diagonal (top: the farthest)";
+            legend(&painter, rect, [&top, "0"], caption);
         }
-        if self.style.mode == Mode::Quality {
+        if self.style.mode == Mode::Quality && scene.original.is_some() {
             legend(&painter, rect, ["0°", "60°"], "smallest angle of each face");
         }
         if fly {
@@ -435,6 +438,7 @@ fn legend(painter: &egui::Painter, rect: egui::Rect, ends: [&str; 2], caption: &
         rect.right_top() + egui::vec2(-w - 70.0, 16.0),
         egui::vec2(w, h),
     );
+    painter.rect_filled(bar.expand(2.0), 2.0, egui::Color32::from_black_alpha(150));
     let steps = 32;
     for s in 0..steps {
         let t0 = s as f32 / steps as f32;
@@ -457,14 +461,15 @@ fn legend(painter: &egui::Painter, rect: egui::Rect, ends: [&str; 2], caption: &
         egui::Align2::LEFT_BOTTOM,
         ends[1],
     );
+    // Right-aligned under the bar, so a long caption stays inside the view.
     at(
-        bar.center_bottom() + egui::vec2(0.0, 4.0),
-        egui::Align2::CENTER_TOP,
+        egui::pos2(rect.right() - 8.0, bar.bottom() + 6.0),
+        egui::Align2::RIGHT_TOP,
         caption,
     );
 }
 
-/// Light text over the 3D view.
+/// Light text over the 3D view, on a dark plate so it reads over a light mesh too.
 fn overlay_text(
     painter: &egui::Painter,
     at: egui::Pos2,
@@ -473,7 +478,10 @@ fn overlay_text(
     size: f32,
 ) {
     let color = egui::Color32::from_gray(220);
-    painter.text(at, align, text, egui::FontId::proportional(size), color);
+    let galley = painter.layout_no_wrap(text.to_string(), egui::FontId::proportional(size), color);
+    let rect = align.anchor_size(at, galley.size());
+    painter.rect_filled(rect.expand(2.0), 3.0, egui::Color32::from_black_alpha(150));
+    painter.galley(rect.min, galley, color);
 }
 
 /// `ramp` in shaders/viewer/mesh.wgsl.
