@@ -56,6 +56,8 @@ pub mod options;
 #[doc(hidden)]
 pub mod parallel;
 mod quadric;
+#[cfg(any(feature = "bench", feature = "viewer"))]
+pub mod raster;
 pub mod remesh;
 pub mod simplify;
 pub mod tiles;

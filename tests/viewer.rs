@@ -305,6 +305,66 @@ fn screenshot_command_writes_a_png() {
 }
 
 /// The size of the box of non-background pixels.
+/// `--side-by-side` saves what the window's B shows: the original in the left half and the
+/// result in the right, each with its label in its top left corner.
+#[test]
+fn a_side_by_side_screenshot_holds_both_panes_and_their_labels() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let shot = |name: &str, extra: &[&str]| {
+        let mut args = vec![
+            "view",
+            "builtin:torus",
+            "--screenshot",
+            name,
+            "--size",
+            "320x160",
+        ];
+        args.extend(extra);
+        expect_code(&meshslim(&args, dir.path()), 0);
+        Pixmap::decode_png(&std::fs::read(dir.path().join(name)).unwrap()).unwrap()
+    };
+    let both = shot("both.png", &["--ratio", "0.02", "--side-by-side"]);
+    assert_eq!((both.width(), both.height()), (320, 160));
+    let half = |img: &Pixmap, x0: u32| -> Vec<u8> {
+        (40..160)
+            .flat_map(|y| {
+                let at = 4 * (y * img.width() + x0) as usize;
+                img.data()[at..at + 4 * 160].to_vec()
+            })
+            .collect()
+    };
+    // Below the labels, each half is a drawn torus, and the 2% result differs from the original.
+    for x0 in [0, 160] {
+        let h = half(&both, x0);
+        assert!(
+            h.chunks(4).any(|p| !is_background(p)),
+            "half at {x0} is empty"
+        );
+    }
+    assert_ne!(
+        half(&both, 0),
+        half(&both, 160),
+        "the result looks like the original"
+    );
+    // The labels: light text in each half's top left corner, where the torus does not reach.
+    for x0 in [0, 160] {
+        let light = (6..22)
+            .flat_map(|y| (x0 + 8..x0 + 60).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                let at = 4 * (y * both.width() + x) as usize;
+                both.data()[at..at + 3].iter().all(|&c| c > 150)
+            })
+            .count();
+        assert!(
+            light > 10,
+            "no label in the half at {x0}: {light} light pixels"
+        );
+    }
+}
+
 fn drawn_extent(png: &[u8]) -> (u32, u32) {
     let img = Pixmap::decode_png(png).expect("a valid PNG");
     let (mut lo, mut hi) = ((u32::MAX, u32::MAX), (0, 0));

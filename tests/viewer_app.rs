@@ -384,6 +384,17 @@ fn a_dropped_file_opens_and_the_result_saves_and_screenshots() {
         row(&right, rw, y)[..],
         "the right pane"
     );
+    // Each pane's label is in the image, as the window draws it over the pane.
+    for (x0, pane, w) in [(0, &left, lw), (lw, &right, rw)] {
+        let y = 14;
+        let at = (4 * (y * (lw + rw) + x0)) as usize;
+        let labelled = &both.data()[at..at + 4 * 60];
+        assert_ne!(
+            labelled,
+            &row(pane, w, y)[..60 * 4],
+            "no label over the pane at {x0}"
+        );
+    }
 }
 
 /// `--method cluster` and `floating-cell` on the gpu backend run on the window's device and the

@@ -400,14 +400,7 @@ pub fn plot_svg(report: &Report) -> String {
 
 /// Renders an SVG (the plot) to PNG bytes with resvg, text in the system's fonts.
 pub fn svg_to_png(svg: &str) -> Result<Vec<u8>, String> {
-    use resvg::{tiny_skia, usvg};
-    let mut opt = usvg::Options::default();
-    opt.fontdb_mut().load_system_fonts();
-    let tree = usvg::Tree::from_str(svg, &opt).map_err(|e| e.to_string())?;
-    let size = tree.size().to_int_size();
-    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height())
-        .ok_or_else(|| format!("cannot allocate a {}x{} image", size.width(), size.height()))?;
-    pixmap.fill(tiny_skia::Color::WHITE);
-    resvg::render(&tree, tiny_skia::Transform::default(), &mut pixmap.as_mut());
-    pixmap.encode_png().map_err(|e| e.to_string())
+    crate::raster::svg_pixmap(svg, Some(resvg::tiny_skia::Color::WHITE))?
+        .encode_png()
+        .map_err(|e| e.to_string())
 }

@@ -33,6 +33,7 @@ Examples:
   meshslim view ../shared/models/horse.ply
   meshslim view ../shared/models/spot/spot_triangulated.obj --mode texture --screenshot spot.png
   meshslim view ../shared/models/horse.ply --screenshot horse.png --ratio 0.1
+  meshslim view ../shared/models/horse.ply --screenshot both.png --ratio 0.01 --side-by-side
   meshslim view lods/horse.lods.json
   meshslim view front/horse.pareto.json
   meshslim view scan.ply --screenshot err.png --ratio 0.01 --mode heatmap --size 1600x1200";
@@ -76,13 +77,19 @@ pub struct ViewArgs {
     #[arg(long)]
     pub wireframe: bool,
 
+    /// With --screenshot: the original on the left and the result on the right, each labelled,
+    /// in two halves of the image (the window's B)
+    #[arg(long)]
+    pub side_by_side: bool,
+
     /// Image size for --screenshot (default 1024x768), or the window's size (default 1280x800),
     /// WIDTHxHEIGHT
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
 
     /// The mesh's axis drawn up: x, y, z, -x, -y, -z, or auto (the largest silhouette).
-    /// Default: the file's convention, +Y (OBJ, PLY, glTF, generated meshes) or +Z (STL)
+    /// Default: +Y for glTF (its specification) and generated meshes; for PLY, OBJ and STL the
+    /// side the mesh rests on (horse.ply stands on +Z), else the file's convention (+Y, STL +Z)
     #[arg(long, value_enum, value_name = "AXIS", allow_hyphen_values = true)]
     pub up: Option<crate::viewer::camera::Up>,
 }
@@ -201,13 +208,14 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     let size = args.size.unwrap_or((1024, 768));
     let frame = progress
         .spinner("simplifying and rendering on the GPU".to_string(), || {
-            crate::viewer::screenshot_with(
-                &model,
-                args.ratio.unwrap_or(1.0),
-                args.method.method(),
+            let shot = crate::viewer::Shot {
+                ratio: args.ratio.unwrap_or(1.0),
+                method: args.method.method(),
                 style,
                 size,
-            )
+                side_by_side: args.side_by_side,
+            };
+            crate::viewer::shoot(&model, shot)
         })
         .map_err(lib)?;
     crate::io::write_atomic(&png, |w| w.write_all(&frame.png))

@@ -453,7 +453,7 @@ impl ViewerApp {
     }
 
     fn write_screenshot(&self, path: &Path) -> Result<()> {
-        let (rgba, size) = self.view.rgba(&self.gpu)?;
+        let (rgba, size) = self.view.rgba(&self.gpu, &self.scene)?;
         let png = super::render::encode_png(&rgba, size)?;
         crate::io::write_atomic(path, |w| std::io::Write::write_all(w, &png))
     }

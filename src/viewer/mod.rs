@@ -41,8 +41,8 @@ pub fn screenshot(model: &Model, ratio: f64, style: Style, size: (u32, u32)) -> 
 }
 
 /// As [`screenshot`], simplified by `method`: `qem`, `cluster` and `floating-cell` on the GPU,
-/// drawn from the buffers they wrote; `hybrid` on the CPU's cores, its result uploaded and
-/// drawn by the same renderer.
+/// drawn from the buffers they wrote; `hybrid` on the CPU's cores and `decimate` on one, their
+/// result uploaded and drawn by the same renderer.
 pub fn screenshot_with(
     model: &Model,
     ratio: f64,
@@ -50,6 +50,39 @@ pub fn screenshot_with(
     style: Style,
     size: (u32, u32),
 ) -> Result<Frame> {
+    shoot(
+        model,
+        Shot {
+            ratio,
+            method,
+            style,
+            size,
+            side_by_side: false,
+        },
+    )
+}
+
+/// What a screenshot draws: the mesh simplified to `ratio` by `method` (1 = as is), in `style`,
+/// `size` pixels; with `side_by_side`, the original and the result in two labelled halves, as
+/// the window's `B` shows them.
+#[derive(Debug, Clone, Copy)]
+pub struct Shot {
+    pub ratio: f64,
+    pub method: crate::Method,
+    pub style: Style,
+    pub size: (u32, u32),
+    pub side_by_side: bool,
+}
+
+/// Renders the [`Shot`] of `model`; returns a PNG and what it drew.
+pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
+    let Shot {
+        ratio,
+        method,
+        mut style,
+        size,
+        side_by_side,
+    } = shot;
     // Checked before the GPU work: a texture or colour mode with nothing to show fails at once.
     if style.mode == Mode::Color && model.mesh.colors.is_none() {
         return Err(Error::InvalidOption(
@@ -68,32 +101,33 @@ pub fn screenshot_with(
     // Every piece of device work below (uploads, the simplification, the texture, the draw) is
     // caught here and becomes an error, not a panic in wgpu's default handler.
     let scope = crate::compute::gpu::ErrorScope::push(&ctx.device);
-    let mut style = style;
-    let (scene, faces) = if ratio < 1.0 {
+    let simplified = if ratio < 1.0 {
         let mut opts = SimplifyOptions::with_ratio(model.up.face_count(), ratio)?;
         opts.method = method;
-        opts.backend = if method != crate::Method::Hybrid {
-            Backend::Gpu
-        } else {
-            Backend::CpuParallel
+        // The GPU runs the rounds and the clustering; hybrid runs on the cores, decimate on one.
+        opts.backend = match method {
+            crate::Method::Hybrid => Backend::CpuParallel,
+            crate::Method::Decimate => Backend::Cpu,
+            _ => Backend::Gpu,
         };
-        let s = scene::simplify(
-            &ctx.device,
-            crate::simplify::OnDevice {
-                rounds: Some(sim),
-                cluster: Some(crate::cluster::gpu::shared()?),
-                upload: None,
-                share_queue: false,
-            },
-            model,
-            &opts,
-            &mut |_| {},
-            &|_| {},
-        )?;
-        let faces = s.report.output_faces;
-        (s.scene, faces)
+        let on = crate::simplify::OnDevice {
+            rounds: Some(sim),
+            cluster: Some(crate::cluster::gpu::shared()?),
+            upload: None,
+            share_queue: false,
+        };
+        let s = scene::simplify(&ctx.device, on, model, &opts, &mut |_| {}, &|_| {})?;
+        Some((s.scene, s.report.output_faces))
     } else {
-        (model.original(&ctx.device)?, model.faces())
+        None
+    };
+    let original = match (&simplified, side_by_side) {
+        (Some(_), false) => None,
+        _ => Some(model.original(&ctx.device)?),
+    };
+    let (scene, faces) = match &simplified {
+        Some((s, faces)) => (s, *faces),
+        None => (original.as_ref().expect("made above"), model.faces()),
     };
     style.error_scale = scene.max_error;
     let mut renderer = Renderer::new(&ctx.device, &ctx.queue);
@@ -102,35 +136,53 @@ pub fn screenshot_with(
         .texture
         .as_ref()
         .filter(|_| style.mode == Mode::Texture)
-        && (t.size.0 > max || t.size.1 > max)
     {
-        return Err(Error::InvalidOption(format!(
-            "the texture is {}x{}, larger than this device's {max} pixels a side",
-            t.size.0, t.size.1
-        )));
-    }
-    if let Some(t) = model
-        .texture
-        .as_ref()
-        .filter(|_| style.mode == Mode::Texture)
-    {
+        if t.size.0 > max || t.size.1 > max {
+            return Err(Error::InvalidOption(format!(
+                "the texture is {}x{}, larger than this device's {max} pixels a side",
+                t.size.0, t.size.1
+            )));
+        }
         renderer.set_texture(&ctx.device, &ctx.queue, Some((&t.rgba, t.size)));
     }
-    // The window's first view of the model.
+    // The window's first view of the model, for each pane's shape.
+    let pane = if side_by_side {
+        ((size.0 / 2).max(1), size.1)
+    } else {
+        size
+    };
     let mut eye = camera::Eye::default();
-    let aspect = size.0 as f32 / size.1 as f32;
-    eye.home(model.up_axis, model.stood, model.extent(), aspect);
+    eye.home(
+        model.up_axis,
+        model.stood,
+        model.extent(),
+        pane.0 as f32 / pane.1 as f32,
+    );
     let cam = eye.camera;
-    let items = [(&scene, cam.model)];
-    let rgba = render::render_rgba(
-        &ctx.device,
-        &ctx.queue,
-        &mut renderer,
-        &items,
-        &cam,
-        &style,
-        size,
-    )?;
+    let mut draw = |mesh: &render::SceneMesh, size| {
+        let items = [(mesh, cam.model)];
+        render::render_rgba(
+            &ctx.device,
+            &ctx.queue,
+            &mut renderer,
+            &items,
+            &cam,
+            &style,
+            size,
+        )
+    };
+    let (rgba, size) = if side_by_side {
+        let left = draw(original.as_ref().expect("made above"), pane)?;
+        // The right pane's width takes the odd pixel.
+        let right_pane = (size.0 - pane.0, size.1);
+        let right = draw(scene, right_pane)?;
+        views::side_by_side(
+            vec![(left, pane), (right, right_pane)],
+            &views::pane_labels(simplified.is_some()),
+        )?
+    } else {
+        (draw(scene, size)?, size)
+    };
     scope.check("rendering the frame")?;
     Ok(Frame {
         adapter: ctx.adapter_name.clone(),

@@ -141,28 +141,16 @@ impl View3d {
         Ok((v.target.read_rgba(&gpu.device, &gpu.queue)?, v.target.size))
     }
 
-    /// What the 3D view shows as one image (RGBA8 rows) and its size: the panes side by side.
-    pub fn rgba(&self, gpu: &Device) -> Result<(Vec<u8>, (u32, u32))> {
+    /// What the 3D view shows as one image (RGBA8 rows) and its size: side by side, both panes
+    /// with their labels.
+    pub fn rgba(&self, gpu: &Device, scene: &Scene) -> Result<(Vec<u8>, (u32, u32))> {
         let panes = (0..self.panes.len().max(1))
             .map(|k| self.pane_rgba(gpu, k))
             .collect::<Result<Vec<_>>>()?;
         if panes.len() == 1 {
             return Ok(panes.into_iter().next().expect("one pane"));
         }
-        let w: u32 = panes.iter().map(|p| p.1.0).sum();
-        let h = panes.iter().map(|p| p.1.1).max().unwrap_or(1);
-        // Opaque black where a pane is a pixel shorter than the other (rounding of the split).
-        let mut out = [0, 0, 0, 255].repeat((w * h) as usize);
-        let mut x0 = 0;
-        for (px, (pw, ph)) in &panes {
-            let row = 4 * *pw as usize;
-            for y in 0..*ph as usize {
-                let at = 4 * (y * w as usize + x0);
-                out[at..at + row].copy_from_slice(&px[y * row..(y + 1) * row]);
-            }
-            x0 += *pw as usize;
-        }
-        Ok((out, (w, h)))
+        side_by_side(panes, &pane_labels(scene.simplified.is_some()))
     }
 
     /// How many instances of the LOD scene draw each level (with `camera`).
@@ -348,17 +336,10 @@ impl View3d {
         };
         let top_left = egui::Align2::LEFT_TOP;
         if split {
-            label(
-                panes[0].left_top() + egui::vec2(8.0, 6.0),
-                top_left,
-                "original",
-            );
-            let right = if scene.simplified.is_some() {
-                "simplified"
-            } else {
-                "original (not simplified yet)"
-            };
-            label(panes[1].left_top() + egui::vec2(8.0, 6.0), top_left, right);
+            let names = pane_labels(scene.simplified.is_some());
+            for (pane, name) in panes.iter().zip(names) {
+                label(pane.left_top() + egui::vec2(8.0, 6.0), top_left, name);
+            }
         }
         if lod {
             let text = format!(
@@ -428,6 +409,54 @@ impl View3d {
         }
         Ok(())
     }
+}
+
+/// The side-by-side panes' labels, as the window draws them over each.
+pub fn pane_labels(simplified: bool) -> [&'static str; 2] {
+    let right = if simplified {
+        "simplified"
+    } else {
+        "original (not simplified yet)"
+    };
+    ["original", right]
+}
+
+/// Panes (RGBA8 rows and size each) side by side as one image, each with its label in its top
+/// left corner as the window shows it: what a screenshot of two panes saves.
+pub fn side_by_side(
+    panes: Vec<(Vec<u8>, (u32, u32))>,
+    labels: &[&str],
+) -> Result<(Vec<u8>, (u32, u32))> {
+    let w: u32 = panes.iter().map(|p| p.1.0).sum();
+    let h = panes.iter().map(|p| p.1.1).max().unwrap_or(1);
+    // Opaque black where a pane is a pixel shorter than the other (rounding of the split).
+    let mut out = [0, 0, 0, 255].repeat((w * h) as usize);
+    let mut svg = format!(r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}">"#);
+    let mut x0 = 0;
+    for ((px, (pw, ph)), text) in panes.iter().zip(labels) {
+        let row = 4 * *pw as usize;
+        for y in 0..*ph as usize {
+            let at = 4 * (y * w as usize + x0);
+            out[at..at + row].copy_from_slice(&px[y * row..(y + 1) * row]);
+        }
+        // The window's overlay: light 13-point text, outlined dark so it reads on any mesh.
+        svg += &format!(
+            r##"<text x="{}" y="19" font-family="DejaVu Sans, sans-serif" font-size="13" fill="#dcdcdc" stroke="#000000" stroke-opacity="0.7" stroke-width="3" paint-order="stroke">{}</text>"##,
+            x0 + 8,
+            text.replace('&', "&amp;").replace('<', "&lt;")
+        );
+        x0 += *pw as usize;
+    }
+    svg += "</svg>";
+    let labels = crate::raster::svg_pixmap(&svg, None).map_err(Error::Internal)?;
+    // Source over: the pixmap is premultiplied, the panes opaque.
+    for (d, s) in out.chunks_exact_mut(4).zip(labels.data().chunks_exact(4)) {
+        let keep = 255 - s[3] as u32;
+        for i in 0..3 {
+            d[i] = (s[i] as u32 + d[i] as u32 * keep / 255) as u8;
+        }
+    }
+    Ok((out, (w, h)))
 }
 
 /// A colour legend: the shader's ramp, its top (red) and bottom (blue) labelled.
