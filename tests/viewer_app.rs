@@ -729,3 +729,57 @@ fn the_window_starts_on_the_cores_over_a_software_adapter() {
         assert_eq!(s.panel.backend, Backend::Gpu, "{}", s.panel.backend_why);
     }
 }
+
+/// A click on the ratio slider's track sets the ratio there (a logarithmic scale: near its
+/// right end is near 1), and the face target follows it.
+#[test]
+fn a_click_on_the_ratio_track_sets_the_ratio() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let model = Model::from_mesh("torus".into(), meshslim::mesh::torus(1.0, 0.35, 48, 24)).unwrap();
+    let faces = model.faces();
+    let mut h = harness(model);
+    h.step();
+    assert_eq!(h.state().panel.ratio, 0.1);
+    // The slider's track, not its value field beside it (both are labelled "ratio").
+    let track = h
+        .get_all_by_label("ratio")
+        .map(|n| n.rect())
+        .max_by(|a, b| a.width().total_cmp(&b.width()))
+        .expect("the ratio slider");
+    assert!(track.width() > 150.0, "a narrow slider: {track:?}");
+    let at = egui::pos2(track.left() + 0.9 * track.width(), track.center().y);
+    click_at(&mut h, at, egui::Modifiers::NONE);
+    let ratio = h.state().panel.ratio;
+    assert!(ratio > 0.3, "the click set {ratio}");
+    h.state_mut().simplify();
+    finish_job(&mut h);
+    let out = h
+        .state()
+        .scene
+        .simplified
+        .as_ref()
+        .unwrap()
+        .report
+        .target_faces;
+    assert_eq!(
+        out,
+        (faces as f64 * ratio).round() as usize,
+        "{}",
+        h.state().status
+    );
+    // Enter in the faces field simplifies at once (it took a second Enter once).
+    h.state_mut().set_target_faces(200);
+    h.step();
+    h.get_all_by_value("200")
+        .next()
+        .expect("the faces field")
+        .focus();
+    h.step();
+    h.key_press(egui::Key::Enter);
+    h.step();
+    finish_job(&mut h);
+    let s = h.state().scene.simplified.as_ref().unwrap();
+    assert_eq!(s.report.target_faces, 200, "{}", h.state().status);
+}
