@@ -140,6 +140,23 @@ fn simplifies_on_the_window_device_and_keeps_drawing() {
     assert_eq!(index_count as usize, 3 * s.report.output_faces);
     let after = h.render().expect("render");
     assert!(drawn_share(&after) > 0.05, "the result is drawn");
+    // The stage times are folded under one header, so Save and Screenshot stay in sight.
+    let simplified = h.state().scene.simplified.as_ref().unwrap();
+    let stages = simplified
+        .report
+        .rounds
+        .as_ref()
+        .unwrap()
+        .stage_seconds
+        .0
+        .clone();
+    assert!(stages.len() > 10);
+    h.step();
+    assert!(h.query_by_label_contains("time per stage").is_some());
+    assert!(
+        h.query_by_label(&stages[0].0).is_none(),
+        "the stage rows unfolded"
+    );
 
     // Side by side: the original and the result, two panes of half the width.
     let (_, full) = h.state().pane_rgba(0).unwrap();
@@ -317,6 +334,8 @@ fn a_dropped_file_opens_and_the_result_saves_and_screenshots() {
         .unwrap_or_else(|| panic!("{}", h.state().status))
         .faces();
     assert_eq!(faces, 5120);
+    // Save writes into the working directory by default: the input's is often read-only.
+    assert_eq!(h.state().panel.save_path, "ball-simplified.ply");
     // An axis chosen for one file is that file's: the next opens with its own.
     h.state_mut().set_up(Some(meshslim::viewer::camera::Up::X));
     assert_eq!(h.state().eye.up, Some(meshslim::viewer::camera::Up::X));
@@ -782,4 +801,21 @@ fn a_click_on_the_ratio_track_sets_the_ratio() {
     finish_job(&mut h);
     let s = h.state().scene.simplified.as_ref().unwrap();
     assert_eq!(s.report.target_faces, 200, "{}", h.state().status);
+}
+
+/// An idle window says so, instead of a frame time of several seconds (0 FPS): it draws on
+/// input then, and the gap between frames is the user's, not the renderer's.
+#[test]
+fn an_idle_window_says_it_draws_on_input() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(900.0, 600.0))
+        .wgpu_setup(meshslim::viewer::app::wgpu_setup())
+        .build_eframe(|cc| ViewerApp::new(cc, Start::Nothing).expect("the viewer starts"));
+    h.step();
+    h.step();
+    assert!(h.query_by_label("frames: drawn on input (idle)").is_some());
+    assert!(h.query_by_label_contains("FPS").is_none());
 }

@@ -295,7 +295,8 @@ impl Panel {
         ui.separator();
         self.front_ui(ui, seen, &mut act);
         ui.separator();
-        stats_ui(ui, view, seen);
+        let animating = seen.jobs.busy() || view.lod_shown(scene) || eye.fly;
+        stats_ui(ui, view, seen, animating);
         ui.separator();
         ui.horizontal(|ui| {
             let l = ui.label("mesh");
@@ -568,13 +569,13 @@ const METHODS: [(Method, &str); 5] = [
 ];
 
 /// The device, the frame time, the counts before and after, and the result's run.
-fn stats_ui(ui: &mut egui::Ui, view: &View3d, seen: &Seen) {
+fn stats_ui(ui: &mut egui::Ui, view: &View3d, seen: &Seen, animating: bool) {
     ui.label(format!("device: {}", seen.gpu.adapter));
-    // The time between the last frames drawn: the window redraws on input, on its own a few
-    // times a second during a job, and continuously in the LOD scene and fly mode; idle, the
-    // gap is the user's, not the renderer's.
+    // The time between the last frames drawn, while the window draws on its own: a few times
+    // a second during a job, continuously in the LOD scene and fly mode. Otherwise it draws on
+    // input alone, and the gap between frames is the user's, not the renderer's.
     let dt = view.clock.smoothed;
-    ui.label(if dt > 0.0 && dt < 1.0 {
+    ui.label(if animating && dt > 0.0 {
         format!("frames: {:.1} ms apart ({:.0} FPS)", dt * 1e3, 1.0 / dt)
     } else {
         "frames: drawn on input (idle)".into()
