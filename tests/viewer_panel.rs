@@ -1,0 +1,143 @@
+//! The window's panel and smaller behaviours, on the real eframe app driven headless by
+//! egui_kittest (lavapipe in CI): the mode a painted mesh opens in, the backend the window
+//! starts on and why, the ratio slider, Enter in the faces field, the idle frame line. With
+//! CI=true a missing adapter fails.
+
+mod common;
+mod viewer_support;
+
+use common::*;
+use eframe::egui;
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use meshslim::simplify::Backend;
+use meshslim::viewer::{Mode, Model, Start, ViewerApp};
+use viewer_support::*;
+
+/// A painted mesh opens in the vertex-colour mode, also with the command line's style unless
+/// its --mode says otherwise; `1` shades it, `6` shows its colours again, and the two frames
+/// differ.
+#[test]
+fn a_coloured_mesh_opens_in_colour_mode() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let mut m = meshslim::mesh::torus(1.0, 0.35, 48, 24);
+    meshslim::mesh::paint(&mut m);
+    let mut h = harness(Model::from_mesh("painted torus".into(), m).unwrap());
+    h.step();
+    assert_eq!(h.state().view.style.mode, Mode::Color);
+    let coloured = h.state().pane_rgba(0).unwrap().0;
+    h.key_press(egui::Key::Num1);
+    h.step();
+    assert_eq!(h.state().view.style.mode, Mode::Shaded);
+    assert_ne!(
+        h.state().pane_rgba(0).unwrap().0,
+        coloured,
+        "colours look shaded"
+    );
+    h.key_press(egui::Key::Num6);
+    h.step();
+    assert_eq!(h.state().view.style.mode, Mode::Color);
+    // The command line's style keeps the mode the mesh picked unless --mode names one.
+    let style = h.state().view.style;
+    h.state_mut().set_style(style, None);
+    assert_eq!(h.state().view.style.mode, Mode::Color);
+    h.state_mut().set_style(style, Some(Mode::Shaded));
+    assert_eq!(h.state().view.style.mode, Mode::Shaded);
+}
+
+/// On a software adapter (lavapipe here) the window starts on cpu-parallel, as the library's
+/// `auto` would, and its panel says why; gpu stays one click away.
+#[test]
+fn the_window_starts_on_the_cores_over_a_software_adapter() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let h = harness(
+        Model::from_mesh("torus".into(), meshslim::mesh::torus(1.0, 0.35, 48, 24)).unwrap(),
+    );
+    let s = h.state();
+    assert!(s.has_gpu_backend(), "{}", s.status);
+    if s.adapter().to_lowercase().contains("llvmpipe") {
+        assert_eq!(s.panel.backend, Backend::CpuParallel);
+        assert!(
+            s.panel.backend_why.contains("software rasterizer"),
+            "{}",
+            s.panel.backend_why
+        );
+    } else {
+        assert_eq!(s.panel.backend, Backend::Gpu, "{}", s.panel.backend_why);
+    }
+}
+
+/// A click on the ratio slider's track sets the ratio there (a logarithmic scale: near its
+/// right end is near 1), and the face target follows it.
+#[test]
+fn a_click_on_the_ratio_track_sets_the_ratio() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let model = Model::from_mesh("torus".into(), meshslim::mesh::torus(1.0, 0.35, 48, 24)).unwrap();
+    let faces = model.faces();
+    let mut h = harness(model);
+    h.step();
+    assert_eq!(h.state().panel.ratio, 0.1);
+    // The slider's track, not its value field beside it (both are labelled "ratio").
+    let track = h
+        .get_all_by_label("ratio")
+        .map(|n| n.rect())
+        .max_by(|a, b| a.width().total_cmp(&b.width()))
+        .expect("the ratio slider");
+    assert!(track.width() > 150.0, "a narrow slider: {track:?}");
+    let at = egui::pos2(track.left() + 0.9 * track.width(), track.center().y);
+    click_at(&mut h, at, egui::Modifiers::NONE);
+    let ratio = h.state().panel.ratio;
+    assert!(ratio > 0.3, "the click set {ratio}");
+    h.state_mut().simplify();
+    finish_job(&mut h);
+    let out = h
+        .state()
+        .scene
+        .simplified
+        .as_ref()
+        .unwrap()
+        .report
+        .target_faces;
+    assert_eq!(
+        out,
+        (faces as f64 * ratio).round() as usize,
+        "{}",
+        h.state().status
+    );
+    // Enter in the faces field simplifies at once (it took a second Enter once).
+    h.state_mut().set_target_faces(200);
+    h.step();
+    h.get_all_by_value("200")
+        .next()
+        .expect("the faces field")
+        .focus();
+    h.step();
+    h.key_press(egui::Key::Enter);
+    h.step();
+    finish_job(&mut h);
+    let s = h.state().scene.simplified.as_ref().unwrap();
+    assert_eq!(s.report.target_faces, 200, "{}", h.state().status);
+}
+
+/// An idle window says so, instead of a frame time of several seconds (0 FPS): it draws on
+/// input then, and the gap between frames is the user's, not the renderer's.
+#[test]
+fn an_idle_window_says_it_draws_on_input() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(900.0, 600.0))
+        .wgpu_setup(meshslim::viewer::app::wgpu_setup())
+        .build_eframe(|cc| ViewerApp::new(cc, Start::Nothing).expect("the viewer starts"));
+    h.step();
+    h.step();
+    assert!(h.query_by_label("frames: drawn on input (idle)").is_some());
+    assert!(h.query_by_label_contains("FPS").is_none());
+}
