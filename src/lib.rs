@@ -39,13 +39,8 @@ pub mod cluster;
 // The GPU layer every family shares: schedules' vocabulary, pipeline cache, error capture.
 #[doc(hidden)]
 pub mod compute;
-// The CPU twin and the round driver: internals, public (and hidden from the docs) only so that
-// the integration tests can diff the GPU's buffers stage by stage.
-#[doc(hidden)]
-pub mod cpu;
 pub mod decimate;
 pub mod error;
-pub mod gpu;
 mod greedy;
 pub mod io;
 pub mod lod;
@@ -53,12 +48,12 @@ pub mod memory;
 pub mod mesh;
 pub mod metrics;
 pub mod options;
-#[doc(hidden)]
-pub mod parallel;
 mod quadric;
 #[cfg(any(feature = "bench", feature = "viewer"))]
 pub mod raster;
 pub mod remesh;
+// The QEM rounds (backends `gpu` and `cpu-parallel`): their schedule, driver and both runners.
+pub mod rounds;
 pub mod simplify;
 pub mod tiles;
 #[cfg(feature = "viewer")]

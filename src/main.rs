@@ -11,7 +11,7 @@ use meshslim::cli::{self, Cli};
 static ALLOC: meshslim::bench::alloc::CountingAlloc = meshslim::bench::alloc::CountingAlloc;
 
 fn main() -> ExitCode {
-    let _runtime_dir = meshslim::gpu::context::quiet_wayland_probe().map(|(dir, value)| {
+    let _runtime_dir = meshslim::compute::context::quiet_wayland_probe().map(|(dir, value)| {
         // SAFETY: set_var races only with other threads reading or writing the environment, and
         // none exists yet: this is the first statement of main, before clap, rayon or wgpu
         // start anything, and no dependency spawns a thread before main.

@@ -326,7 +326,7 @@ impl StopReason {
 }
 
 /// Why no collapse was left where a run stopped above its target: the result's edges, counted
-/// by the first of the rounds' checks each fails (see [`crate::cpu::blocked_edges`]).
+/// by the first of the rounds' checks each fails (see [`crate::rounds::cpu::blocked_edges`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct Blocked {
     pub edges: usize,

@@ -3,12 +3,12 @@
 
 use crate::cluster::gpu::GpuClusterer;
 use crate::error::{Error, Result};
-use crate::gpu::{GpuRounds, GpuSimplifier};
 use crate::mesh::Mesh;
 pub use crate::options::{
     Backend, Blocked, Cancel, Method, SimplifyOptions, SimplifyReport, StopReason,
 };
-use crate::parallel::Upload;
+use crate::rounds::Upload;
+use crate::rounds::gpu::{GpuRounds, GpuSimplifier};
 use std::borrow::Cow;
 
 /// Pipelines a caller made on a device of its own (a window's), for [`simplify_on`]: the `gpu`
@@ -102,7 +102,7 @@ pub fn simplify_on<'a>(
     let (out, mut report, kept) = result?;
     report.auto = auto;
     if report.output_faces > opts.target_faces && report.stop_reason != StopReason::TargetReached {
-        report.blocked = Some(crate::cpu::blocked_edges(&out, opts)?);
+        report.blocked = Some(crate::rounds::cpu::blocked_edges(&out, opts)?);
     }
     Ok((out, report, kept))
 }
@@ -143,7 +143,7 @@ fn run<'a>(
         (Method::Qem, Backend::Cpu) => {
             crate::greedy::simplify_greedy(mesh, opts, progress).map(none)
         }
-        (Method::Qem, Backend::CpuParallel) => crate::cpu::simplify_upload(
+        (Method::Qem, Backend::CpuParallel) => crate::rounds::cpu::simplify_upload(
             &Upload::pinned(mesh, &opts.pin).attributes(&opts.attributes),
             mesh,
             opts,
@@ -161,11 +161,18 @@ fn run<'a>(
                     }
                     _ => Cow::Owned(Upload::pinned(mesh, &opts.pin).attributes(&opts.attributes)),
                 };
-                let (m, r, rounds) =
-                    crate::gpu::run_rounds(sim, None, &up, mesh, opts, on.share_queue, progress)?;
+                let (m, r, rounds) = crate::rounds::gpu::run_rounds(
+                    sim,
+                    None,
+                    &up,
+                    mesh,
+                    opts,
+                    on.share_queue,
+                    progress,
+                )?;
                 Ok((m, r, Some(Kept::Rounds(Box::new((rounds, up))))))
             }
-            None => crate::gpu::simplify_gpu(mesh, opts, progress).map(none),
+            None => crate::rounds::gpu::simplify_gpu(mesh, opts, progress).map(none),
         },
         (Method::Qem, Backend::Auto) => Err(Error::Internal(
             "Backend::Auto reached a backend unresolved".into(),
@@ -176,7 +183,7 @@ fn run<'a>(
 /// What [`Backend::Auto`] picks on this machine, and why, in one line: the process's shared GPU
 /// device when its adapter is hardware, else `cpu-parallel`.
 pub fn auto_backend() -> (Backend, String) {
-    match crate::gpu::shared_context() {
+    match crate::rounds::gpu::shared_context() {
         Ok(ctx) if ctx.software => (
             Backend::CpuParallel,
             format!(
@@ -186,7 +193,7 @@ pub fn auto_backend() -> (Backend, String) {
             ),
         ),
         // The shared device: the adapter found here is the one that simplifies.
-        Ok(_) => match crate::gpu::shared() {
+        Ok(_) => match crate::rounds::gpu::shared() {
             Ok((ctx, _)) => (Backend::Gpu, format!("gpu on {}", ctx.adapter_name)),
             Err(e) => (Backend::CpuParallel, format!("cpu-parallel ({e})")),
         },

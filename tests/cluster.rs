@@ -190,7 +190,7 @@ fn max_error_bounds_the_cell() {
 /// report says gpu; without one the error is the GPU's, never a refused option.
 #[test]
 fn every_clustering_method_takes_the_gpu_backend() {
-    let adapter = meshslim::gpu::shared().is_ok();
+    let adapter = meshslim::rounds::gpu::shared().is_ok();
     for method in [Method::Cluster, Method::FloatingCell, Method::Hybrid] {
         let mut o = opts(100, method);
         o.backend = Backend::Gpu;

@@ -5,12 +5,12 @@
 mod common;
 
 use common::*;
-use meshslim::cpu::CpuRounds;
-use meshslim::gpu::types::*;
-use meshslim::gpu::{GpuRounds, GpuSimplifier};
+use meshslim::compute::types::*;
 use meshslim::options::AttributeWeights;
-use meshslim::parallel::schedule::Buf;
-use meshslim::parallel::{RoundRunner, SELECTION_PASSES, Selection, Upload};
+use meshslim::rounds::cpu::CpuRounds;
+use meshslim::rounds::gpu::{GpuRounds, GpuSimplifier};
+use meshslim::rounds::schedule::Buf;
+use meshslim::rounds::{RoundRunner, SELECTION_PASSES, Selection, Upload};
 use meshslim::{Backend, Mesh, SimplifyOptions, simplify};
 
 fn pod<T: bytemuck::Pod>(bytes: Vec<u8>) -> Vec<T> {
@@ -30,7 +30,7 @@ fn families_on_one_device_share_its_pipelines() {
     let cache = meshslim::compute::gpu::Pipelines::new(&ctx.device);
     let rounds = GpuSimplifier::on(&cache, &ctx.queue).unwrap();
     let after_rounds = cache.compiled();
-    let rounds_stages: Vec<&str> = meshslim::parallel::schedule::STAGES
+    let rounds_stages: Vec<&str> = meshslim::rounds::schedule::STAGES
         .iter()
         .flat_map(|l| l.iter().map(|s| s.entry))
         .collect();
@@ -162,10 +162,10 @@ fn each_stage_matches_its_cpu_twin() {
         );
         // cost_ceiling on the GPU's histogram must find the GPU's ceiling; live_list and
         // edge_costs then run on the CPU with it.
-        meshslim::cpu::cost_ceiling::cost_ceiling(
+        meshslim::rounds::cpu::cost_ceiling::cost_ceiling(
             &p,
             &g_hist,
-            meshslim::cpu::atomics(&mut cpu.counters),
+            meshslim::rounds::cpu::atomics(&mut cpu.counters),
         );
         assert_eq!(cpu.counters[2], gc.ceiling, "{name}: cost_ceiling");
         cpu.costs_under_ceiling(&p).unwrap();
@@ -254,7 +254,7 @@ fn each_stage_matches_its_cpu_twin() {
             "{name}: edge_state after selection"
         );
         // collapse relies on it (the CPU rounds check it on their own state every round).
-        let shared = meshslim::cpu::select::shared_face(
+        let shared = meshslim::rounds::cpu::select::shared_face(
             &cpu.offsets,
             &cpu.vertex_faces,
             &cpu.edges[..ne],
@@ -272,10 +272,10 @@ fn each_stage_matches_its_cpu_twin() {
         );
         // dispatch_args, as it last ran: after the last pass's select_win.
         let mut args = [0u32; 12];
-        meshslim::cpu::dispatch_args::dispatch_args(
+        meshslim::rounds::cpu::dispatch_args::dispatch_args(
             &p,
             &cpu.edge_offsets,
-            meshslim::cpu::atomics(&mut cpu.counters),
+            meshslim::rounds::cpu::atomics(&mut cpu.counters),
             &mut args,
         );
         assert_eq!(
@@ -487,7 +487,7 @@ fn gpu_mesh_is_drawable_from_the_simplifier_buffers() {
     let mut opts = SimplifyOptions::with_ratio(m.triangles.len(), 0.25).unwrap();
     opts.backend = Backend::Gpu;
     let mut rounds = GpuRounds::new(&sim, &up, SELECTION_PASSES).unwrap();
-    let driven = meshslim::parallel::drive(&mut rounds, &up, &opts, &mut |_| {}).unwrap();
+    let driven = meshslim::rounds::drive(&mut rounds, &up, &opts, &mut |_| {}).unwrap();
     let faces = up.face_count() - driven.removed.iter().sum::<usize>();
     // On the target or one below (an interior collapse removes two faces).
     assert!(

@@ -12,8 +12,8 @@ use meshslim::cluster::gpu::{GpuClusterMesh, GpuClusterer, Part};
 use meshslim::cluster::gpu_schedule::CBuf;
 use meshslim::cluster::grid::Grid;
 use meshslim::cluster::stages::{self, Placement};
-use meshslim::cpu::common::quadric_eval;
-use meshslim::gpu::types::{ClusterPlaced, Quadric, SORT_BLOCK};
+use meshslim::compute::common::quadric_eval;
+use meshslim::compute::types::{ClusterPlaced, Quadric, SORT_BLOCK};
 
 /// Meshes, each with the cell sizes to cluster it at and whether to lock some vertices (every
 /// 7th: singleton keys, the fourth radix pass).
@@ -221,7 +221,7 @@ fn each_cluster_stage_matches_its_cpu_twin() {
                 "{label}: bucket_faces"
             );
             let mut scanned = cpu.faces.face_keep.clone();
-            meshslim::cpu::prefix_sum::prefix_sum(nf as u32, &mut scanned, &mut Vec::new());
+            meshslim::rounds::cpu::prefix_sum::prefix_sum(nf as u32, &mut scanned, &mut Vec::new());
             assert_eq!(
                 pod::<u32>(rd(&gpu, CBuf::FaceKeep, 4 * (nf + 1))),
                 scanned,

@@ -17,7 +17,7 @@ use meshslim::cluster::gpu::{GpuClusterMesh, GpuClusterer, Part};
 use meshslim::cluster::gpu_schedule::CBuf;
 use meshslim::cluster::gpu_schedule::ROUND_SLOTS;
 use meshslim::cluster::stages;
-use meshslim::gpu::types::{ClusterPlaced, Params, Quadric};
+use meshslim::compute::types::{ClusterPlaced, Params, Quadric};
 
 /// Meshes, each with the nominal radii (unit-diagonal frame) to build at and whether to lock
 /// every 7th vertex (centres of themselves from the start).
@@ -303,7 +303,7 @@ fn each_floating_stage_matches_its_cpu_twin() {
             // Centres numbered, vertices keyed by cluster.
             let mut head: Vec<u32> = rd(&gpu, CBuf::FcHead, nv + 1);
             gpu.run_fc_part(FcPart::Clusters).unwrap();
-            meshslim::cpu::prefix_sum::prefix_sum(nv as u32, &mut head, &mut Vec::new());
+            meshslim::rounds::cpu::prefix_sum::prefix_sum(nv as u32, &mut head, &mut Vec::new());
             assert_eq!(rd::<u32>(&gpu, CBuf::FcHead, nv + 1), head, "{label}: head");
             let (mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv]);
             ft::fc_cluster_keys(&c, &centre, &head, &mut keys, &mut vals);

@@ -343,3 +343,58 @@ fn one_dispatch_and_one_owner_per_viewer_concern() {
     }
     assert!(wrong.is_empty(), "{wrong:#?}");
 }
+
+/// A family is a folder: every stage in shaders/rounds/ and shaders/core/ has its CPU twin, a
+/// function of the stage's name, in src/rounds/cpu/ (the rounds' `cpu-parallel` backend, which
+/// also runs the core stages), and every stage in shaders/cluster/ in tests/cluster_twins/ (the
+/// clustering's twins are test code); a family's runner (an `impl Runner` of the compute core)
+/// lives in its own folder.
+#[test]
+fn each_family_is_a_folder_with_a_twin_for_every_stage() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text_of = |dir: &Path| {
+        let mut files = Vec::new();
+        code_files(dir, &mut files);
+        files
+            .iter()
+            .map(|f| std::fs::read_to_string(f).unwrap())
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let mut missing = Vec::new();
+    for (shaders, twins) in [
+        ("rounds", "src/rounds/cpu"),
+        ("core", "src/rounds/cpu"),
+        ("cluster", "tests/cluster_twins"),
+    ] {
+        let twins_text = text_of(&root.join(twins));
+        for entry in std::fs::read_dir(root.join("shaders").join(shaders)).unwrap() {
+            let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+            let Some(stage) = name.strip_suffix(".wgsl") else {
+                continue;
+            };
+            if !stage.ends_with(".inc") && !twins_text.contains(&format!("fn {stage}(")) {
+                missing.push(format!(
+                    "shaders/{shaders}/{name}: no fn {stage} in {twins}/"
+                ));
+            }
+        }
+    }
+    let mut files = Vec::new();
+    sources(&root.join("src"), &mut files);
+    for file in &files {
+        let rel = file.strip_prefix(root.join("src")).unwrap();
+        let text = code(&std::fs::read_to_string(file).unwrap());
+        let runs = text.lines().any(|l| {
+            let l = l.trim_start();
+            l.starts_with("impl") && (l.contains("Runner<") || l.contains("RoundRunner for"))
+        });
+        if runs && !(rel.starts_with("rounds") || rel.starts_with("cluster")) {
+            missing.push(format!(
+                "src/{}: a runner outside its family's folder",
+                rel.display()
+            ));
+        }
+    }
+    assert!(missing.is_empty(), "{missing:#?}");
+}

@@ -115,7 +115,7 @@ fn seams_are_kept_and_attributes_follow() {
 /// seam.
 #[test]
 fn corner_attributes_of_the_upload_are_the_input_corners() {
-    use meshslim::parallel::{Upload, corner_attributes};
+    use meshslim::rounds::{Upload, corner_attributes};
     let m = seamed_torus();
     let up = Upload::new(&m);
     let attrs = corner_attributes(&up.flags, &up.vertex_attr, &up.indices, &up.face_extra);
@@ -129,7 +129,7 @@ fn corner_attributes_of_the_upload_are_the_input_corners() {
             // The same position and the same UV as the input corner: its own attribute vertex.
             assert_eq!(got, input[k], "face {f} corner {k}");
             let v = up.indices[3 * f + k] as usize;
-            seam_corners += (up.flags[v] & meshslim::gpu::types::flag::SEAM != 0) as usize;
+            seam_corners += (up.flags[v] & meshslim::compute::types::flag::SEAM != 0) as usize;
             assert_eq!(uv[got as usize], uv[input[k] as usize]);
         }
     }
@@ -143,9 +143,9 @@ fn corner_attributes_of_the_upload_are_the_input_corners() {
 /// a flat grid).
 #[test]
 fn seam_bends_cost_to_slide_away() {
-    use meshslim::cpu::CpuRounds;
-    use meshslim::cpu::common::quadric_eval;
-    use meshslim::parallel::{SELECTION_PASSES, Upload};
+    use meshslim::compute::common::quadric_eval;
+    use meshslim::rounds::cpu::CpuRounds;
+    use meshslim::rounds::{SELECTION_PASSES, Upload};
     let mut m = meshslim::mesh::grid(8);
     let mut uvs: Vec<[f32; 2]> = m.positions.iter().map(|p| [p[0], p[1]]).collect();
     // The lower-left quarter's faces take vertices of their own with shifted UVs: a seam along
@@ -251,8 +251,8 @@ fn shared_models_keep_their_invariants() {
 /// quadrics kept between them. Each stop lands on its target and keeps the invariants.
 #[test]
 fn a_resumed_run_lands_each_target_and_keeps_the_invariants() {
-    use meshslim::cpu::CpuRounds;
-    use meshslim::parallel::{Driver, RoundRunner, SELECTION_PASSES, Upload};
+    use meshslim::rounds::cpu::CpuRounds;
+    use meshslim::rounds::{Driver, RoundRunner, SELECTION_PASSES, Upload};
     let m = meshslim::mesh::noisy_sphere(5, 0.01, 3);
     let up = Upload::new(&m);
     let n = up.face_count();

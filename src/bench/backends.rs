@@ -168,7 +168,7 @@ fn with_method(faces: usize, method: crate::Method) -> SimplifyOptions {
 /// The GPU adapter's name, or why there is none.
 pub fn gpu_name() -> String {
     static NAME: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-    NAME.get_or_init(|| match crate::gpu::shared() {
+    NAME.get_or_init(|| match crate::rounds::gpu::shared() {
         Ok((c, _)) => c.adapter_name.clone(),
         Err(e) => format!("no GPU ({e})"),
     })
@@ -178,7 +178,7 @@ pub fn gpu_name() -> String {
 /// Every backend this machine can run: all of [`BACKENDS`] but the `meshopt-attr-*` ones, less the GPU ones (`gpu`,
 /// `cluster-gpu`) without an adapter.
 pub fn available_backends() -> Vec<&'static BenchBackend> {
-    let gpu = crate::gpu::shared().is_ok();
+    let gpu = crate::rounds::gpu::shared().is_ok();
     BACKENDS
         .iter()
         .filter(|b| gpu || !b.name.ends_with("gpu"))

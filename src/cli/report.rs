@@ -205,7 +205,7 @@ pub(super) fn write_summary(
 }
 
 /// The round-based backends' statistics: adapter, rounds, removals, time per stage.
-fn write_rounds(out: &mut impl Write, rr: &crate::parallel::RoundsReport) -> std::io::Result<()> {
+fn write_rounds(out: &mut impl Write, rr: &crate::rounds::RoundsReport) -> std::io::Result<()> {
     if let Some(a) = &rr.adapter {
         writeln!(out, "adapter             {a}")?;
         writeln!(

@@ -16,7 +16,7 @@ use super::{
     Built, ClusterReport, Points, Work, check_backend, clustered_report, land, output, prepare,
     tally,
 };
-use crate::cpu::common::{V3, dot, length, sub, tie_rank, xyz};
+use crate::compute::common::{V3, dot, length, sub, tie_rank, xyz};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::mesh::morton::morton3;

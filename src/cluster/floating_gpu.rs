@@ -11,10 +11,10 @@ use super::gpu::{ClusterBuild, GpuClusterMesh, Part};
 use super::gpu_schedule::{
     self as sched, CBuf, RANK_PASSES, ROUND_SLOTS, cluster_passes, float_params,
 };
+use crate::compute::common::V3;
+use crate::compute::context::checked_buffer;
 use crate::compute::gpu::ErrorScope;
-use crate::cpu::common::V3;
 use crate::error::{Error, Result};
-use crate::gpu::context::checked_buffer;
 
 /// A part of a floating-cell build recorded on its own (the tests read the buffers after each);
 /// the sort passes, cells and faces are [`Part`]s.

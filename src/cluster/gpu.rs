@@ -8,13 +8,13 @@
 use crate::cluster::gpu_schedule::{self as sched, CBuf, CCount, CGrid, CStage, CStep};
 use crate::cluster::grid::Grid;
 use crate::cluster::stages::{Placed, Placement};
+use crate::compute::common::xyz;
+use crate::compute::context::{checked_buffer, checked_buffer_init};
 use crate::compute::gpu::{ErrorScope, Groups, Kernels, Pipelines, Runner};
-use crate::cpu::common::xyz;
+use crate::compute::types::*;
 use crate::error::{Error, Result};
-use crate::gpu::GpuMesh;
-use crate::gpu::context::{checked_buffer, checked_buffer_init};
-use crate::gpu::simplifier::{DRAW_ARGS_USAGE, MESH_USAGE};
-use crate::gpu::types::*;
+use crate::rounds::gpu::GpuMesh;
+use crate::rounds::gpu::simplifier::{DRAW_ARGS_USAGE, MESH_USAGE};
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -56,12 +56,12 @@ impl GpuClusterer {
     }
 }
 
-/// The process's clustering pipelines on the shared device ([`crate::gpu::shared_context`]),
-/// made on first use.
+/// The process's clustering pipelines on the shared device
+/// ([`crate::rounds::gpu::shared_context`]), made on first use.
 pub fn shared() -> Result<&'static GpuClusterer> {
     static CLUSTERER: std::sync::OnceLock<std::result::Result<GpuClusterer, String>> =
         std::sync::OnceLock::new();
-    let ctx = crate::gpu::shared_context()?;
+    let ctx = crate::rounds::gpu::shared_context()?;
     CLUSTERER
         .get_or_init(|| GpuClusterer::on(&ctx.pipelines, &ctx.queue).map_err(|e| e.to_string()))
         .as_ref()

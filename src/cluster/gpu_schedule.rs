@@ -1,5 +1,5 @@
 //! The clustering build on the GPU, described once as the rounds are in
-//! `crate::parallel::schedule`: every stage's entry point, its bindings by WGSL variable name in
+//! `crate::rounds::schedule`: every stage's entry point, its bindings by WGSL variable name in
 //! binding order, the buffer each takes and the grid it runs over; and the parts of a build in
 //! order. The runner (`gpu.rs`) binds and dispatches from these, the CPU twins
 //! (tests/cluster_twins) are named after them, and `compute::tests` checks every description
@@ -16,11 +16,11 @@
 /// writes; the runner swaps them after each pass.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum CBuf {
-    /// [`crate::gpu::types::ClusterParams`] (uniform).
+    /// [`crate::compute::types::ClusterParams`] (uniform).
     Cluster,
     /// The rounds' `Params` (uniform) with the vertex and face counts, for the adjacency stages.
     Params,
-    /// The pass's [`crate::gpu::types::RadixParams`] (uniform, one buffer per pass).
+    /// The pass's [`crate::compute::types::RadixParams`] (uniform, one buffer per pass).
     Radix,
     /// A prefix sum's count (uniform `ScanParams`); which one is the [`CStep::PrefixSum`]'s.
     ScanCount,
@@ -52,9 +52,9 @@ pub enum CBuf {
     BucketFaces,
     ClusterFaces,
     FaceOrigin,
-    /// The clusters' vertices as a renderer's vertex buffer ([`crate::gpu::GpuMesh`]).
+    /// The clusters' vertices as a renderer's vertex buffer ([`crate::rounds::gpu::GpuMesh`]).
     MeshPositions,
-    /// [`crate::gpu::types::FloatParams`] (uniform, one buffer per round slot).
+    /// [`crate::compute::types::FloatParams`] (uniform, one buffer per round slot).
     Floating,
     FcGrade,
     FcRank,
@@ -92,7 +92,7 @@ pub enum CGrid {
 pub type CStage = crate::compute::schedule::Stage<CBuf, CGrid>;
 
 use crate::cluster::grid::{Grid, SINGLETON};
-use crate::gpu::types::{ClusterParams, FloatParams, RadixParams, SORT_BLOCK};
+use crate::compute::types::{ClusterParams, FloatParams, RadixParams, SORT_BLOCK};
 use CCount::{Faces, Vertices};
 use CGrid::{Each, SortBlocks};
 

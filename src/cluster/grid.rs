@@ -2,7 +2,7 @@
 //! integer resolution, whose steps near 20 cells an axis move the face count by ~10%, more than
 //! the ±5% band) found by counting passes (`cluster_probe`), four sizes a pass.
 
-use crate::cpu::common::{V3, xyz};
+use crate::compute::common::{V3, xyz};
 use crate::mesh::morton::morton3;
 use rayon::prelude::*;
 

@@ -76,7 +76,7 @@ const FOLD_COS: f32 = 0.5;
 /// faces in blocks so that a streamed input gets them too. The rounds after the clustering
 /// measure turning from these, not from the clusters' faces.
 fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
-    use crate::cpu::common::{cross, length, scale, sub, xyz};
+    use crate::compute::common::{cross, length, scale, sub, xyz};
     let mut at: Vec<u32> = Vec::new();
     for (k, &(origin, _)) in b.faces.iter().enumerate() {
         let o = origin as usize;
@@ -109,7 +109,7 @@ fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
 /// split in one cell can stand a face on edge; the rounds after may turn a face up to
 /// `max_normal_angle_deg` further, so a face left nearly on edge here could end up flipped.
 fn folded_clusters(b: &Built, normals: &[[f32; 3]]) -> Vec<u32> {
-    use crate::cpu::common::{cross, dot, length, sub};
+    use crate::compute::common::{cross, dot, length, sub};
     let mut bad: Vec<u32> = b
         .faces
         .par_iter()
@@ -164,17 +164,17 @@ pub(super) fn cluster_repaired(
 
 /// The rounds from `up` on `opts.backend` (cpu-parallel or gpu).
 pub(super) fn rounds(
-    up: &crate::parallel::Upload,
+    up: &crate::rounds::Upload,
     mesh: &Mesh,
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
     match opts.backend {
         crate::options::Backend::Gpu => {
-            let (ctx, sim) = crate::gpu::shared()?;
-            crate::gpu::simplify_upload(ctx, sim, up, mesh, opts, progress)
+            let (ctx, sim) = crate::rounds::gpu::shared()?;
+            crate::rounds::gpu::simplify_upload(ctx, sim, up, mesh, opts, progress)
         }
-        _ => crate::cpu::simplify_upload(up, mesh, opts, progress),
+        _ => crate::rounds::cpu::simplify_upload(up, mesh, opts, progress),
     }
 }
 
@@ -205,7 +205,7 @@ pub fn simplify_hybrid(
 pub(crate) fn hybrid_upload(
     mesh: &Mesh,
     opts: &SimplifyOptions,
-) -> Result<(crate::parallel::Upload, f64, ClusterReport, SimplifyOptions)> {
+) -> Result<(crate::rounds::Upload, f64, ClusterReport, SimplifyOptions)> {
     let backend = check_backend(opts)?;
     let opts = SimplifyOptions {
         backend,
@@ -221,7 +221,7 @@ pub(crate) fn hybrid_upload(
         || opts.target_faces == 0
     {
         (
-            crate::parallel::Upload::new(mesh).attributes(&opts.attributes),
+            crate::rounds::Upload::new(mesh).attributes(&opts.attributes),
             0.0,
         )
     } else {
@@ -236,7 +236,7 @@ pub(crate) fn hybrid_upload(
         let (clustered, quadrics) = output(mesh, work.pts, &built, opts.attributes.color > 0.0);
         let frame = (work.pts.center, work.pts.scale);
         (
-            crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics)
+            crate::rounds::Upload::with_quadrics(&clustered, frame, &quadrics)
                 .reference_normals(&normals)
                 .attributes(&opts.attributes),
             max_error(&built),

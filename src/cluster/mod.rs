@@ -28,9 +28,9 @@ pub use floating::simplify_floating;
 pub(crate) use hybrid::hybrid_upload;
 pub use hybrid::{HYBRID_EXTRA, HYBRID_FACTOR, HYBRID_MIN_SHARE, HYBRID_SKIP, simplify_hybrid};
 
-use crate::cpu::common::{V3, xyz};
+use crate::compute::common::{V3, xyz};
+use crate::compute::types::Quadric;
 use crate::error::{Error, Result};
-use crate::gpu::types::Quadric;
 use crate::mesh::Mesh;
 use crate::mesh::prepare::{denormalize, frame_of, normalize};
 use crate::options::{Backend, ClusterReport, Method, SimplifyOptions, SimplifyReport, StopReason};
@@ -295,7 +295,7 @@ impl Work<'_, '_> {
                     .par_iter_mut()
                     .zip(q)
                     .with_min_len(4096)
-                    .for_each(|(s, p)| *s = crate::cpu::common::quadric_add(s, &p)),
+                    .for_each(|(s, p)| *s = crate::compute::common::quadric_add(s, &p)),
             }
             Ok(())
         })?;
@@ -577,11 +577,11 @@ fn area(pts: &Points) -> Result<(f64, usize)> {
                 part.iter()
                     .map(|t| {
                         let p = t.map(|v| xyz(pts.positions[v as usize]));
-                        let c = crate::cpu::common::cross(
-                            crate::cpu::common::sub(p[1], p[0]),
-                            crate::cpu::common::sub(p[2], p[0]),
+                        let c = crate::compute::common::cross(
+                            crate::compute::common::sub(p[1], p[0]),
+                            crate::compute::common::sub(p[2], p[0]),
                         );
-                        0.5 * crate::cpu::common::length(c) as f64
+                        0.5 * crate::compute::common::length(c) as f64
                     })
                     .sum::<f64>()
             })
@@ -699,11 +699,11 @@ pub fn simplify_drawn(
     Ok((out, report, drawn))
 }
 
-/// A clustering's result on the device ([`crate::gpu::GpuMesh`]: one vertex per cluster, the
-/// kept faces as indices) and the same arrays on the host, in its order, for a renderer's
+/// A clustering's result on the device ([`crate::rounds::gpu::GpuMesh`]: one vertex per cluster,
+/// the kept faces as indices) and the same arrays on the host, in its order, for a renderer's
 /// per-vertex extras (normals, the error heatmap).
 pub struct Drawn {
-    pub gpu: crate::gpu::GpuMesh,
+    pub gpu: crate::rounds::gpu::GpuMesh,
     /// Per cluster, in the unit-diagonal frame (w = 1).
     pub positions: Vec<[f32; 4]>,
     pub indices: Vec<u32>,

@@ -6,11 +6,11 @@
 
 use super::grid::Grid;
 pub use super::grid::SINGLETON;
-use crate::cpu::common::{
+use crate::compute::common::{
     V3, add, cross, dot, length, quadric_add, quadric_eval, quadric_from_plane, quadric_shift,
     scale, sub, xyz,
 };
-use crate::gpu::types::Quadric;
+use crate::compute::types::Quadric;
 use rayon::prelude::*;
 
 /// The vertex→face lists (CSR): `faces_of(v) = vertex_faces[offsets[v]..offsets[v + 1]]`, each

@@ -159,7 +159,7 @@ pub fn simplify_file_in_blocks(
     // The hybrid's rounds, in memory on the clustered mesh, from the clusters' quadrics.
     progress(0.5);
     report.intermediate_faces = Some(clustered.triangles.len());
-    let up = crate::parallel::Upload::with_quadrics(&clustered, frame, &quadrics)
+    let up = crate::rounds::Upload::with_quadrics(&clustered, frame, &quadrics)
         .reference_normals(&normals)
         .attributes(&opts.attributes);
     let opts = &SimplifyOptions {
@@ -194,7 +194,7 @@ fn output(
     pts: &Points,
     b: &Built,
     colors: Option<&[[f32; 4]]>,
-) -> (Mesh, Vec<crate::gpu::types::Quadric>) {
+) -> (Mesh, Vec<crate::compute::types::Quadric>) {
     let mut id = vec![u32::MAX; b.clusters];
     let mut positions = Vec::new();
     let mut out_colors = Vec::new();

@@ -9,12 +9,12 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-/// Compute pipelines by entry point, made once per device and shared by every family on it:
-/// the rounds, the clustering and a viewer's window on one device compile the prefix sum, the
+/// Compute pipelines by entry point, made once per device and shared by every family on it: the
+/// rounds, the clustering and a viewer's window on one device compile the prefix sum, the
 /// vertex→face lists and the face planes once. Whoever owns the device makes its cache (the
-/// process's shared [`crate::gpu::GpuContext`] holds one; the viewer's window makes one for both
-/// families when it opens) and hands it to each family; there is no process-wide registry, since a `wgpu::Device` compares by an id that
-/// devices of two instances can share.
+/// process's shared [`crate::compute::context::GpuContext`] holds one; the viewer's window makes
+/// one for both families when it opens) and hands it to each family; there is no process-wide
+/// registry, since a `wgpu::Device` compares by an id that devices of two instances can share.
 pub struct Pipelines {
     device: wgpu::Device,
     made: Mutex<HashMap<&'static str, wgpu::ComputePipeline>>,

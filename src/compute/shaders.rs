@@ -149,7 +149,7 @@ const MAX_STORAGE_BUFFERS: u32 = 16;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::types::*;
+    use crate::compute::types::*;
 
     fn parse(stem: &str, src: &str) -> naga::Module {
         let module = naga::front::wgsl::parse_str(src)
@@ -227,7 +227,7 @@ mod tests {
     /// index out of step would not fail to compile, only make the backends disagree.
     #[test]
     fn wgsl_constants_match_their_rust_twins() {
-        use crate::cpu::edge_costs::CounterField as C;
+        use crate::rounds::cpu::edge_costs::CounterField as C;
         let module = parse("draw_args", &stage_source("rounds/draw_args").unwrap());
         let value = |name: &str| -> u32 {
             let (_, c) = module

@@ -5,7 +5,7 @@
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::options::{Backend, Method, SimplifyOptions, StopReason};
-use crate::parallel::{Driver, RoundRunner, SELECTION_PASSES, Upload};
+use crate::rounds::{Driver, RoundRunner, SELECTION_PASSES, Upload};
 use std::time::Instant;
 
 /// One level of a chain.
@@ -149,11 +149,11 @@ fn chain_rounds(
     let mut cpu;
     let mut gpu;
     let runner: &mut dyn RoundRunner = if opts.backend == Backend::Gpu {
-        let (_, sim) = crate::gpu::shared()?;
-        gpu = crate::gpu::GpuRounds::new(sim, up, SELECTION_PASSES)?;
+        let (_, sim) = crate::rounds::gpu::shared()?;
+        gpu = crate::rounds::gpu::GpuRounds::new(sim, up, SELECTION_PASSES)?;
         &mut gpu
     } else {
-        cpu = crate::cpu::CpuRounds::new(up, SELECTION_PASSES);
+        cpu = crate::rounds::cpu::CpuRounds::new(up, SELECTION_PASSES);
         &mut cpu
     };
     let mut d = Driver::new(up, opts);

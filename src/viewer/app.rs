@@ -59,7 +59,7 @@ pub fn wgpu_setup() -> egui_wgpu::WgpuSetup {
     let mut setup = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
     setup.instance_descriptor.backends = wgpu::Backends::PRIMARY;
     setup.power_preference = wgpu::PowerPreference::HighPerformance;
-    setup.device_descriptor = Arc::new(crate::gpu::context::device_descriptor);
+    setup.device_descriptor = Arc::new(crate::compute::context::device_descriptor);
     egui_wgpu::WgpuSetup::CreateNew(setup)
 }
 

@@ -2,8 +2,8 @@
 //! that a `gpu` result is drawn from the buffers it was written to.
 
 use crate::cluster::gpu::GpuClusterer;
-use crate::gpu::GpuSimplifier;
 use crate::options::Backend;
+use crate::rounds::gpu::GpuSimplifier;
 use eframe::egui;
 use eframe::egui_wgpu;
 use std::sync::Arc;

@@ -1,8 +1,8 @@
 //! Looking at a simplification: the renderer draws the simplifier's own GPU buffers
-//! ([`crate::gpu::GpuMesh`]) with the indirect draw arguments its rounds write, on the device the
-//! simplifier ran on. `meshslim view MESH` opens the interactive window ([`app`], eframe on
-//! wgpu, sharing eframe's device with the simplifier); `--screenshot` renders one frame offscreen
-//! to a PNG, which needs no window system (lavapipe included).
+//! ([`crate::rounds::gpu::GpuMesh`]) with the indirect draw arguments its rounds write, on the
+//! device the simplifier ran on. `meshslim view MESH` opens the interactive window ([`app`], eframe
+//! on wgpu, sharing eframe's device with the simplifier); `--screenshot` renders one frame
+//! offscreen to a PNG, which needs no window system (lavapipe included).
 
 mod actions;
 pub mod app;
@@ -97,7 +97,7 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
             })
         )));
     }
-    let (ctx, sim) = crate::gpu::shared()?;
+    let (ctx, sim) = crate::rounds::gpu::shared()?;
     // Every piece of device work below (uploads, the simplification, the texture, the draw) is
     // caught here and becomes an error, not a panic in wgpu's default handler.
     let scope = crate::compute::gpu::ErrorScope::push(&ctx.device);

@@ -5,7 +5,7 @@
 
 use super::camera::Camera;
 use crate::error::{Error, Result};
-use crate::gpu::GpuMesh;
+use crate::rounds::gpu::GpuMesh;
 use glam::Mat4;
 use wgpu::util::DeviceExt;
 
@@ -124,7 +124,7 @@ impl SceneMesh {
     ) -> Result<SceneMesh> {
         // Zeros where the extra is missing.
         let buf = |label: &str, data: &[u8], len: usize| {
-            crate::gpu::context::checked_buffer_init(
+            crate::compute::context::checked_buffer_init(
                 device,
                 label,
                 data,

@@ -14,8 +14,8 @@ use meshslim::cluster::gpu_schedule::{
 };
 use meshslim::cluster::grid::Grid;
 use meshslim::cluster::stages::{self, Csr};
-use meshslim::cpu::common::{V3, dot, sub, xyz};
-use meshslim::gpu::types::{ClusterParams, ClusterPlaced, FloatParams, Params, Quadric};
+use meshslim::compute::common::{V3, dot, sub, xyz};
+use meshslim::compute::types::{ClusterParams, ClusterPlaced, FloatParams, Params, Quadric};
 
 /// Per vertex: [`floating::grade`] over its faces in CSR order.
 pub fn fc_grades(
@@ -362,7 +362,7 @@ pub fn run(
             head: head.clone(),
         });
     }
-    meshslim::cpu::prefix_sum::prefix_sum(nv as u32, &mut head, &mut Vec::new());
+    meshslim::rounds::cpu::prefix_sum::prefix_sum(nv as u32, &mut head, &mut Vec::new());
     let (mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv]);
     fc_cluster_keys(&c, &centre, &head, &mut keys, &mut vals);
     let cluster_sort = twins::sort(&keys, &vals, cluster_passes(nv));

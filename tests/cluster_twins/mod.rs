@@ -15,9 +15,11 @@ use meshslim::cluster::gpu::ClusterBuild;
 use meshslim::cluster::gpu_schedule::{cluster_params, radix_params, radix_passes};
 use meshslim::cluster::grid::{Grid, SINGLETON};
 use meshslim::cluster::stages::{self, Csr, Placed, Placement, Surface};
-use meshslim::cpu::common::xyz;
-use meshslim::cpu::prefix_sum::prefix_sum;
-use meshslim::gpu::types::{ClusterParams, ClusterPlaced, Quadric, RadixParams, SORT_BLOCK, place};
+use meshslim::compute::common::xyz;
+use meshslim::compute::types::{
+    ClusterParams, ClusterPlaced, Quadric, RadixParams, SORT_BLOCK, place,
+};
+use meshslim::rounds::cpu::prefix_sum::prefix_sum;
 
 pub fn grid_of(c: &ClusterParams) -> Grid {
     Grid {

@@ -351,8 +351,8 @@ pub fn expect_code(o: &Output, code: i32) {
 
 /// The process's GPU device, or None (with a note) when this machine has no adapter; with
 /// CI=true a missing adapter fails the test instead.
-pub fn gpu_context() -> Option<&'static meshslim::gpu::GpuContext> {
-    match meshslim::gpu::shared() {
+pub fn gpu_context() -> Option<&'static meshslim::compute::context::GpuContext> {
+    match meshslim::rounds::gpu::shared() {
         Ok((ctx, _)) => Some(ctx),
         Err(e) if std::env::var("CI").is_ok_and(|v| v == "true") => {
             panic!("CI=true but no GPU adapter: {e}")

@@ -4,7 +4,7 @@
 //! CPU in edge order; no stage's result depends on it (each writes its own edge's slots).
 
 use super::edge_costs::{CounterField, counter};
-use crate::gpu::types::{EdgeCandidate, Params, state};
+use crate::compute::types::{EdgeCandidate, Params, state};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 

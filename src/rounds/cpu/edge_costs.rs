@@ -8,9 +8,9 @@
 //! both endpoints' neighbourhoods and rarely fail on a manifold, so they run in `validate`,
 //! only for the edges that win a selection pass.
 
-use super::common::*;
 use super::{Scatter, face_of, faces_of, par_for};
-use crate::gpu::types::{Counters, EdgeCandidate, Params, state};
+use crate::compute::common::*;
+use crate::compute::types::{Counters, EdgeCandidate, Params, state};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// The priority of collapsing `c` (its error, as `edge_errors` wrote it, scaled by the worst

@@ -2,7 +2,7 @@
 //! written at index `n`, in three stages — per-block sums, a scan of the block sums, and each
 //! block's local scan plus its offset. Integer results equal the GPU's exactly.
 
-use crate::gpu::types::SCAN_BLOCK;
+use crate::compute::types::SCAN_BLOCK;
 use rayon::prelude::*;
 
 pub fn blocks(n: u32) -> u32 {

@@ -1,19 +1,16 @@
 //! Backend `gpu`: the rounds as WGSL compute passes run by wgpu (shaders/core/ and
-//! shaders/rounds/ hold one file per stage; src/cpu/ holds their twins).
+//! shaders/rounds/ hold one file per stage; `rounds::cpu` holds their twins), on the process's
+//! device ([`shared`]) or a caller's.
 
-pub mod context;
 pub mod simplifier;
-// The GPU structs and constants with their Rust twins: public for the stage-by-stage tests.
-#[doc(hidden)]
-pub mod types;
 
-pub use context::GpuContext;
+pub use crate::compute::context::GpuContext;
 pub use simplifier::{GpuMesh, GpuRounds, GpuSimplifier};
 
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::options::{SimplifyOptions, SimplifyReport};
-use crate::parallel::{RoundsReport, SELECTION_PASSES, Upload, simplify_rounds};
+use crate::rounds::{RoundsReport, SELECTION_PASSES, Upload, simplify_rounds};
 
 /// Simplifies on the first GPU adapter found, made ready once per process ([`shared`]).
 pub fn simplify_gpu(

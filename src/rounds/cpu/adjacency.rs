@@ -4,7 +4,7 @@
 //! everything gathered from them, are the same on every run and on CPU and GPU.
 
 use super::{Scatter, par_for};
-use crate::gpu::types::Params;
+use crate::compute::types::Params;
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// Per face: one count per corner (`counts` cleared, `vertex_count + 1` long).

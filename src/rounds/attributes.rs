@@ -1,9 +1,9 @@
 //! The appearance channels the rounds carry: which (the greedy reference's [`Layout`]), each
 //! attribute vertex's values weighted for the round's f32 buffers, and the solved values written
 //! back into the output. The math is the stages' (shaders/rounds/attributes.inc.wgsl and its
-//! twin src/cpu/attributes.rs).
+//! twin src/rounds/cpu/attributes.rs).
 
-use crate::gpu::types::attr_layout;
+use crate::compute::types::attr_layout;
 use crate::mesh::Mesh;
 use crate::options::AttributeWeights;
 use crate::quadric::attributes::Layout;

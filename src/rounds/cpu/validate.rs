@@ -7,7 +7,7 @@
 use super::edge_costs::{CounterField, counter};
 use super::vertex_flags::count_containing;
 use super::{Scatter, face_of, faces_of, par_for};
-use crate::gpu::types::{EdgeCandidate, Params, flag, state};
+use crate::compute::types::{EdgeCandidate, Params, flag, state};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// Faces on the collapse's edge (1 or 2), or `None` when the collapse would break the topology.

@@ -4,7 +4,7 @@
 //! the order stays close to the greedy one.
 
 use super::edge_costs::{CounterField, counter};
-use crate::gpu::types::{HIST_BINS, HIST_SHIFT, INVALID_COST, Params};
+use crate::compute::types::{HIST_BINS, HIST_SHIFT, INVALID_COST, Params};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 pub fn cost_ceiling(params: &Params, histogram: &[u32], counters: &[AtomicU32]) {

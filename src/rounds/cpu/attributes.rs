@@ -5,8 +5,8 @@
 //! and its sums (stride `4m + 1`: `G` per channel, then `D` per channel, then `W`), relative to
 //! its vertex's position like the quadrics.
 
-use super::common::{V3, dot};
-use crate::gpu::types::{Params, Quadric, attr_layout};
+use crate::compute::common::{V3, dot};
+use crate::compute::types::{Params, Quadric, attr_layout};
 
 /// The channels of the round (`Params::attributes`).
 #[derive(Clone, Copy)]

@@ -7,7 +7,7 @@
 
 use super::edge_costs::{CounterField, counter};
 use super::{par_for, par_for_mut};
-use crate::gpu::types::{EdgeCandidate, HIST_BINS, HIST_SHIFT, Params, state};
+use crate::compute::types::{EdgeCandidate, HIST_BINS, HIST_SHIFT, Params, state};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// Per edge: winners add the faces they remove to their cost bin (`histogram` cleared).

@@ -4,7 +4,7 @@
 //! border bit to the survivor, so these flags stay true without being recomputed each round.
 
 use super::{face_of, faces_of, par_for_mut};
-use crate::gpu::types::{Params, flag};
+use crate::compute::types::{Params, flag};
 
 /// Faces of `list` containing `u`.
 pub fn count_containing(indices: &[u32], list: &[u32], u: u32) -> u32 {

@@ -1,14 +1,23 @@
-//! The round driver shared by the `gpu` and `cpu-parallel` backends: what is uploaded, how many
-//! collapses each round aims for, when it trims to land on the target, why it stops, and how
-//! the result becomes a [`Mesh`] again. The backends only run the stages ([`RoundRunner`]).
+//! The QEM rounds, one family in one folder: their schedule ([`schedule`]: every stage and the
+//! order they run in), the appearance they carry ([`attributes`]), and the backends that run the
+//! stages — [`gpu`] (the WGSL passes, shaders/rounds/) and [`cpu`] (`cpu-parallel`: each
+//! stage's CPU twin, the same bytes). This file is the round driver both share: what is
+//! uploaded, how many collapses each round aims for, when it trims to land on the target, why
+//! it stops, and how the result becomes a [`Mesh`] again. The backends only run the stages
+//! ([`RoundRunner`]).
 
 pub mod attributes;
+// The CPU twins: internals, public (and hidden from the docs) only so that the integration
+// tests can diff the GPU's buffers stage by stage.
+#[doc(hidden)]
+pub mod cpu;
+pub mod gpu;
 pub mod schedule;
 
 pub use attributes::RoundAttributes;
 
+use crate::compute::types::{Counters, FaceExtra, Params, flag};
 use crate::error::Result;
-use crate::gpu::types::{Counters, FaceExtra, Params, flag};
 use crate::mesh::Mesh;
 use crate::mesh::prepare::Surface;
 pub use crate::options::{RoundsReport, StageTimes};
@@ -76,7 +85,7 @@ pub struct Upload {
     pub seams: usize,
     /// Per class: the quadric carried in (the hybrid method's clusters), relative to the
     /// vertex; `None` computes them in the first round.
-    pub quadrics: Option<Vec<crate::gpu::types::Quadric>>,
+    pub quadrics: Option<Vec<crate::compute::types::Quadric>>,
     /// Per face: the first round's plane (unit normal, area), carried in with the quadrics: the
     /// face's own, or with [`Upload::reference_normals`] the normal of the input face it came
     /// from, which the flip test measures turning from.
@@ -187,7 +196,7 @@ impl Upload {
     pub fn with_quadrics(
         input: &Mesh,
         frame: ([f64; 3], f64),
-        quadrics: &[crate::gpu::types::Quadric],
+        quadrics: &[crate::compute::types::Quadric],
     ) -> Upload {
         let surface = Surface::in_frame(input, Some(frame));
         let carried = quadrics
@@ -201,7 +210,7 @@ impl Upload {
     /// `carried`: (class, quadric) pairs to sum per class; `pin`: input vertices to pin.
     fn from_surface(
         surface: Surface,
-        carried: Option<Vec<(u32, &crate::gpu::types::Quadric)>>,
+        carried: Option<Vec<(u32, &crate::compute::types::Quadric)>>,
         pin: &[u32],
     ) -> Upload {
         let s = &surface;
@@ -250,11 +259,11 @@ impl Upload {
             }
         }
         let quadrics = carried.map(|pairs| {
-            let mut q = vec![crate::gpu::types::Quadric::default(); n as usize];
+            let mut q = vec![crate::compute::types::Quadric::default(); n as usize];
             for (c, x) in pairs {
                 let d = dense[c as usize];
                 if d != u32::MAX {
-                    q[d as usize] = crate::cpu::common::quadric_add(&q[d as usize], x);
+                    q[d as usize] = crate::compute::common::quadric_add(&q[d as usize], x);
                 }
             }
             q
@@ -265,7 +274,7 @@ impl Upload {
                 ..Default::default()
             };
             let mut planes = vec![[0.0f32; 4]; s.faces.len()];
-            crate::cpu::face_planes::face_planes(&p, &positions, &indices, &mut planes);
+            crate::rounds::cpu::face_planes::face_planes(&p, &positions, &indices, &mut planes);
             planes
         });
         let Surface {
@@ -547,7 +556,7 @@ pub fn simplify_rounds(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::types::INVALID_COST;
+    use crate::compute::types::INVALID_COST;
     use crate::mesh::grid;
 
     /// A runner whose ordinary rounds find nothing (every candidate under the ceiling fails)

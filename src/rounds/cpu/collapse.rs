@@ -9,9 +9,9 @@
 //! one vertex), so these writes never meet.
 
 use super::attributes::Channels;
-use super::common::{V3, dot, quadric_add, quadric_shift, sub, xyz};
 use super::{Scatter, corner_on, face_of, faces_of, par_for};
-use crate::gpu::types::{EdgeCandidate, FaceExtra, NO_ATTR, Params, Quadric, flag, state};
+use crate::compute::common::{V3, dot, quadric_add, quadric_shift, sub, xyz};
+use crate::compute::types::{EdgeCandidate, FaceExtra, NO_ATTR, Params, Quadric, flag, state};
 
 /// The attribute vertex a corner of the removed vertex takes under map `m` (see [`NO_ATTR`]).
 fn mapped(m: [u32; 4], a: u32) -> u32 {

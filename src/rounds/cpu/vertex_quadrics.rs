@@ -5,9 +5,11 @@
 //! to their mean normal, as the greedy reference does. A gather in the sorted face order, so the
 //! sums do not depend on thread timing. Quadrics are relative to the vertex.
 
-use super::common::{cross, dot, length, quadric_add, quadric_from_plane, scale, sub, xyz};
 use super::{corner_attr, face_of, faces_of, par_for_mut};
-use crate::gpu::types::{FaceExtra, Params, Quadric};
+use crate::compute::common::{
+    cross, dot, length, quadric_add, quadric_from_plane, scale, sub, xyz,
+};
+use crate::compute::types::{FaceExtra, Params, Quadric};
 
 /// The constraint plane through edge `e` (from the vertex) perpendicular to `surface`, weighted
 /// by the border weight and the squared edge length; zero when degenerate.

@@ -1,12 +1,12 @@
-//! The round, described once: every stage's entry point, its bindings by their WGSL variable
-//! names in binding order (uniform params first, then read-only, then read_write buffers), the
-//! buffer each binding takes and the grid it runs over; and the order the stages run in
-//! ([`ROUND`]). The GPU runner ([`crate::gpu::GpuRounds`]) binds and dispatches from these
-//! descriptions and the CPU twin ([`crate::cpu::CpuRounds`]) steps through the same list, so the
-//! two cannot drift apart; a test reads every shader with naga and checks each description's
-//! bindings (names, order, access) against the WGSL, so two swapped buffers fail `cargo test`.
+//! The round, described once: every stage's entry point, its bindings by their WGSL variable names
+//! in binding order (uniform params first, then read-only, then read_write buffers), the buffer
+//! each binding takes and the grid it runs over; and the order the stages run in ([`ROUND`]). The
+//! GPU runner ([`crate::rounds::gpu::GpuRounds`]) binds and dispatches from these descriptions and
+//! the CPU twin ([`crate::rounds::cpu::CpuRounds`]) steps through the same list, so the two cannot
+//! drift apart; a test reads every shader with naga and checks each description's bindings (names,
+//! order, access) against the WGSL, so two swapped buffers fail `cargo test`.
 
-use crate::gpu::types::Params;
+use crate::compute::types::Params;
 
 /// A buffer of the rounds. Per-vertex and per-face buffers come in two halves that swap each
 /// round: the plain names are the half the round reads, the `*Out` ones the half compaction
@@ -57,7 +57,7 @@ pub enum Buf {
     Dispatch,
     DrawArgs,
     /// Per attribute vertex of the welded input: its weighted appearance values
-    /// ([`crate::gpu::types::attr_layout`]); never compacted, the faces' corners index it.
+    /// ([`crate::compute::types::attr_layout`]); never compacted, the faces' corners index it.
     AttrValues,
     /// Per attribute vertex: its attribute sums `G`, `D`, `W` relative to its vertex.
     AttrSums,
@@ -114,7 +114,7 @@ impl Grid {
 }
 
 /// A stage of the rounds: a WGSL entry point in `shaders/<shader>.wgsl`, the twin of the CPU
-/// function of the same name in `src/cpu/`.
+/// function of the same name in `src/rounds/cpu/`.
 pub type Stage = crate::compute::schedule::Stage<Buf, Grid>;
 pub use crate::compute::schedule::{Access, Binding};
 
@@ -277,7 +277,7 @@ pub enum When {
     /// The first round, when the rounds carry appearance channels (`Params::attributes`):
     /// after the quadrics, computed or carried in, since it adds to them.
     FirstRoundAttributes,
-    /// Repeated as the round's [`crate::parallel::Selection`] says.
+    /// Repeated as the round's [`crate::rounds::Selection`] says.
     EachSelectionPass,
     /// When the round trims its winners to land on the target (`Params::trim`).
     Trimming,

@@ -3,7 +3,7 @@
 //! stage.
 
 use super::edge_costs::{CounterField, counter};
-use crate::gpu::types::{Params, WG};
+use crate::compute::types::{Params, WG};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 fn grid(n: u32) -> [u32; 4] {

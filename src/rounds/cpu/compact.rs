@@ -5,7 +5,7 @@
 
 use super::edge_costs::{CounterField, counter};
 use super::{Scatter, par_for};
-use crate::gpu::types::{DrawArgs, FaceExtra, Params, Quadric};
+use crate::compute::types::{DrawArgs, FaceExtra, Params, Quadric};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// Per max(vertex, face): 1 for a surviving vertex, 1 for a face whose remapped corners are

@@ -1,8 +1,8 @@
 //! Twin of shaders/core/face_planes.wgsl: each face's unit normal and area (first round only). The
 //! normal stays with the face as its reference for the flip test; the area weights its quadric.
 
-use super::common::{cross, length, scale, sub, xyz};
-use crate::gpu::types::Params;
+use crate::compute::common::{cross, length, scale, sub, xyz};
+use crate::compute::types::Params;
 use rayon::prelude::*;
 
 pub fn face_planes(

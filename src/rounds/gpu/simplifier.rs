@@ -2,12 +2,12 @@
 //! per mesh ([`GpuMesh`] plus the working buffers), and one command buffer per round whose only
 //! read-back is the 64-byte counters block (and the stage timestamps when the device has them).
 
-use super::context::{checked_buffer, checked_buffer_init};
-use super::types::*;
+use crate::compute::context::{checked_buffer, checked_buffer_init};
 use crate::compute::gpu::{ErrorScope, Groups, Kernels, Pipelines, Runner};
+use crate::compute::types::*;
 use crate::error::{Error, Result};
-use crate::parallel::schedule::{self, Buf, Count, RoundStep, Stage, Step, When};
-use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
+use crate::rounds::schedule::{self, Buf, Count, RoundStep, Stage, Step, When};
+use crate::rounds::{Download, RoundRunner, Selection, StageTimes, Upload};
 use std::time::Instant;
 
 const SU: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
@@ -388,7 +388,7 @@ impl<'a> GpuRounds<'a> {
 
     /// A copy of the mesh as it stands, made on the GPU (nothing goes through the host), while
     /// the rounds go on: a level of detail. `vertices` and `faces` are the counts after the last
-    /// round ([`crate::parallel::Driver`] knows them).
+    /// round ([`crate::rounds::Driver`] knows them).
     pub fn snapshot(&self, up: &Upload, vertices: usize, faces: usize) -> Result<GpuMesh> {
         let dev = &self.sim.device;
         let scope = ErrorScope::push(dev);

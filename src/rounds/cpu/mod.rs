@@ -10,7 +10,6 @@
 pub mod adjacency;
 pub mod attributes;
 pub mod collapse;
-pub mod common;
 pub mod compact;
 pub mod cost_ceiling;
 pub mod dispatch_args;
@@ -29,11 +28,11 @@ pub mod vertex_flags;
 pub mod vertex_quadrics;
 
 use crate::compute::schedule::Step as S;
+use crate::compute::types::*;
 use crate::error::{Error, Result};
-use crate::gpu::types::*;
 use crate::options::{Blocked, SimplifyOptions};
-use crate::parallel::schedule::{self, Buf, RoundStep, Stage, Step, When};
-use crate::parallel::{Download, RoundRunner, Selection, StageTimes, Upload};
+use crate::rounds::schedule::{self, Buf, RoundStep, Stage, Step, When};
+use crate::rounds::{Download, RoundRunner, Selection, StageTimes, Upload};
 use edge_costs::CounterField;
 use rayon::prelude::*;
 use std::marker::PhantomData;
@@ -48,8 +47,8 @@ pub fn simplify_upload(
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(crate::mesh::Mesh, crate::options::SimplifyReport)> {
-    let mut runner = CpuRounds::new(up, crate::parallel::SELECTION_PASSES);
-    crate::parallel::simplify_rounds(&mut runner, up, mesh, opts, progress, Default::default())
+    let mut runner = CpuRounds::new(up, crate::rounds::SELECTION_PASSES);
+    crate::rounds::simplify_rounds(&mut runner, up, mesh, opts, progress, Default::default())
 }
 
 /// Runs `body(id)` for every invocation id in `0..n`, in parallel.
@@ -78,8 +77,8 @@ pub fn face_of(indices: &[u32], f: u32) -> [u32; 3] {
     [indices[i], indices[i + 1], indices[i + 2]]
 }
 
-/// Which corner of face `f` is on vertex `v` (the last when none), as shaders/rounds/seams.inc.wgsl's
-/// `corner_attr` picks it.
+/// Which corner of face `f` is on vertex `v` (the last when none), as
+/// shaders/rounds/seams.inc.wgsl's `corner_attr` picks it.
 #[inline]
 pub fn corner_on(indices: &[u32], f: u32, v: u32) -> usize {
     face_of(indices, f)
@@ -88,8 +87,8 @@ pub fn corner_on(indices: &[u32], f: u32, v: u32) -> usize {
         .unwrap_or(2)
 }
 
-/// Twin of shaders/rounds/seams.inc.wgsl's `corner_attr`: the attribute vertex face `f` uses at its corner
-/// on vertex `v`.
+/// Twin of shaders/rounds/seams.inc.wgsl's `corner_attr`: the attribute vertex face `f` uses at its
+/// corner on vertex `v`.
 #[inline]
 pub fn corner_attr(indices: &[u32], face_extra: &[FaceExtra], f: u32, v: u32) -> u32 {
     face_extra[f as usize].attr[corner_on(indices, f, v)]
@@ -470,7 +469,7 @@ impl RoundRunner for CpuRounds {
 pub fn blocked_edges(mesh: &crate::mesh::Mesh, opts: &SimplifyOptions) -> Result<Blocked> {
     let up = Upload::new(mesh);
     let nf = up.face_count() as u32;
-    let mut runner = CpuRounds::new(&up, crate::parallel::SELECTION_PASSES);
+    let mut runner = CpuRounds::new(&up, crate::rounds::SELECTION_PASSES);
     let needed = nf.saturating_sub(opts.target_faces as u32).max(1);
     let params = Params {
         edge_capacity: 3 * nf,

@@ -2,7 +2,7 @@
 //! operations in the same order, so CPU and GPU floats agree to rounding (the GPU may fuse
 //! multiply-adds).
 
-use crate::gpu::types::Quadric;
+use crate::compute::types::Quadric;
 
 pub type V3 = [f32; 3];
 

@@ -8,10 +8,10 @@
 //! locked vertex touches a winner's face and drops out at the next pass, and the others compete
 //! again (Luby-style).
 
-use super::common::tie_rank;
 use super::edge_costs::{CounterField, counter};
 use super::{Scatter, faces_of, par_for};
-use crate::gpu::types::{EdgeCandidate, state};
+use crate::compute::common::tie_rank;
+use crate::compute::types::{EdgeCandidate, state};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// Faces around either endpoint of edge `e` (those on the edge come twice, harmlessly).

@@ -5,9 +5,9 @@
 //! Each attribute vertex belongs to one vertex, whose invocation alone writes its sums.
 
 use super::attributes::Channels;
-use super::common::{dot, sub, xyz};
 use super::{Scatter, corner_attr, face_of, faces_of, par_for_mut};
-use crate::gpu::types::{FaceExtra, Params, Quadric};
+use crate::compute::common::{dot, sub, xyz};
+use crate::compute::types::{FaceExtra, Params, Quadric};
 
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn vertex_attributes(

@@ -6,7 +6,7 @@
 //! twice cost 1.8 s of lavapipe time on the 1M scan.
 
 use super::{Scatter, face_of, faces_of, par_for};
-use crate::gpu::types::Params;
+use crate::compute::types::Params;
 
 /// Lists every neighbour `u > v` of `v` once, in face-list order, into `slots` (two per face of
 /// `list`: a face adds at most two), and returns how many. A neighbour is new when the listed

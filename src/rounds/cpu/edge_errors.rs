@@ -8,10 +8,10 @@
 //! the same faces).
 
 use super::attributes::Channels;
-use super::common::*;
 use super::edge_costs::{CounterField, counter};
 use super::{corner_attr, face_of, faces_of};
-use crate::gpu::types::{
+use crate::compute::common::*;
+use crate::compute::types::{
     EdgeCandidate, FaceExtra, HIST_BINS, HIST_SHIFT, NO_ATTR, Params, Quadric, flag, state,
 };
 use rayon::prelude::*;
