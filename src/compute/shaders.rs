@@ -223,23 +223,41 @@ mod tests {
         }
     }
 
+    /// The initializer of `const name` in `module` (parsed from a stage that includes `file`).
+    fn constant<'m>(module: &'m naga::Module, file: &str, name: &str) -> &'m naga::Expression {
+        let (_, c) = module
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no const {name} in {file}"));
+        &module.global_expressions[c.init]
+    }
+
+    /// The value of `const name`, which the twins' tests need to be a u32 literal.
+    fn u32_constant(module: &naga::Module, file: &str, name: &str) -> u32 {
+        match *constant(module, file, name) {
+            naga::Expression::Literal(naga::Literal::U32(v)) => v,
+            ref e => panic!("const {name} is not a u32 literal: {e:?}"),
+        }
+    }
+
+    /// The size in bytes of `struct name`, as naga lays it out for the GPU.
+    fn struct_size(module: &naga::Module, file: &str, name: &str) -> usize {
+        let (_, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no struct {name} in {file}"));
+        ty.inner.size(module.to_ctx()) as usize
+    }
+
     /// The constants of shaders/common.inc.wgsl against their Rust twins: a state, flag or counter
     /// index out of step would not fail to compile, only make the backends disagree.
     #[test]
     fn wgsl_constants_match_their_rust_twins() {
         use crate::rounds::cpu::edge_costs::CounterField as C;
         let module = parse("draw_args", &stage_source("rounds/draw_args").unwrap());
-        let value = |name: &str| -> u32 {
-            let (_, c) = module
-                .constants
-                .iter()
-                .find(|(_, c)| c.name.as_deref() == Some(name))
-                .unwrap_or_else(|| panic!("no const {name} in common.wgsl"));
-            match module.global_expressions[c.init] {
-                naga::Expression::Literal(naga::Literal::U32(v)) => v,
-                ref e => panic!("const {name} is not a u32 literal: {e:?}"),
-            }
-        };
+        let value = |name: &str| u32_constant(&module, "common.wgsl", name);
         let pairs = [
             ("WG", WG),
             ("SCAN_BLOCK", SCAN_BLOCK),
@@ -278,14 +296,7 @@ mod tests {
     #[test]
     fn wgsl_structs_match_their_rust_twins() {
         let module = parse("draw_args", &stage_source("rounds/draw_args").unwrap());
-        let size = |name: &str| {
-            let (_, ty) = module
-                .types
-                .iter()
-                .find(|(_, t)| t.name.as_deref() == Some(name))
-                .unwrap_or_else(|| panic!("no struct {name} in common.wgsl"));
-            ty.inner.size(module.to_ctx()) as usize
-        };
+        let size = |name: &str| struct_size(&module, "common.wgsl", name);
         use std::mem::size_of;
         assert_eq!(size("Params"), size_of::<Params>());
         assert_eq!(size("ScanParams"), size_of::<ScanParams>());
@@ -298,25 +309,13 @@ mod tests {
             "cluster_quadrics",
             &stage_source("cluster/cluster_quadrics").unwrap(),
         );
-        let size = |name: &str| {
-            let (_, ty) = module
-                .types
-                .iter()
-                .find(|(_, t)| t.name.as_deref() == Some(name))
-                .unwrap_or_else(|| panic!("no struct {name} in cluster.wgsl"));
-            ty.inner.size(module.to_ctx()) as usize
-        };
+        let size = |name: &str| struct_size(&module, "cluster.wgsl", name);
         assert_eq!(size("ClusterParams"), size_of::<ClusterParams>());
         assert_eq!(size("RadixParams"), size_of::<RadixParams>());
         assert_eq!(size("ClusterPlaced"), size_of::<ClusterPlaced>());
         let module = parse("fc_quadrics", &stage_source("cluster/fc_quadrics").unwrap());
-        let (_, ty) = module
-            .types
-            .iter()
-            .find(|(_, t)| t.name.as_deref() == Some("FloatParams"))
-            .expect("no struct FloatParams in floating.wgsl");
         assert_eq!(
-            ty.inner.size(module.to_ctx()) as usize,
+            struct_size(&module, "floating.wgsl", "FloatParams"),
             size_of::<FloatParams>()
         );
     }
@@ -326,12 +325,7 @@ mod tests {
     #[test]
     fn floating_constants_match_their_rust_twins() {
         let module = parse("fc_decide", &stage_source("cluster/fc_decide").unwrap());
-        let (_, c) = module
-            .constants
-            .iter()
-            .find(|(_, c)| c.name.as_deref() == Some("JITTER"))
-            .expect("no const JITTER in floating.wgsl");
-        match module.global_expressions[c.init] {
+        match *constant(&module, "floating.wgsl", "JITTER") {
             naga::Expression::Literal(naga::Literal::F32(v)) => {
                 assert_eq!(v.to_bits(), crate::cluster::floating::JITTER.to_bits())
             }
@@ -346,17 +340,7 @@ mod tests {
             "cluster_quadrics",
             &stage_source("cluster/cluster_quadrics").unwrap(),
         );
-        let value = |name: &str| -> u32 {
-            let (_, c) = module
-                .constants
-                .iter()
-                .find(|(_, c)| c.name.as_deref() == Some(name))
-                .unwrap_or_else(|| panic!("no const {name} in cluster.wgsl"));
-            match module.global_expressions[c.init] {
-                naga::Expression::Literal(naga::Literal::U32(v)) => v,
-                ref e => panic!("const {name} is not a u32 literal: {e:?}"),
-            }
-        };
+        let value = |name: &str| u32_constant(&module, "cluster.wgsl", name);
         let pairs = [
             ("SINGLETON", crate::cluster::grid::SINGLETON),
             ("UNCLAIMED", crate::cluster::floating::UNCLAIMED),
