@@ -62,6 +62,33 @@ impl Names {
         self.map.insert(name.to_string(), i);
         i
     }
+
+    /// Each face's id (those before the first statement get "default", numbered after every
+    /// name the file gave) and the names; `None` when the file never named one.
+    fn per_face(mut self, ids: Vec<u32>) -> Option<(Vec<u32>, Vec<String>)> {
+        if !self.used {
+            return None;
+        }
+        let d = if ids.contains(&NONE) {
+            self.id("default")
+        } else {
+            0
+        };
+        let ids = ids
+            .into_iter()
+            .map(|i| if i == NONE { d } else { i })
+            .collect();
+        Some((ids, self.list))
+    }
+}
+
+/// Per mesh vertex, the value its corner's index `k` (1: `vt`, 2: `vn`) names in `values`; zero
+/// where that index is absent.
+fn per_vertex<T: Copy + Default>(corners_of: &[[u32; 3]], k: usize, values: &[T]) -> Vec<T> {
+    corners_of
+        .iter()
+        .map(|c| values.get(c[k] as usize).copied().unwrap_or_default())
+        .collect()
 }
 
 /// Reads an OBJ file.
@@ -382,51 +409,21 @@ fn read_from(r: impl BufRead, path: &Path) -> Result<Mesh> {
         ..Default::default()
     };
     if any_vt_corner {
-        mesh.uvs = Some(
-            corners_of
-                .iter()
-                .map(|c| texcoords.get(c[1] as usize).copied().unwrap_or([0.0; 2]))
-                .collect(),
-        );
+        mesh.uvs = Some(per_vertex(&corners_of, 1, &texcoords));
     }
     if any_vn_corner {
-        mesh.normals = Some(
-            corners_of
-                .iter()
-                .map(|c| normals.get(c[2] as usize).copied().unwrap_or([0.0; 3]))
-                .collect(),
-        );
+        mesh.normals = Some(per_vertex(&corners_of, 2, &normals));
     }
     if any_color {
         mesh.colors = Some(corners_of.iter().map(|c| colors[c[0] as usize]).collect());
     }
-    if groups.used {
-        let d = if face_groups.contains(&NONE) {
-            groups.id("default")
-        } else {
-            0
-        };
-        mesh.face_groups = Some(
-            face_groups
-                .into_iter()
-                .map(|g| if g == NONE { d } else { g })
-                .collect(),
-        );
-        mesh.groups = groups.list;
+    if let Some((ids, names)) = groups.per_face(face_groups) {
+        mesh.face_groups = Some(ids);
+        mesh.groups = names;
     }
-    if materials.used {
-        let d = if face_materials.contains(&NONE) {
-            materials.id("default")
-        } else {
-            0
-        };
-        mesh.face_materials = Some(
-            face_materials
-                .into_iter()
-                .map(|m| if m == NONE { d } else { m })
-                .collect(),
-        );
-        mesh.materials = materials.list.into_iter().map(Material::named).collect();
+    if let Some((ids, names)) = materials.per_face(face_materials) {
+        mesh.face_materials = Some(ids);
+        mesh.materials = names.into_iter().map(Material::named).collect();
     }
     mesh.material_libs = libs;
     Ok(mesh)
