@@ -31,11 +31,13 @@ fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
     let mut views: Vec<Value> = Vec::new();
     let mut accessors: Vec<Value> = Vec::new();
     let nv = mesh.positions.len();
-    let mut push_attr = |bin: &mut Vec<u8>,
+    let mut attrs = serde_json::Map::new();
+    // One vertex attribute: its floats appended to the buffer, a view and an accessor over
+    // them, and the accessor named in the primitives' `attributes`.
+    let mut push_attr = |name: &str,
                          data: &mut dyn Iterator<Item = f32>,
                          ty: &str,
-                         extra: Value|
-     -> usize {
+                         extra: Value| {
         let start = bin.len();
         for x in data {
             bin.extend_from_slice(&x.to_le_bytes());
@@ -47,48 +49,43 @@ fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
             a.extend(e);
         }
         accessors.push(a);
-        accessors.len() - 1
+        attrs.insert(name.into(), json!(accessors.len() - 1));
     };
-    let mut attrs = serde_json::Map::new();
     if nv > 0 {
         let b = mesh.bounds().unwrap_or(crate::mesh::Aabb {
             min: [0.0; 3],
             max: [0.0; 3],
         });
-        let i = push_attr(
-            &mut bin,
+        push_attr(
+            "POSITION",
             &mut mesh.positions.iter().flatten().copied(),
             "VEC3",
             json!({"min": b.min, "max": b.max}),
         );
-        attrs.insert("POSITION".into(), json!(i));
         if let Some(n) = &mesh.normals {
-            let i = push_attr(
-                &mut bin,
+            push_attr(
+                "NORMAL",
                 &mut n.iter().flatten().copied(),
                 "VEC3",
                 json!({}),
             );
-            attrs.insert("NORMAL".into(), json!(i));
         }
         // glTF counts UVs from the image's top-left corner.
         if let Some(t) = mesh.uvs_from(UvOrigin::TopLeft) {
-            let i = push_attr(
-                &mut bin,
+            push_attr(
+                "TEXCOORD_0",
                 &mut t.iter().flatten().copied(),
                 "VEC2",
                 json!({}),
             );
-            attrs.insert("TEXCOORD_0".into(), json!(i));
         }
         if let Some(c) = &mesh.colors {
-            let i = push_attr(
-                &mut bin,
+            push_attr(
+                "COLOR_0",
                 &mut c.iter().flatten().copied(),
                 "VEC4",
                 json!({}),
             );
-            attrs.insert("COLOR_0".into(), json!(i));
         }
     }
     // Faces by (group, material), in face order within each.
