@@ -9,7 +9,7 @@ use clap::Args;
 
 use super::args::{Input, parse_f64, parse_input_arg};
 use super::error::{UsageError, lib};
-use super::files::load;
+use super::files::{check_directory, load};
 use super::report::Progress;
 
 pub(super) const BENCH_AFTER_HELP: &str = "\
@@ -101,15 +101,7 @@ pub(super) fn run_bench(args: BenchArgs) -> Result<ExitCode> {
         .into());
     }
     for file in args.json.iter().filter(|_| !json_stdout).chain(&args.plot) {
-        if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty())
-            && !dir.is_dir()
-        {
-            anyhow::bail!(
-                "{}: the output directory {} does not exist",
-                file.display(),
-                dir.display()
-            );
-        }
+        check_directory(file, "the output directory")?;
     }
     let progress = Progress::new(std::io::stderr().is_terminal());
     let mut inputs = Vec::new();

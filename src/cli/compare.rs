@@ -11,7 +11,7 @@ use clap::Args;
 use super::args::{Input, parse_input_arg};
 use super::error::lib;
 use super::files::load;
-use super::report::{Progress, write_comparison};
+use super::report::{Progress, write_comparison, write_json_with};
 
 pub(super) const COMPARE_AFTER_HELP: &str = "\
 Distances are Metro's (as MeshLab's Hausdorff Distance filter): points sampled uniformly by
@@ -66,17 +66,12 @@ pub(super) fn run_compare(args: CompareArgs) -> Result<ExitCode> {
     let out = std::io::stdout();
     let mut out = out.lock();
     if args.json {
-        let mut json = serde_json::to_value(&c)?;
-        let obj = json
-            .as_object_mut()
-            .expect("the comparison serializes as an object");
         let extra = serde_json::json!({
             "a": args.a.display(),
             "b": args.b.display(),
             "seconds": { "load": load_s, "compare": compare_s },
         });
-        obj.extend(extra.as_object().cloned().unwrap_or_default());
-        writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
+        write_json_with(&mut out, &c, extra)?;
     } else {
         write_comparison(&mut out, &args.a, &args.b, &c, load_s, compare_s)?;
     }

@@ -8,7 +8,7 @@ use clap::Args;
 
 use super::args::{Input, parse_input_arg};
 use super::files::load;
-use super::report::Progress;
+use super::report::{Progress, write_json_with};
 use crate::mesh;
 
 pub(super) const INFO_AFTER_HELP: &str = "\
@@ -42,10 +42,6 @@ pub(super) fn run_info(args: InfoArgs) -> Result<ExitCode> {
     let out = std::io::stdout();
     let mut out = out.lock();
     if args.json {
-        let mut json = serde_json::to_value(&topo)?;
-        let obj = json
-            .as_object_mut()
-            .expect("the topology report serializes as an object");
         let extra = serde_json::json!({
             "input": args.input.display(),
             "diagonal": diagonal,
@@ -61,8 +57,7 @@ pub(super) fn run_info(args: InfoArgs) -> Result<ExitCode> {
             "groups": mesh.groups.len(),
             "quality": quality,
         });
-        obj.extend(extra.as_object().cloned().unwrap_or_default());
-        writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
+        write_json_with(&mut out, &topo, extra)?;
     } else {
         let t = &topo;
         let yes_no = |b: bool, yes: &'static str, no: &'static str| if b { yes } else { no };

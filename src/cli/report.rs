@@ -11,6 +11,21 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use super::args::Input;
 use crate::SimplifyReport;
 
+/// `report`'s JSON object with the fields of `extra` (what the command adds: paths, seconds)
+/// after its own, pretty-printed on a line.
+pub(super) fn write_json_with(
+    out: &mut impl Write,
+    report: &impl serde::Serialize,
+    extra: serde_json::Value,
+) -> anyhow::Result<()> {
+    let mut json = serde_json::to_value(report)?;
+    json.as_object_mut()
+        .expect("a report serializes as an object")
+        .extend(extra.as_object().cloned().unwrap_or_default());
+    writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
+    Ok(())
+}
+
 pub(super) struct Times {
     pub(super) load: f64,
     pub(super) simplify: f64,
