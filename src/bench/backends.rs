@@ -4,7 +4,7 @@
 use super::peers::{meshopt_simplify, meshopt_simplify_sloppy, meshopt_simplify_with_attributes};
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::options::SimplifyOptions;
+use crate::options::{Backend, Method, SimplifyOptions};
 
 /// One implementation the benchmark can run. A new backend (cpu-parallel, gpu) is one entry in
 /// [`BACKENDS`]: its name, a line of help, the simplify call that is timed, and the device
@@ -29,90 +29,70 @@ pub static BACKENDS: &[BenchBackend] = &[
     BenchBackend {
         name: "cpu",
         about: "meshslim's greedy quadric edge collapse (the quality reference)",
-        simplify: |m, faces| Ok(crate::simplify(m, &SimplifyOptions::with_faces(faces))?.0),
+        simplify: |m, faces| ours(m, faces, Method::Qem, Backend::Cpu),
         device: cpu_name,
         band: 0.0,
     },
     BenchBackend {
         name: "cpu-parallel",
         about: "meshslim's GPU rounds run on the CPU's cores (rayon)",
-        simplify: |m, faces| {
-            Ok(crate::simplify(m, &with_backend(faces, crate::Backend::CpuParallel))?.0)
-        },
+        simplify: |m, faces| ours(m, faces, Method::Qem, Backend::CpuParallel),
         device: cpu_name,
         band: 0.0,
     },
     BenchBackend {
         name: "gpu",
         about: "meshslim's rounds as WGSL compute passes (wgpu)",
-        simplify: |m, faces| Ok(crate::simplify(m, &with_backend(faces, crate::Backend::Gpu))?.0),
+        simplify: |m, faces| ours(m, faces, Method::Qem, Backend::Gpu),
         device: gpu_name,
         band: 0.0,
     },
     BenchBackend {
         name: "cluster",
         about: "meshslim's uniform-grid vertex clustering (cpu-parallel; topology not kept)",
-        simplify: |m, faces| Ok(crate::simplify(m, &with_method(faces, crate::Method::Cluster))?.0),
+        simplify: |m, faces| ours(m, faces, Method::Cluster, Backend::CpuParallel),
         device: cpu_name,
         band: crate::cluster::BAND,
     },
     BenchBackend {
         name: "cluster-gpu",
         about: "meshslim's uniform-grid vertex clustering as WGSL compute passes (wgpu)",
-        simplify: |m, faces| {
-            let mut o = with_method(faces, crate::Method::Cluster);
-            o.backend = crate::Backend::Gpu;
-            Ok(crate::simplify(m, &o)?.0)
-        },
+        simplify: |m, faces| ours(m, faces, Method::Cluster, Backend::Gpu),
         device: gpu_name,
         band: crate::cluster::BAND,
     },
     BenchBackend {
         name: "floating-cell",
         about: "meshslim's floating-cell vertex clustering, Low & Tan (cpu-parallel)",
-        simplify: |m, faces| {
-            Ok(crate::simplify(m, &with_method(faces, crate::Method::FloatingCell))?.0)
-        },
+        simplify: |m, faces| ours(m, faces, Method::FloatingCell, Backend::CpuParallel),
         device: cpu_name,
         band: crate::cluster::BAND,
     },
     BenchBackend {
         name: "floating-cell-gpu",
         about: "meshslim's floating-cell vertex clustering as WGSL compute passes (wgpu)",
-        simplify: |m, faces| {
-            let mut o = with_method(faces, crate::Method::FloatingCell);
-            o.backend = crate::Backend::Gpu;
-            Ok(crate::simplify(m, &o)?.0)
-        },
+        simplify: |m, faces| ours(m, faces, Method::FloatingCell, Backend::Gpu),
         device: gpu_name,
         band: crate::cluster::BAND,
     },
     BenchBackend {
         name: "decimate",
         about: "meshslim's vertex decimation, Schroeder (cpu; keeps a subset of the vertices)",
-        simplify: |m, faces| {
-            let mut o = with_method(faces, crate::Method::Decimate);
-            o.backend = crate::Backend::Cpu;
-            Ok(crate::simplify(m, &o)?.0)
-        },
+        simplify: |m, faces| ours(m, faces, Method::Decimate, Backend::Cpu),
         device: cpu_name,
         band: 0.0,
     },
     BenchBackend {
         name: "hybrid",
         about: "meshslim's clustering to 2x the target + 20k faces, then the rounds (cpu-parallel)",
-        simplify: |m, faces| Ok(crate::simplify(m, &with_method(faces, crate::Method::Hybrid))?.0),
+        simplify: |m, faces| ours(m, faces, Method::Hybrid, Backend::CpuParallel),
         device: cpu_name,
         band: 0.0,
     },
     BenchBackend {
         name: "hybrid-gpu",
         about: "meshslim's hybrid with the rounds as WGSL compute passes (wgpu)",
-        simplify: |m, faces| {
-            let mut o = with_method(faces, crate::Method::Hybrid);
-            o.backend = crate::Backend::Gpu;
-            Ok(crate::simplify(m, &o)?.0)
-        },
+        simplify: |m, faces| ours(m, faces, Method::Hybrid, Backend::Gpu),
         device: gpu_name,
         band: 0.0,
     },
@@ -153,16 +133,12 @@ pub static BACKENDS: &[BenchBackend] = &[
     },
 ];
 
-fn with_backend(faces: usize, backend: crate::Backend) -> SimplifyOptions {
+/// meshslim's `method` on `backend`, the other options at their defaults for `faces` faces.
+fn ours(m: &Mesh, faces: usize, method: Method, backend: Backend) -> Result<Mesh> {
     let mut o = SimplifyOptions::with_faces(faces);
-    o.backend = backend;
-    o
-}
-
-fn with_method(faces: usize, method: crate::Method) -> SimplifyOptions {
-    let mut o = with_backend(faces, crate::Backend::CpuParallel);
     o.method = method;
-    o
+    o.backend = backend;
+    Ok(crate::simplify(m, &o)?.0)
 }
 
 /// The GPU adapter's name, or why there is none.

@@ -8,20 +8,18 @@ use super::report::{Report, Row};
 
 /// The report as a table, one row per line, errors relative to the input's diagonal.
 pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()> {
-    let mesh_w = report
-        .rows
-        .iter()
-        .map(|r| r.mesh.len())
-        .chain([4])
-        .max()
-        .unwrap_or(4);
-    let backend_w = report
-        .rows
-        .iter()
-        .map(|r| r.backend.len())
-        .chain([7])
-        .max()
-        .unwrap_or(7);
+    // A column as wide as its longest entry, and at least as its header.
+    let width = |len: fn(&Row) -> usize, header: usize| {
+        report
+            .rows
+            .iter()
+            .map(len)
+            .chain([header])
+            .max()
+            .unwrap_or(header)
+    };
+    let mesh_w = width(|r| r.mesh.len(), 4);
+    let backend_w = width(|r| r.backend.len(), 7);
     // The colour column only when some input has colours (attribute-free tables stay as they
     // were).
     let colors = report.rows.iter().any(|r| r.color_err.is_some());
