@@ -13,14 +13,14 @@
 use super::grid::Grid;
 use super::stages::{self, Csr, Placed};
 use super::{
-    Built, ClusterReport, Points, Work, check_backend, clustered_report, land, output, prepare,
-    tally,
+    Built, ClusterReport, Points, Work, check_backend, clustered_report, device_for, land, output,
+    prepare, tally,
 };
 use crate::compute::common::{V3, dot, length, sub, tie_rank, xyz};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::mesh::morton::morton3;
-use crate::options::{Backend, Method, SimplifyOptions, SimplifyReport};
+use crate::options::{Method, SimplifyOptions, SimplifyReport};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -343,11 +343,7 @@ pub fn simplify_floating(
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
-    let on = match check_backend(opts)? {
-        Backend::Gpu => Some(super::gpu::shared()?),
-        _ => None,
-    };
-    let (out, report, _) = floating_on(on, mesh, opts, progress)?;
+    let (out, report, _) = floating_on(device_for(opts)?, mesh, opts, progress)?;
     Ok((out, report))
 }
 

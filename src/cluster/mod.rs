@@ -659,17 +659,21 @@ fn check_backend(opts: &SimplifyOptions) -> Result<Backend> {
     })
 }
 
+/// The process's shared clusterer when `opts` asks for the GPU; `None`: the CPU's cores.
+fn device_for(opts: &SimplifyOptions) -> Result<Option<&'static gpu::GpuClusterer>> {
+    Ok(match check_backend(opts)? {
+        Backend::Gpu => Some(gpu::shared()?),
+        _ => None,
+    })
+}
+
 /// `--method cluster`.
 pub fn simplify_cluster(
     mesh: &Mesh,
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
-    let on = match check_backend(opts)? {
-        Backend::Gpu => Some(gpu::shared()?),
-        _ => None,
-    };
-    let (out, report, _) = cluster_on(on, mesh, opts, progress)?;
+    let (out, report, _) = cluster_on(device_for(opts)?, mesh, opts, progress)?;
     Ok((out, report))
 }
 
