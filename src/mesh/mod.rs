@@ -243,22 +243,20 @@ impl Mesh {
             nf,
         )?;
         check_len("face_groups", self.face_groups.as_ref().map(Vec::len), nf)?;
-        if let Some(m) = &self.face_materials
-            && let Some(f) = m.iter().position(|&m| m as usize >= self.materials.len())
-        {
+        // The first face whose id is not below `defined`, and that id.
+        let undefined = |ids: &Option<Vec<u32>>, defined: usize| {
+            let ids = ids.as_ref()?;
+            let f = ids.iter().position(|&i| i as usize >= defined)?;
+            Some((f, ids[f], defined))
+        };
+        if let Some((f, m, n)) = undefined(&self.face_materials, self.materials.len()) {
             return Err(Error::InvalidMesh(format!(
-                "face {f} uses material {}, but only {} are defined",
-                m[f],
-                self.materials.len()
+                "face {f} uses material {m}, but only {n} are defined"
             )));
         }
-        if let Some(g) = &self.face_groups
-            && let Some(f) = g.iter().position(|&g| g as usize >= self.groups.len())
-        {
+        if let Some((f, g, n)) = undefined(&self.face_groups, self.groups.len()) {
             return Err(Error::InvalidMesh(format!(
-                "face {f} is in group {}, but only {} are defined",
-                g[f],
-                self.groups.len()
+                "face {f} is in group {g}, but only {n} are defined"
             )));
         }
         Ok(())
