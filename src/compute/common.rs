@@ -54,17 +54,9 @@ pub fn tie_rank(e: u32) -> u32 {
 
 /// `weight · (n·y + d)²` for the plane `n·y + d = 0` (unit `n`), in the frame of the vertex.
 pub fn quadric_from_plane(n: V3, d: f32, w: f32) -> Quadric {
+    let [a00, a01, a02, a11, a12, a22, b0, b1, b2, c] = crate::quadric::plane_terms(n, d, w);
     Quadric {
-        q: [
-            [
-                w * n[0] * n[0],
-                w * n[0] * n[1],
-                w * n[0] * n[2],
-                w * n[1] * n[1],
-            ],
-            [w * n[1] * n[2], w * n[2] * n[2], w * n[0] * d, w * n[1] * d],
-            [w * n[2] * d, w * d * d, w, 0.0],
-        ],
+        q: [[a00, a01, a02, a11], [a12, a22, b0, b1], [b2, c, w, 0.0]],
     }
 }
 

@@ -6,6 +6,23 @@
 
 pub(crate) mod attributes;
 
+/// The terms of `w·(n·p + d)²` in storage order: A's upper triangle, b, c. One definition for
+/// the f64 quadric here and the f32 one the rounds' shaders and their twins keep.
+pub fn plane_terms<T: Copy + std::ops::Mul<Output = T>>(n: [T; 3], d: T, w: T) -> [T; 10] {
+    [
+        w * n[0] * n[0],
+        w * n[0] * n[1],
+        w * n[0] * n[2],
+        w * n[1] * n[1],
+        w * n[1] * n[2],
+        w * n[2] * n[2],
+        w * n[0] * d,
+        w * n[1] * d,
+        w * n[2] * d,
+        w * d * d,
+    ]
+}
+
 /// A weighted sum of squared distances to planes. All f64: f32 loses the small differences of
 /// large sums on million-triangle meshes.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -20,19 +37,12 @@ pub struct Quadric {
 impl Quadric {
     /// `weight · (n·p + d)²` for the plane `n·p + d = 0` (`n` of unit length).
     pub fn from_plane(n: [f64; 3], d: f64, weight: f64) -> Self {
-        let w = weight;
+        let [a00, a01, a02, a11, a12, a22, b0, b1, b2, c] = plane_terms(n, d, weight);
         Quadric {
-            a: [
-                w * n[0] * n[0],
-                w * n[0] * n[1],
-                w * n[0] * n[2],
-                w * n[1] * n[1],
-                w * n[1] * n[2],
-                w * n[2] * n[2],
-            ],
-            b: [w * n[0] * d, w * n[1] * d, w * n[2] * d],
-            c: w * d * d,
-            weight: w,
+            a: [a00, a01, a02, a11, a12, a22],
+            b: [b0, b1, b2],
+            c,
+            weight,
         }
     }
 
