@@ -322,36 +322,31 @@ impl HalfEdges {
         let h1 = self.new_edge(v, v1);
         let o1 = twin(h1);
         self.to[h0 as usize] = v;
-        if f0 == NONE {
-            // prev → h0 → h1 → next along the border.
-            self.link(hp, h0);
-            self.link(h0, h1);
-            self.link(h1, hn);
-        } else {
-            // (v0, v1, a) becomes (v0, v, a) and (v, v1, a).
-            let a = self.to[hn as usize];
-            let x = self.new_edge(v, a);
-            let f2 = self.new_face();
-            self.set_face([h0, x, hp], f0);
-            self.set_face([h1, hn, twin(x)], f2);
-        }
-        if f1 == NONE {
-            self.link(op, o1);
-            self.link(o1, o0);
-            self.link(o0, on);
-        } else {
-            // (v1, v0, b) becomes (v1, v, b) and (v, v0, b).
-            let b = self.to[on as usize];
-            let z = self.new_edge(v, b);
-            let f3 = self.new_face();
-            self.set_face([o1, z, op], f1);
-            self.set_face([o0, on, twin(z)], f3);
-        }
+        self.split_side(v, f0, [hp, h0, h1, hn]);
+        self.split_side(v, f1, [op, o1, o0, on]);
         if self.out[v1 as usize] == o0 {
             self.out[v1 as usize] = o1;
         }
         self.fix_out(v, h1);
         (v, h1 / 2)
+    }
+
+    /// One side of a split edge: `prev → first → second → next` around face `f`, where `first`
+    /// and `second` are the halves of the edge (`first` ends at `v`). A border side is relinked
+    /// in that order; a face (c0, c1, a) becomes (c0, v, a) and (v, c1, a). The two sides are
+    /// mirror images, so one function serves both.
+    fn split_side(&mut self, v: u32, f: u32, [prev, first, second, next]: [u32; 4]) {
+        if f == NONE {
+            self.link(prev, first);
+            self.link(first, second);
+            self.link(second, next);
+        } else {
+            let a = self.to[next as usize];
+            let x = self.new_edge(v, a);
+            let g = self.new_face();
+            self.set_face([first, x, prev], f);
+            self.set_face([second, next, twin(x)], g);
+        }
     }
 
     /// Whether `e` can be flipped without breaking the mesh: two faces, distinct opposite
