@@ -445,6 +445,66 @@ fn one_line(name: &str) -> String {
 
 /// Whether the ids `per_face` first appear in the order 0, 1, 2, … and every one of `count` is
 /// used, so that a reader numbering names by first appearance gets the same ids back.
+/// A per-face name list the writer emits where it changes (`g` for groups, `usemtl` for
+/// materials); the same code serves both.
+struct Switch<'m> {
+    keyword: &'static str,
+    ids: Option<&'m [u32]>,
+    names: Vec<&'m str>,
+    current: u32,
+}
+
+impl<'m> Switch<'m> {
+    /// Declares every name in id order first when first use would number them otherwise (a
+    /// reader numbers them as it meets them), so the ids read back are the ones written.
+    fn declared(
+        keyword: &'static str,
+        ids: Option<&'m [u32]>,
+        names: Vec<&'m str>,
+        out: &mut String,
+    ) -> Switch<'m> {
+        use std::fmt::Write as _;
+        let mut s = Switch {
+            keyword,
+            ids,
+            names,
+            current: NONE,
+        };
+        if let Some(ids) = s.ids
+            && !in_first_use_order(ids, s.names.len())
+        {
+            let what = if keyword == "g" {
+                "groups"
+            } else {
+                "materials"
+            };
+            let _ = writeln!(out, "# {what} in id order");
+            for (i, name) in s.names.iter().enumerate() {
+                let _ = writeln!(out, "{keyword} {}", one_line(name));
+                s.current = i as u32;
+            }
+        }
+        s
+    }
+
+    /// Switches to face `f`'s name when it differs from the last written.
+    fn face(&mut self, f: usize, out: &mut String) {
+        use std::fmt::Write as _;
+        if let Some(ids) = self.ids
+            && ids[f] != self.current
+        {
+            self.current = ids[f];
+            let name = self.names.get(self.current as usize).copied();
+            let _ = writeln!(
+                out,
+                "{} {}",
+                self.keyword,
+                one_line(name.unwrap_or("default"))
+            );
+        }
+    }
+}
+
 fn in_first_use_order(per_face: &[u32], count: usize) -> bool {
     let mut next = 0u32;
     for &g in per_face {
@@ -506,48 +566,14 @@ pub fn write_obj_libs<W: Write>(w: &mut W, mesh: &Mesh, libs: &[String]) -> io::
             }
         }
     }
-    let mut cur_group = NONE;
-    let mut cur_mat = NONE;
-    if let Some(fg) = &mesh.face_groups
-        && !in_first_use_order(fg, mesh.groups.len())
-    {
-        out.push_str("# groups in id order\n");
-        for (i, g) in mesh.groups.iter().enumerate() {
-            let _ = writeln!(out, "g {}", one_line(g));
-            cur_group = i as u32;
-        }
-    }
-    if let Some(fm) = &mesh.face_materials
-        && !in_first_use_order(fm, mesh.materials.len())
-    {
-        out.push_str("# materials in id order\n");
-        for (i, m) in mesh.materials.iter().enumerate() {
-            let _ = writeln!(out, "usemtl {}", one_line(&m.name));
-            cur_mat = i as u32;
-        }
-    }
+    let names = mesh.groups.iter().map(String::as_str).collect();
+    let mut groups = Switch::declared("g", mesh.face_groups.as_deref(), names, &mut out);
+    let names = mesh.materials.iter().map(|m| m.name.as_str()).collect();
+    let mut materials = Switch::declared("usemtl", mesh.face_materials.as_deref(), names, &mut out);
     let (has_t, has_n) = (mesh.uvs.is_some(), mesh.normals.is_some());
     for (f, t) in mesh.triangles.iter().enumerate() {
-        if let Some(fg) = &mesh.face_groups
-            && fg[f] != cur_group
-        {
-            cur_group = fg[f];
-            let name = mesh
-                .groups
-                .get(cur_group as usize)
-                .map_or("default", String::as_str);
-            let _ = writeln!(out, "g {}", one_line(name));
-        }
-        if let Some(fm) = &mesh.face_materials
-            && fm[f] != cur_mat
-        {
-            cur_mat = fm[f];
-            let name = mesh
-                .materials
-                .get(cur_mat as usize)
-                .map_or("default", |m| m.name.as_str());
-            let _ = writeln!(out, "usemtl {}", one_line(name));
-        }
+        groups.face(f, &mut out);
+        materials.face(f, &mut out);
         out.push('f');
         for &v in t {
             let i = v as u64 + 1;
