@@ -32,22 +32,12 @@ impl Device {
                 format!("gpu backend unavailable on this device ({e}); cpu backends work"),
             ),
         };
-        // A software rasterizer (lavapipe, llvmpipe) runs the rounds slower than the CPU's
-        // cores (the 1M scan to 1%: 33 s on gpu against 4.4 s on cpu), so the window starts on
-        // cpu-parallel there, gpu one click away.
+        // The library's `auto` on the window's own adapter; gpu stays one click away.
         let info = rs.adapter.get_info();
         let start = match &sim {
-            Some(_) if info.device_type != wgpu::DeviceType::Cpu => {
-                (Backend::Gpu, format!("gpu on {}", info.name))
+            Some(_) => {
+                crate::simplify::auto_on(&info.name, info.device_type == wgpu::DeviceType::Cpu)
             }
-            Some(_) => (
-                Backend::CpuParallel,
-                format!(
-                    "cpu-parallel: the adapter, {}, is a software rasterizer, slower than the \
-                     CPU's cores (gpu runs on it when chosen)",
-                    info.name
-                ),
-            ),
             None => (
                 Backend::CpuParallel,
                 "cpu-parallel: the gpu backend is unavailable on this device".into(),
