@@ -70,18 +70,26 @@ impl<'a> State<'a> {
     fn push_edges_of(&mut self, v: u32, heap: &mut Queue) {
         let m = self.next_mark();
         self.mark[v as usize] = m;
-        for i in 0..self.vert_faces.get(v as usize).len() {
-            let f = self.vert_faces.get(v as usize)[i] as usize;
-            for u in self.topo_faces[f] {
+        // The neighbours first, their quadrics and positions asked of the cache as they are
+        // found, then the placements: the loads overlap instead of each waiting on the last.
+        let mut nbrs = std::mem::take(&mut self.scratch);
+        nbrs.clear();
+        for &f in self.vert_faces.get(v as usize) {
+            for u in self.topo_faces[f as usize] {
                 if self.mark[u as usize] != m {
                     self.mark[u as usize] = m;
-                    if let Some((_, _, _, err)) = self.placement(v, u) {
-                        let (lo, hi) = if v < u { (v, u) } else { (u, v) };
-                        heap.push(key(err), lo, hi, self.stamp(lo, hi));
-                    }
+                    self.prefetch_vertex(u);
+                    nbrs.push(u);
                 }
             }
         }
+        for &u in &nbrs {
+            if let Some((_, _, _, err)) = self.placement(v, u) {
+                let (lo, hi) = if v < u { (v, u) } else { (u, v) };
+                heap.push(key(err), lo, hi, self.stamp(lo, hi));
+            }
+        }
+        self.scratch = nbrs;
     }
 }
 
@@ -186,6 +194,9 @@ impl<'a> State<'a> {
             if k > key_limit {
                 heap.push(k, a, b, stamp);
                 return true;
+            }
+            if let Some((na, nb)) = heap.peek() {
+                self.prefetch_edge(na, nb);
             }
             // A removed vertex's version was bumped too, so one comparison retires every entry
             // whose edge changed or vanished.

@@ -90,6 +90,12 @@ impl Queue {
         }
     }
 
+    /// The endpoints of the entry that comes out next, when it is already sorted (in the
+    /// bucket being taken); `None` when the next pop opens a new bucket.
+    pub(crate) fn peek(&self) -> Option<(u32, u32)> {
+        self.active.peek().map(|Reverse((_, a, b, _))| (*a, *b))
+    }
+
     pub(crate) fn is_empty(&self) -> bool {
         self.active.is_empty() && self.waiting == 0
     }

@@ -89,6 +89,20 @@ impl VertFaces {
     }
 }
 
+/// A hint that the cache line at `p` is read soon.
+#[inline(always)]
+fn at(p: *const u8) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch is only a hint: it reads nothing the program sees and never faults,
+    // whatever the address (wrapping_add may point past an array's end); SSE is in every
+    // x86_64 target's baseline.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(p as *const i8)
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
+}
+
 /// `topo_faces` entry of a removed face. The hot loops test this instead of `face_alive`: the
 /// face's vertices are read next anyway, so liveness costs no extra cache line.
 pub(super) const DEAD: u32 = u32::MAX;
@@ -146,6 +160,37 @@ impl<'a> State<'a> {
         p.face_origin = live(&p.face_origin, &self.face_alive);
         p.ref_normal = live(&p.ref_normal, &self.face_alive);
         p
+    }
+
+    /// Asks the cache for what evaluating edge (a, b) reads first: the run calls it for the
+    /// queue's next entry while it evaluates this one. The evaluation was bound by the chain of
+    /// misses from a vertex to its face list to the faces (`perf annotate`: 38% of its samples
+    /// on those three loads); with this and [`State::prefetch_vertex`] the 1M scan at 10% took
+    /// 0.80 s against 0.92 s (the best of five interleaved runs, same output).
+    #[inline]
+    pub(super) fn prefetch_edge(&self, a: u32, b: u32) {
+        for v in [a as usize, b as usize] {
+            let faces = self.vert_faces.get(v);
+            at(faces.as_ptr() as *const u8);
+            for &f in faces.iter().take(8) {
+                at(self.topo_faces.as_ptr().wrapping_add(f as usize) as *const u8);
+            }
+            at(self.p.pos.as_ptr().wrapping_add(v) as *const u8);
+            self.prefetch_vertex(v as u32);
+            at(self.version.as_ptr().wrapping_add(v) as *const u8);
+        }
+    }
+
+    /// Asks the cache for what a placement reads of `v`.
+    #[inline]
+    pub(super) fn prefetch_vertex(&self, v: u32) {
+        let v = v as usize;
+        at(self.p.pos.as_ptr().wrapping_add(v) as *const u8);
+        // A quadric's 88 bytes span up to three lines.
+        let q = self.p.quadrics.as_ptr().wrapping_add(v) as *const u8;
+        for offset in [0, 64, std::mem::size_of::<crate::quadric::Quadric>() - 1] {
+            at(q.wrapping_add(offset));
+        }
     }
 
     pub(super) fn stamp(&self, a: u32, b: u32) -> u32 {
