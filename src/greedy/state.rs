@@ -91,7 +91,7 @@ impl VertFaces {
 
 /// A hint that the cache line at `p` is read soon.
 #[inline(always)]
-fn at(p: *const u8) {
+fn prefetch(p: *const u8) {
     #[cfg(target_arch = "x86_64")]
     // SAFETY: a prefetch is only a hint: it reads nothing the program sees and never faults,
     // whatever the address (wrapping_add may point past an array's end); SSE is in every
@@ -171,13 +171,12 @@ impl<'a> State<'a> {
     pub(super) fn prefetch_edge(&self, a: u32, b: u32) {
         for v in [a as usize, b as usize] {
             let faces = self.vert_faces.get(v);
-            at(faces.as_ptr() as *const u8);
+            prefetch(faces.as_ptr() as *const u8);
             for &f in faces.iter().take(8) {
-                at(self.topo_faces.as_ptr().wrapping_add(f as usize) as *const u8);
+                prefetch(self.topo_faces.as_ptr().wrapping_add(f as usize) as *const u8);
             }
-            at(self.p.pos.as_ptr().wrapping_add(v) as *const u8);
             self.prefetch_vertex(v as u32);
-            at(self.version.as_ptr().wrapping_add(v) as *const u8);
+            prefetch(self.version.as_ptr().wrapping_add(v) as *const u8);
         }
     }
 
@@ -185,11 +184,11 @@ impl<'a> State<'a> {
     #[inline]
     pub(super) fn prefetch_vertex(&self, v: u32) {
         let v = v as usize;
-        at(self.p.pos.as_ptr().wrapping_add(v) as *const u8);
+        prefetch(self.p.pos.as_ptr().wrapping_add(v) as *const u8);
         // A quadric's 88 bytes span up to three lines.
         let q = self.p.quadrics.as_ptr().wrapping_add(v) as *const u8;
         for offset in [0, 64, std::mem::size_of::<crate::quadric::Quadric>() - 1] {
-            at(q.wrapping_add(offset));
+            prefetch(q.wrapping_add(offset));
         }
     }
 
