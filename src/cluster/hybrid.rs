@@ -149,17 +149,107 @@ pub(super) fn cluster_repaired(
         if bad.is_empty() {
             break;
         }
-        for (v, &k) in built.vertex_cluster.iter().enumerate() {
-            if bad.binary_search(&k).is_ok() {
-                work.locked[v] = true;
+        built = match work.gather {
+            Some(_) => take_apart(work, &grid, &built, &bad),
+            // Streamed: no vertex→face lists to place the new singletons by, so a whole build.
+            None => {
+                for (v, &k) in built.vertex_cluster.iter().enumerate() {
+                    if bad.binary_search(&k).is_ok() {
+                        work.locked[v] = true;
+                    }
+                }
+                work.build(&grid)?
             }
-        }
-        built = work.build(&grid)?;
+        };
         normals = origin_normals(work, &built)?;
         report.builds += 1;
         report.repaired_clusters += bad.len();
     }
     Ok((grid, built, normals))
+}
+
+/// What [`Work::build`] at `grid` gives once the members of the `bad` clusters (sorted ids of
+/// `b`, the build at `grid` before) are locked, which this does too: worked out from `b`
+/// instead of built again. A cluster is one connected component of its cell, so locking its
+/// members takes it out of the cell whole; every other cluster keeps its members, its box,
+/// its placement and its place in the order the clusters are numbered in (cells in key order,
+/// a cell's clusters by root, the locked vertices last in id order). Only the new singletons
+/// are placed, and the faces taken again. Measured on the 1M scan at 10%: a whole build took
+/// 0.09 s of each of the two repairs' 0.12 s.
+fn take_apart(work: &mut Work, grid: &Grid, b: &Built, bad: &[u32]) -> Built {
+    use super::stages::{Surface, cluster_quadric};
+    use crate::compute::common::xyz;
+    let g = work
+        .gather
+        .as_ref()
+        .expect("taking clusters apart places singletons by the vertex→face lists");
+    let positions = &work.pts.positions;
+    let mut is_bad = vec![false; b.clusters];
+    for &k in bad {
+        is_bad[k as usize] = true;
+    }
+    // The locked vertices, in id order: the singleton clusters at the end of the numbering, with
+    // their placement where they were singletons before.
+    let mut singles: Vec<(u32, Option<super::stages::Placed>)> = Vec::new();
+    for (v, &k) in b.vertex_cluster.iter().enumerate() {
+        if work.locked[v] {
+            singles.push((v as u32, Some(b.placed[k as usize])));
+        } else if is_bad[k as usize] {
+            work.locked[v] = true;
+            singles.push((v as u32, None));
+        }
+    }
+    // The clusters that stay, in their order; a cell's clusters are consecutive, so counting
+    // key changes counts the cells.
+    let mut new_id = vec![u32::MAX; b.clusters];
+    let mut placed = Vec::with_capacity(b.clusters);
+    let mut cells = 0;
+    let mut last_key = None;
+    for (k, p) in b.placed.iter().enumerate() {
+        // Every member of a cluster is locked or none is: `attr` is one of them.
+        if work.locked[p.attr as usize] {
+            continue;
+        }
+        new_id[k] = placed.len() as u32;
+        placed.push(*p);
+        let key = grid.key(xyz(positions[p.attr as usize]));
+        if last_key != Some(key) {
+            cells += 1;
+            last_key = Some(key);
+        }
+    }
+    let kept = placed.len();
+    let surface = Surface {
+        positions,
+        faces: &work.pts.faces,
+        planes: &g.planes,
+        csr: &g.csr,
+        border: &g.border,
+        border_weight: work.border_weight,
+    };
+    // A singleton's box is its vertex, as `build` gives it.
+    placed.par_extend(singles.par_iter().map(|&(v, old)| {
+        old.unwrap_or_else(|| {
+            let p = xyz(positions[v as usize]);
+            cluster_quadric(&surface, &[v], p, p, p)
+        })
+    }));
+    let mut vertex_cluster: Vec<u32> = b
+        .vertex_cluster
+        .par_iter()
+        .map(|&k| new_id[k as usize])
+        .collect();
+    for (i, &(v, _)) in singles.iter().enumerate() {
+        vertex_cluster[v as usize] = (kept + i) as u32;
+    }
+    let clusters = placed.len();
+    Built {
+        placed,
+        faces: super::stages::cluster_faces(&work.pts.faces, &vertex_cluster, clusters, true),
+        vertex_cluster,
+        clusters,
+        cells: cells + singles.len(),
+    }
 }
 
 /// The rounds from `up` on `opts.backend` (cpu-parallel or gpu).
@@ -244,4 +334,79 @@ pub(crate) fn hybrid_upload(
     };
     report.seconds = t.elapsed().as_secs_f64();
     Ok((up, built_error, report, opts))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Placements, faces, vertex clusters and the cluster and cell counts.
+    type Bits<'a> = (Vec<Vec<u32>>, &'a [(u32, [u32; 3])], &'a [u32], usize, usize);
+
+    /// A build's every output as bits, to compare two builds exactly.
+    fn bits(b: &Built) -> Bits<'_> {
+        let placed = b
+            .placed
+            .iter()
+            .map(|p| {
+                let mut v: Vec<u32> = p.pos.iter().map(|x| x.to_bits()).collect();
+                v.extend(bytemuck::cast_slice::<_, u32>(std::slice::from_ref(
+                    &p.quadric,
+                )));
+                v.push(p.attr);
+                v.push(p.how as u32);
+                v
+            })
+            .collect();
+        (placed, &b.faces, &b.vertex_cluster, b.clusters, b.cells)
+    }
+
+    /// Taking clusters apart from the build before gives, bit for bit, what building again with
+    /// their members locked gives: for any set of clusters (singletons among them), twice in a
+    /// row, on a painted sphere whose colour steps split cells and on a grid whose border is
+    /// locked from the start.
+    #[test]
+    fn take_apart_equals_a_whole_build() {
+        let mut painted = crate::mesh::noisy_sphere(5, 0.01, 7);
+        crate::mesh::paint(&mut painted);
+        let cases = [(painted, false, 0.5), (crate::mesh::grid(60), true, 0.0)];
+        for (mesh, lock_border, color) in cases {
+            let mut opts = SimplifyOptions::with_ratio(mesh.triangles.len(), 0.1).unwrap();
+            opts.lock_border = lock_border;
+            opts.attributes.color = color;
+            let mut pts = Points::new(&mesh);
+            let mut work = prepare(&mut pts, &opts, true).unwrap();
+            work.colors = super::super::colors::ColourSplit::of(&mesh, color);
+            let mut report = ClusterReport::default();
+            let target = opts.target_faces;
+            let (grid, mut built, _) =
+                cluster_to(&work, 3 * target, None, Some(target), &mut report).unwrap();
+            let what = format!("{} faces, lock_border {lock_border}", mesh.triangles.len());
+            if color > 0.0 {
+                assert!(built.clusters > built.cells, "{what}: no cell was split");
+            }
+            for step in [5usize, 3] {
+                // Every step-th cluster, and every locked vertex's singleton.
+                let mut bad: Vec<u32> = (0..built.clusters as u32)
+                    .filter(|&k| k as usize % step == 1)
+                    .collect();
+                bad.extend(
+                    (0..work.locked.len())
+                        .filter(|&v| work.locked[v])
+                        .map(|v| built.vertex_cluster[v])
+                        .step_by(2),
+                );
+                bad.sort_unstable();
+                bad.dedup();
+                let apart = take_apart(&mut work, &grid, &built, &bad);
+                let whole = work.build(&grid).unwrap();
+                assert_eq!(bits(&apart), bits(&whole), "{what}: every {step}th cluster");
+                assert!(
+                    whole.clusters > built.clusters,
+                    "{what}: nothing taken apart"
+                );
+                built = whole;
+            }
+        }
+    }
 }
