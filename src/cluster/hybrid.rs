@@ -37,34 +37,54 @@ pub const HYBRID_SKIP: f64 = 0.5;
 const MAX_REPAIRS: usize = 4;
 
 /// The clusters at either end of an edge that more than two faces share, or that two faces
-/// run the same way (a fold), sorted.
+/// run the same way (a fold), sorted. The half-edges are bucketed by their lower cluster (a
+/// counting sort) and each small bucket sorted alone: sorting all of them by (edge, direction)
+/// took 0.02-0.04 s a check on the 1M scan at 10% (three checks), this 0.013-0.016 s, the
+/// same clusters on every scan and shared model at 10% and 1%.
 fn pinched_clusters(b: &Built) -> Vec<u32> {
-    let mut half: Vec<(u64, bool)> = b
-        .faces
-        .par_iter()
-        .flat_map_iter(|(_, t)| {
-            (0..3).map(move |i| {
-                let (a, c) = (t[i], t[(i + 1) % 3]);
-                (((a.min(c) as u64) << 32) | a.max(c) as u64, a < c)
-            })
-        })
-        .collect();
-    half.par_sort_unstable();
-    let mut bad = Vec::new();
-    let mut i = 0;
-    while i < half.len() {
-        let mut j = i + 1;
-        while j < half.len() && half[j].0 == half[i].0 {
-            j += 1;
-        }
-        let pinched = j - i > 2 || (j - i == 2 && half[i].1 == half[i + 1].1);
-        if pinched {
-            bad.push((half[i].0 >> 32) as u32);
-            bad.push(half[i].0 as u32);
-        }
-        i = j;
-    }
-    bad.sort_unstable();
+    let half = |i: usize| {
+        let t = b.faces[i / 3].1;
+        let (a, c) = (t[i % 3], t[(i + 1) % 3]);
+        (a.min(c), a.max(c), a < c)
+    };
+    let (order, start) =
+        crate::mesh::prepare::counting_sort(b.clusters, b.faces.len() * 3, |i| half(i).0);
+    let mut bad: Vec<u32> = (0..b.clusters)
+        .into_par_iter()
+        .with_min_len(1024)
+        .fold(
+            || (Vec::new(), Vec::new()),
+            |(mut ends, mut out): (Vec<(u32, bool)>, Vec<u32>), k| {
+                let bucket = &order[start[k] as usize..start[k + 1] as usize];
+                if bucket.len() < 2 {
+                    return (ends, out);
+                }
+                ends.clear();
+                ends.extend(bucket.iter().map(|&i| {
+                    let (_, c, forward) = half(i as usize);
+                    (c, forward)
+                }));
+                ends.sort_unstable();
+                let mut i = 0;
+                while i < ends.len() {
+                    let mut j = i + 1;
+                    while j < ends.len() && ends[j].0 == ends[i].0 {
+                        j += 1;
+                    }
+                    if j - i > 2 || (j - i == 2 && ends[i].1 == ends[i + 1].1) {
+                        out.extend([k as u32, ends[i].0]);
+                    }
+                    i = j;
+                }
+                (ends, out)
+            },
+        )
+        .map(|(_, out)| out)
+        .reduce(Vec::new, |mut a, b| {
+            a.extend(b);
+            a
+        });
+    bad.par_sort_unstable();
     bad.dedup();
     bad
 }
@@ -341,7 +361,13 @@ mod tests {
     use super::*;
 
     /// Placements, faces, vertex clusters and the cluster and cell counts.
-    type Bits<'a> = (Vec<Vec<u32>>, &'a [(u32, [u32; 3])], &'a [u32], usize, usize);
+    type Bits<'a> = (
+        Vec<Vec<u32>>,
+        &'a [(u32, [u32; 3])],
+        &'a [u32],
+        usize,
+        usize,
+    );
 
     /// A build's every output as bits, to compare two builds exactly.
     fn bits(b: &Built) -> Bits<'_> {
@@ -359,6 +385,31 @@ mod tests {
             })
             .collect();
         (placed, &b.faces, &b.vertex_cluster, b.clusters, b.cells)
+    }
+
+    /// An edge with three faces pinches both its clusters, as does one that two faces run the
+    /// same way; an edge two faces run opposite ways does not.
+    #[test]
+    fn pinched_clusters_are_three_face_edges_and_folds() {
+        let faces = [[0, 1, 2], [1, 0, 3], [0, 1, 4], [2, 3, 4], [2, 3, 5], [3, 6, 5]];
+        let b = Built {
+            placed: Vec::new(),
+            faces: faces.iter().enumerate().map(|(f, &t)| (f as u32, t)).collect(),
+            vertex_cluster: Vec::new(),
+            clusters: 7,
+            cells: 7,
+        };
+        assert_eq!(pinched_clusters(&b), [0, 1, 2, 3]);
+        // Without the third face on (0, 1) and the second face running 2 -> 3: none.
+        let b = Built {
+            faces: [faces[0], faces[1], faces[3], [3, 2, 5]]
+                .iter()
+                .enumerate()
+                .map(|(f, &t)| (f as u32, t))
+                .collect(),
+            ..b
+        };
+        assert!(pinched_clusters(&b).is_empty());
     }
 
     /// Taking clusters apart from the build before gives, bit for bit, what building again with
