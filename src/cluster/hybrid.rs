@@ -391,10 +391,21 @@ mod tests {
     /// same way; an edge two faces run opposite ways does not.
     #[test]
     fn pinched_clusters_are_three_face_edges_and_folds() {
-        let faces = [[0, 1, 2], [1, 0, 3], [0, 1, 4], [2, 3, 4], [2, 3, 5], [3, 6, 5]];
+        let faces = [
+            [0, 1, 2],
+            [1, 0, 3],
+            [0, 1, 4],
+            [2, 3, 4],
+            [2, 3, 5],
+            [3, 6, 5],
+        ];
         let b = Built {
             placed: Vec::new(),
-            faces: faces.iter().enumerate().map(|(f, &t)| (f as u32, t)).collect(),
+            faces: faces
+                .iter()
+                .enumerate()
+                .map(|(f, &t)| (f as u32, t))
+                .collect(),
             vertex_cluster: Vec::new(),
             clusters: 7,
             cells: 7,
@@ -410,6 +421,30 @@ mod tests {
             ..b
         };
         assert!(pinched_clusters(&b).is_empty());
+    }
+
+    /// The border vertices are the grid's outline and none of its inside; a closed sphere has
+    /// none, and a face that repeats a vertex adds none (its edges lie on the sphere's own).
+    #[test]
+    fn border_vertices_are_the_ends_of_one_face_edges() {
+        let border = |m: &Mesh| {
+            let csr = super::super::Csr::new(m.positions.len(), &m.triangles);
+            super::super::border_vertices(&csr, &m.triangles)
+        };
+        let g = crate::mesh::grid(12);
+        let b = g.bounds().unwrap();
+        let outline: Vec<bool> = g
+            .positions
+            .iter()
+            .map(|p| (0..2).any(|k| p[k] == b.min[k] || p[k] == b.max[k]))
+            .collect();
+        assert!(outline.iter().any(|&o| o) && outline.iter().any(|&o| !o));
+        assert_eq!(border(&g), outline);
+        let mut s = crate::mesh::icosphere(2);
+        assert!(!border(&s).contains(&true));
+        let [a, c, _] = s.triangles[0];
+        s.triangles.push([a, a, c]);
+        assert!(!border(&s).contains(&true));
     }
 
     /// Taking clusters apart from the build before gives, bit for bit, what building again with
