@@ -198,7 +198,7 @@ impl Work<'_, '_> {
                 }
                 // Streamed: the union-find fed block by block.
                 (None, _) => {
-                    let mut u = stages::CellUnion::new(cells.vertex_cell.len());
+                    let u = stages::CellUnion::new(cells.vertex_cell.len());
                     self.pts.blocks(&mut |_, faces| {
                         u.join_faces(&cells, faces);
                         Ok(())
