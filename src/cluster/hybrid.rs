@@ -2,8 +2,9 @@
 //! non-manifold edge taken apart) to an intermediate count, then the QEM rounds to the exact
 //! target from the clusters' quadrics (Garland & Shaffer's multiphase simplification, 2002).
 //! On `--backend gpu` the rounds run on the device from the same upload; the clustering stays
-//! on the CPU on both backends: its split of cells by connectivity is a union-find, and it is a
-//! tenth of the hybrid's time (docs/PERFORMANCE.md, "Clustering").
+//! on the CPU on both backends: its split of cells by connectivity is a union-find, and its
+//! repairs are worked out from the build before (docs/PERFORMANCE.md, "Speed against
+//! meshoptimizer").
 
 use super::grid::Grid;
 use super::{
