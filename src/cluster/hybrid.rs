@@ -518,15 +518,69 @@ mod tests {
         assert!(!border(&s).contains(&true));
     }
 
+    /// The cells' labels are each vertex's lowest in-cell component id, the same on one thread
+    /// and on eight, where big cells (tens of vertices each) make the threads link the same
+    /// trees at once.
+    #[test]
+    fn cell_labels_are_the_same_on_any_thread_count() {
+        use super::super::stages::{cell_keys, cell_labels, cell_ranges, radix_sort};
+        let mut m = crate::mesh::noisy_sphere(6, 0.02, 11);
+        // Two sides of a seam: coincident vertices, joined by position.
+        m.positions.push(m.positions[0]);
+        let (positions, lo, hi) = super::super::unit_frame_points(&m);
+        let grid = Grid::new(lo, hi, 0.04);
+        let keys = cell_keys(&grid, &positions, &vec![false; positions.len()]);
+        let (sorted, members) = radix_sort(&keys);
+        let cells = cell_ranges(&sorted, members);
+        let labels = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| cell_labels(&cells, &m.triangles, &positions))
+        };
+        let one = labels(1);
+        let v = positions.len() - 1;
+        assert_eq!(one[v], one[0], "coincident vertices are one component");
+        for (v, &l) in one.iter().enumerate() {
+            assert!(
+                l as usize <= v && one[l as usize] == l,
+                "vertex {v}: label {l}"
+            );
+            assert_eq!(cells.vertex_cell[v], cells.vertex_cell[l as usize]);
+        }
+        assert!(
+            one.iter()
+                .enumerate()
+                .filter(|&(v, &l)| l as usize != v)
+                .count()
+                > v / 2
+        );
+        for _ in 0..4 {
+            assert_eq!(labels(8), one);
+        }
+    }
+
     /// Taking clusters apart from the build before gives, bit for bit, what building again with
     /// their members locked gives: for any set of clusters (singletons among them), twice in a
-    /// row, on a painted sphere whose colour steps split cells and on a grid whose border is
-    /// locked from the start.
+    /// row, on a painted sphere whose colour steps split cells, on a grid whose border is
+    /// locked from the start, and on a sphere with repeated, reversed and degenerate faces
+    /// (whose clustered faces the deduplication drops).
     #[test]
     fn take_apart_equals_a_whole_build() {
         let mut painted = crate::mesh::noisy_sphere(5, 0.01, 7);
         crate::mesh::paint(&mut painted);
-        let cases = [(painted, false, 0.5), (crate::mesh::grid(60), true, 0.0)];
+        let mut repeated = crate::mesh::noisy_sphere(5, 0.01, 9);
+        let n = repeated.triangles.len();
+        for f in (0..n).step_by(7) {
+            let [a, b, c] = repeated.triangles[f];
+            repeated.triangles.extend([[a, b, c], [a, c, b], [a, a, b]]);
+        }
+        let cases = [
+            (painted, false, 0.5),
+            (crate::mesh::grid(60), true, 0.0),
+            (repeated, false, 0.0),
+        ];
         for (mesh, lock_border, color) in cases {
             let mut opts = SimplifyOptions::with_ratio(mesh.triangles.len(), 0.1).unwrap();
             opts.lock_border = lock_border;
