@@ -206,16 +206,11 @@ pub(super) fn cluster_repaired(
 /// members takes it out of the cell whole; every other cluster keeps its members, its box,
 /// its placement and its place in the order the clusters are numbered in (cells in key order,
 /// a cell's clusters by root, the locked vertices last in id order). Only the new singletons
-/// are placed, and the faces taken again. Measured on the 1M scan at 10%: a whole build took
+/// are placed, and the faces at them taken again ([`faces_taken_apart`]). Measured on the 1M scan at 10%: a whole build took
 /// 0.09 s of each of the two repairs' 0.12 s.
 fn take_apart(work: &mut Work, grid: &Grid, b: &Built, bad: &[u32]) -> Built {
-    use super::stages::{Surface, cluster_quadric};
+    use super::stages::cluster_quadric;
     use crate::compute::common::xyz;
-    let g = work
-        .gather
-        .as_ref()
-        .expect("taking clusters apart places singletons by the vertex→face lists");
-    let positions = &work.pts.positions;
     let mut is_bad = vec![false; b.clusters];
     for &k in bad {
         is_bad[k as usize] = true;
@@ -233,6 +228,7 @@ fn take_apart(work: &mut Work, grid: &Grid, b: &Built, bad: &[u32]) -> Built {
     }
     // The clusters that stay, in their order; a cell's clusters are consecutive, so counting
     // key changes counts the cells.
+    let positions = &work.pts.positions;
     let mut new_id = vec![u32::MAX; b.clusters];
     let mut placed = Vec::with_capacity(b.clusters);
     let mut cells = 0;
@@ -251,14 +247,9 @@ fn take_apart(work: &mut Work, grid: &Grid, b: &Built, bad: &[u32]) -> Built {
         }
     }
     let kept = placed.len();
-    let surface = Surface {
-        positions,
-        faces: &work.pts.faces,
-        planes: &g.planes,
-        csr: &g.csr,
-        border: &g.border,
-        border_weight: work.border_weight,
-    };
+    let surface = work
+        .surface()
+        .expect("taking clusters apart places singletons by the vertex→face lists");
     // A singleton's box is its vertex, as `build` gives it.
     placed.par_extend(singles.par_iter().map(|&(v, old)| {
         old.unwrap_or_else(|| {
@@ -279,7 +270,7 @@ fn take_apart(work: &mut Work, grid: &Grid, b: &Built, bad: &[u32]) -> Built {
     }
     let clusters = placed.len();
     Built {
-        faces: faces_taken_apart(work, b, &new_id, &singles, &vertex_cluster, clusters),
+        faces: faces_taken_apart(&surface, b, &new_id, &singles, &vertex_cluster, clusters),
         placed,
         vertex_cluster,
         clusters,
@@ -296,7 +287,7 @@ fn take_apart(work: &mut Work, grid: &Grid, b: &Built, bad: &[u32]) -> Built {
 /// this and [`origin_normals`]' lookup the hybrid at 1% took 0.334 s against 0.384 s (best of
 /// five interleaved in-process runs).
 fn faces_taken_apart(
-    work: &Work,
+    s: &super::stages::Surface,
     b: &Built,
     new_id: &[u32],
     singles: &[(u32, Option<super::stages::Placed>)],
@@ -304,15 +295,11 @@ fn faces_taken_apart(
     clusters: usize,
 ) -> Vec<(u32, [u32; 3])> {
     use super::stages::{dedupe_faces, rotated};
-    let g = work
-        .gather
-        .as_ref()
-        .expect("taken apart with vertex→face lists");
-    let faces = &work.pts.faces;
+    let faces = s.faces;
     let mut around: Vec<u32> = singles
         .iter()
-        .filter(|s| s.1.is_none())
-        .flat_map(|&(v, _)| g.csr.faces_of(v).iter().copied())
+        .filter(|single| single.1.is_none())
+        .flat_map(|&(v, _)| s.csr.faces_of(v).iter().copied())
         .collect();
     around.sort_unstable();
     around.dedup();

@@ -234,28 +234,17 @@ impl Work<'_, '_> {
                 (Some(q), Some(marked))
             }
         };
+        let surface = self.surface();
         let placed: Vec<Placed> = (0..clusters.len())
             .into_par_iter()
             .with_min_len(256)
             .map_init(Vec::new, |members, k| {
                 members.clear();
                 members.extend(clusters.members(&cells, label.as_deref(), k));
-                let (lo, hi) = boxes[k];
-                match (&self.gather, &scattered) {
-                    (Some(g), _) => {
-                        let surface = stages::Surface {
-                            positions: &self.pts.positions,
-                            faces: &self.pts.faces,
-                            planes: &g.planes,
-                            csr: &g.csr,
-                            border: &g.border,
-                            border_weight: self.border_weight,
-                        };
-                        stages::cluster_quadric(&surface, members, centre(k), lo, hi)
-                    }
-                    (None, Some(q)) => {
-                        stages::place(&self.pts.positions, q[k], members, centre(k), lo, hi)
-                    }
+                let ((lo, hi), o) = (boxes[k], centre(k));
+                match (&surface, &scattered) {
+                    (Some(s), _) => stages::cluster_quadric(s, members, o, lo, hi),
+                    (None, Some(q)) => stages::place(&self.pts.positions, q[k], members, o, lo, hi),
                     (None, None) => unreachable!("cluster quadrics scattered without a gather"),
                 }
             })
@@ -280,6 +269,19 @@ impl Work<'_, '_> {
 }
 
 impl Work<'_, '_> {
+    /// What [`stages::cluster_quadric`] reads; `None` without vertex→face lists (`cluster`).
+    fn surface(&self) -> Option<stages::Surface<'_>> {
+        let g = self.gather.as_ref()?;
+        Some(stages::Surface {
+            positions: &self.pts.positions,
+            faces: &self.pts.faces,
+            planes: &g.planes,
+            csr: &g.csr,
+            border: &g.border,
+            border_weight: self.border_weight,
+        })
+    }
+
     /// [`stages::scatter_quadrics`] over the faces' blocks (one block in memory: the same
     /// sums), block after block, the marked faces' ids made global.
     fn scatter(&self, vertex_cluster: &[u32], origins: &[V3]) -> Result<(Vec<Quadric>, Marked)> {
