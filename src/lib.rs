@@ -31,6 +31,7 @@
 
 #[cfg(feature = "bench")]
 pub mod bench;
+mod cache;
 #[cfg(feature = "cli")]
 pub mod cli;
 // Vertex clustering; public (hidden) for the tests of its stages.

@@ -2,6 +2,7 @@
 //! vertex, liveness, versions that retire stale queue entries, and the run's statistics.
 
 use super::prepare::Prepared;
+use crate::cache::{prefetch, prefetch_ptr};
 use crate::options::SimplifyOptions;
 
 /// The faces around each vertex, all in one arena: a vertex's list is `data[start..start + len]`
@@ -89,20 +90,6 @@ impl VertFaces {
     }
 }
 
-/// A hint that the cache line at `p` is read soon.
-#[inline(always)]
-fn prefetch(p: *const u8) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch is only a hint: it reads nothing the program sees and never faults,
-    // whatever the address (wrapping_add may point past an array's end); SSE is in every
-    // x86_64 target's baseline.
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(p as *const i8)
-    };
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = p;
-}
-
 /// `topo_faces` entry of a removed face. The hot loops test this instead of `face_alive`: the
 /// face's vertices are read next anyway, so liveness costs no extra cache line.
 pub(super) const DEAD: u32 = u32::MAX;
@@ -171,12 +158,14 @@ impl<'a> State<'a> {
     pub(super) fn prefetch_edge(&self, a: u32, b: u32) {
         for v in [a as usize, b as usize] {
             let faces = self.vert_faces.get(v);
-            prefetch(faces.as_ptr() as *const u8);
+            prefetch(faces, 0);
             for &f in faces.iter().take(8) {
-                prefetch(self.topo_faces.as_ptr().wrapping_add(f as usize) as *const u8);
+                prefetch(&self.topo_faces, f as usize);
+                // Read beside the corners by every moved face's normal check.
+                prefetch(&self.p.ref_normal, f as usize);
             }
             self.prefetch_vertex(v as u32);
-            prefetch(self.version.as_ptr().wrapping_add(v) as *const u8);
+            prefetch(&self.version, v);
         }
     }
 
@@ -184,11 +173,11 @@ impl<'a> State<'a> {
     #[inline]
     pub(super) fn prefetch_vertex(&self, v: u32) {
         let v = v as usize;
-        prefetch(self.p.pos.as_ptr().wrapping_add(v) as *const u8);
+        prefetch(&self.p.pos, v);
         // A quadric's 88 bytes span up to three lines.
         let q = self.p.quadrics.as_ptr().wrapping_add(v) as *const u8;
         for offset in [0, 64, std::mem::size_of::<crate::quadric::Quadric>() - 1] {
-            prefetch(q.wrapping_add(offset));
+            prefetch_ptr(q.wrapping_add(offset));
         }
     }
 
