@@ -109,10 +109,17 @@ pub fn probe_cells(grids: &[Grid], positions: &[[f32; 4]], locked: &[bool]) -> V
 pub fn probe_count(cells: &[[u32; 4]], faces: &[[u32; 3]]) -> [usize; 4] {
     faces
         .par_iter()
+        .enumerate()
         .with_min_len(4096)
         .fold(
             || [0usize; 4],
-            |mut acc, t| {
+            |mut acc, (f, t)| {
+                // The faces' corners are scattered over the vertices: asked for ahead.
+                if let Some(ahead) = faces.get(f + crate::cache::AHEAD) {
+                    for &v in ahead {
+                        crate::cache::prefetch(cells, v as usize);
+                    }
+                }
                 let [a, b, c] = t.map(|v| cells[v as usize]);
                 for i in 0..4 {
                     acc[i] += (a[i] != b[i] && b[i] != c[i] && a[i] != c[i]) as usize;

@@ -61,6 +61,11 @@ struct Points<'m> {
 /// build takes them, and their box: what the GPU tests and examples upload too.
 pub fn unit_frame_points(mesh: &Mesh) -> (Vec<[f32; 4]>, V3, V3) {
     let (center, scale) = frame_of(mesh);
+    points_in_frame(mesh, center, scale)
+}
+
+/// `mesh`'s positions as [`unit_frame_points`] gives them, in the frame `(center, scale)`.
+fn points_in_frame(mesh: &Mesh, center: [f64; 3], scale: f64) -> (Vec<[f32; 4]>, V3, V3) {
     let positions: Vec<[f32; 4]> = mesh
         .positions
         .par_iter()
@@ -105,7 +110,7 @@ impl<'m> Points<'m> {
     fn of(mesh: &Mesh, faces: std::borrow::Cow<'m, [[u32; 3]]>) -> Points<'m> {
         let (center, scale) = frame_of(mesh);
         let attr: Vec<u32> = (0..mesh.positions.len() as u32).collect();
-        let (positions, lo, hi) = unit_frame_points(mesh);
+        let (positions, lo, hi) = points_in_frame(mesh, center, scale);
         Points {
             positions,
             faces,

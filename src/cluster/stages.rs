@@ -6,6 +6,7 @@
 
 use super::grid::Grid;
 pub use super::grid::SINGLETON;
+use crate::cache::{AHEAD, prefetch};
 use crate::compute::common::{
     V3, add, cross, dot, length, quadric_add, quadric_eval, quadric_from_plane, quadric_shift,
     scale, sub, xyz,
@@ -494,6 +495,20 @@ pub fn scatter_quadrics(
             let mut acc = vec![Quadric::default(); n];
             let mut kept = Vec::new();
             for (i, t) in part.iter().enumerate() {
+                // The faces come in no spatial order: ask for a later face's vertices, and
+                // for a nearer one's clusters' sums, while this one is added. The 1M scan at
+                // 10%: 0.0163 -> 0.0129 s for this pass, best of 15 (same sums).
+                if let Some(ahead) = part.get(i + AHEAD) {
+                    for &v in ahead {
+                        prefetch(positions, v as usize);
+                        prefetch(vertex_cluster, v as usize);
+                    }
+                }
+                if let Some(near) = part.get(i + AHEAD / 2) {
+                    for &v in near {
+                        prefetch(&acc, vertex_cluster[v as usize] as usize);
+                    }
+                }
                 let k = t.map(|v| vertex_cluster[v as usize]);
                 if let Some(r) = rotated(k) {
                     kept.push(((ci * chunk + i) as u32, r));
