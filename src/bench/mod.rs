@@ -95,23 +95,29 @@ pub fn run(
         let diagonal = mesh.bounds().map_or(0.0, |b| b.diagonal());
         for &ratio in &targets {
             let target = SimplifyOptions::with_ratio(faces, ratio)?.target_faces;
-            for backend in &opts.backends {
-                let mut times = Vec::with_capacity(opts.repeat);
-                let mut peak: Option<u64> = None;
-                let mut out = None;
-                for _ in 0..opts.repeat {
-                    drop(out.take()); // the previous output is not part of this run's baseline
+            // The repeats take turns across the backends (each backend's first run, then each
+            // one's second, ...): a burst of load from elsewhere on the machine, or the page
+            // faults a call pays after another has freed its memory, then lands on every
+            // backend alike instead of on whichever ran during it, and the ratios between them
+            // hold from run to run.
+            let mut runs: Vec<Timed> = opts.backends.iter().map(|_| Timed::default()).collect();
+            for _ in 0..opts.repeat {
+                for (backend, run) in opts.backends.iter().zip(&mut runs) {
+                    drop(run.out.take()); // the previous output is not part of this run's baseline
                     let (result, bytes) = alloc::measure(|| {
                         let t = Instant::now();
                         let r = (backend.simplify)(mesh, target);
                         (r, t.elapsed().as_secs_f64())
                     });
                     let (simplified, seconds) = result;
-                    out = Some(simplified?);
-                    times.push(seconds);
-                    peak = bytes.map(|b| peak.map_or(b, |p| p.max(b)));
+                    run.out = Some(simplified?);
+                    run.times.push(seconds);
+                    run.peak = bytes.map(|b| run.peak.map_or(b, |p| p.max(b)));
                     step();
                 }
+            }
+            for (backend, run) in opts.backends.iter().zip(runs) {
+                let Timed { times, peak, out } = run;
                 let out = out.expect("repeat is at least 1");
                 let c = if out.face_count() == 0 {
                     None
@@ -162,6 +168,14 @@ pub fn run(
     })
 }
 
+/// One backend's timed runs of one case: their seconds, the largest peak, the last output.
+#[derive(Default)]
+struct Timed {
+    times: Vec<f64>,
+    peak: Option<u64>,
+    out: Option<Mesh>,
+}
+
 fn median(xs: &[f64]) -> f64 {
     let mut v = xs.to_vec();
     v.sort_by(f64::total_cmp);
@@ -182,6 +196,49 @@ mod tests {
     fn median_of_odd_and_even_counts() {
         assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
         assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+    }
+
+    /// Two backends that write down when they run, and the order a run of three repeats
+    /// calls them in: taking turns, each row still with its own three times.
+    #[test]
+    fn repeats_take_turns_across_the_backends() {
+        use std::sync::Mutex;
+        static CALLS: Mutex<Vec<&str>> = Mutex::new(Vec::new());
+        fn called(name: &'static str, m: &Mesh, faces: usize) -> Result<Mesh> {
+            CALLS.lock().unwrap().push(name);
+            Ok(crate::bench::meshopt_simplify(m, faces))
+        }
+        let backend = |name, simplify| BenchBackend {
+            name,
+            about: "",
+            simplify,
+            device: cpu_name,
+            band: 0.0,
+        };
+        let a: &'static BenchBackend = Box::leak(Box::new(backend("a", |m, f| called("a", m, f))));
+        let b: &'static BenchBackend = Box::leak(Box::new(backend("b", |m, f| called("b", m, f))));
+        let opts = BenchOptions {
+            ratios: vec![0.5],
+            backends: vec![a, b],
+            repeat: 3,
+            compare: CompareOptions {
+                samples: Some(100),
+                ..Default::default()
+            },
+        };
+        let report = run(
+            &[("ico".to_string(), mesh::icosphere(2))],
+            &opts,
+            &mut |_| {},
+        )
+        .unwrap();
+        assert_eq!(*CALLS.lock().unwrap(), ["a", "b", "a", "b", "a", "b"]);
+        let rows: Vec<(&str, usize)> = report
+            .rows
+            .iter()
+            .map(|r| (r.backend.as_str(), r.times_s.len()))
+            .collect();
+        assert_eq!(rows, [("a", 3), ("b", 3)]);
     }
 
     #[test]
