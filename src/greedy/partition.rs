@@ -84,9 +84,19 @@ pub(super) fn partitioned_level(
     assert_eq!(cuts.nt, nt, "cuts made for another mesh");
     let regions = cuts.regions;
     let nf = p.faces.len();
-    let region_of = |t: u32| cuts.region_of(t);
+    // Each vertex's region looked up, not worked out (two divisions) for every corner of every
+    // face and again at the write-back; both passes on every core. The 1M scan at 10%: the
+    // first level's marking 0.019 -> 0.005-0.006 s.
+    let vertex_region: Vec<u32> = (0..nt as u32)
+        .into_par_iter()
+        .with_min_len(1 << 14)
+        .map(|t| cuts.region_of(t))
+        .collect();
+    let region_of = |t: u32| vertex_region[t as usize];
     let face_topo = |f: usize| p.faces[f].map(|v| p.topo[v as usize]);
     let face_region: Vec<u32> = (0..nf)
+        .into_par_iter()
+        .with_min_len(1 << 14)
         .map(|f| {
             let r = face_topo(f).map(region_of);
             if r[0] == r[1] && r[1] == r[2] {
