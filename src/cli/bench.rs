@@ -15,12 +15,12 @@ use super::report::Progress;
 pub(super) const BENCH_AFTER_HELP: &str = "\
 Each mesh is simplified to each ratio by each backend, --repeat times, the backends taking
 turns run by run (so load from elsewhere on the machine falls on all of them alike); the table
-reports the median wall time of the simplify call, input triangles per second, the peak heap held during
-the call (counted by the binary's allocator, output included), and the two-sided Metro
-distance to the input (as 'meshslim compare'), mean and max, relative to its bounding-box
-diagonal. Without MESH it runs the deterministic 1M-triangle scan: ../shared/models/igea.ply
-subdivided once when present ($MESHSLIM_MODELS names another folder), else a procedural
-displaced sphere.
+reports the median wall time of the simplify call, input triangles per second, the peak heap
+held during the call (counted by the binary's allocator, output included), and the two-sided
+Metro distance to the input (as 'meshslim compare'), mean and max, relative to its
+bounding-box diagonal. Without MESH it runs the deterministic 1M-triangle scan:
+../shared/models/igea.ply subdivided once when present ($MESHSLIM_MODELS names another
+folder), else a procedural displaced sphere.
 
 Examples:
   # the benchmark: the 1M scan, every backend, ratios 0.5, 0.1 and 0.01

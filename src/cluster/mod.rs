@@ -75,27 +75,18 @@ fn points_in_frame(mesh: &Mesh, center: [f64; 3], scale: f64) -> (Vec<[f32; 4]>,
             [q[0] as f32, q[1] as f32, q[2] as f32, 1.0]
         })
         .collect();
+    let empty = || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    let grow = |(lo, hi): (V3, V3), (l, h): (V3, V3)| {
+        (
+            [0, 1, 2].map(|i| lo[i].min(l[i])),
+            [0, 1, 2].map(|i| hi[i].max(h[i])),
+        )
+    };
     let (lo, hi) = positions
         .par_iter()
         .with_min_len(4096)
-        .fold(
-            || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
-            |(lo, hi), p| {
-                (
-                    [0, 1, 2].map(|i| lo[i].min(p[i])),
-                    [0, 1, 2].map(|i| hi[i].max(p[i])),
-                )
-            },
-        )
-        .reduce(
-            || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
-            |a, b| {
-                (
-                    [0, 1, 2].map(|i| a.0[i].min(b.0[i])),
-                    [0, 1, 2].map(|i| a.1[i].max(b.1[i])),
-                )
-            },
-        );
+        .fold(empty, |b, p| grow(b, (xyz(*p), xyz(*p))))
+        .reduce(empty, grow);
     (positions, lo, hi)
 }
 
