@@ -206,8 +206,8 @@ pub(super) fn cluster_repaired(
 /// members takes it out of the cell whole; every other cluster keeps its members, its box,
 /// its placement and its place in the order the clusters are numbered in (cells in key order,
 /// a cell's clusters by root, the locked vertices last in id order). Only the new singletons
-/// are placed, and the faces at them taken again ([`faces_taken_apart`]). Measured on the 1M scan at 10%: a whole build took
-/// 0.09 s of each of the two repairs' 0.12 s.
+/// are placed, and the faces at them taken again ([`faces_taken_apart`]). Measured on the 1M
+/// scan at 10%: a whole build took 0.09 s of each of the two repairs' 0.12 s.
 fn take_apart(work: &mut Work, grid: &Grid, b: &Built, bad: &[u32]) -> Built {
     use super::stages::cluster_quadric;
     use crate::compute::common::xyz;
