@@ -5,9 +5,11 @@
 mod common;
 
 use common::*;
+use meshslim::compute::common::{length, sub, xyz};
 use meshslim::compute::types::*;
 use meshslim::options::AttributeWeights;
 use meshslim::rounds::cpu::CpuRounds;
+use meshslim::rounds::cpu::edge_costs::CounterField;
 use meshslim::rounds::gpu::{GpuRounds, GpuSimplifier};
 use meshslim::rounds::schedule::Buf;
 use meshslim::rounds::{RoundRunner, SELECTION_PASSES, Selection, Upload};
@@ -117,7 +119,7 @@ fn each_stage_matches_its_cpu_twin() {
         let g_norm: Vec<[f32; 4]> = pod(rd(Buf::FaceNormalsOut, 16 * nf));
         for (f, (g, c)) in g_norm.iter().zip(&cpu.face_normals).enumerate() {
             assert!(
-                (0..4).all(|k| close(g[k], c[k], 1e-4)),
+                unit_close(g, c, 1e-4),
                 "{name}: face_normals[{f}] {g:?} {c:?}"
             );
         }
@@ -151,10 +153,41 @@ fn each_stage_matches_its_cpu_twin() {
             .zip(&cpu.histogram)
             .map(|(g, c)| g.abs_diff(*c))
             .sum();
-        assert!(
-            moved_bins as usize * 1000 <= 2 * ne,
-            "{name}: {moved_bins} histogram counts differ over {ne} edges"
-        );
+        // An error's rounding on hardware: 1e-5 of its ends' quadrics' largest terms. With
+        // appearance channels an error is what is left of terms far larger than itself, and an
+        // H200 moved 58 counts of the painted torus's 3,456 edges.
+        let size: Vec<f32> = cpu
+            .quadrics
+            .iter()
+            .map(|q| q.q.iter().flatten().fold(0f32, |m, x| m.max(x.abs())))
+            .collect();
+        let rounding: Vec<f32> = cpu.edges[..ne]
+            .iter()
+            .map(|&[a, b]| 1e-5 * (size[a as usize] + size[b as usize]))
+            .collect();
+        let strict = rounds_like_the_cpu();
+        if strict {
+            assert!(
+                moved_bins as usize * 1000 <= 2 * ne,
+                "{name}: {moved_bins} histogram counts differ over {ne} edges"
+            );
+        } else {
+            // Each edge that moves takes a count from one bin to another: at most two per edge
+            // whose error is within its rounding of a bin's edge.
+            let bin_edge = |bin: u32| f32::from_bits(bin << HIST_SHIFT);
+            let near_an_edge = (0..ne)
+                .filter(|&e| errors[e].cost_bits != INVALID_COST)
+                .filter(|&e| {
+                    let x = f32::from_bits(errors[e].cost_bits);
+                    let bin = errors[e].cost_bits >> HIST_SHIFT;
+                    x - rounding[e] < bin_edge(bin) || x + rounding[e] >= bin_edge(bin + 1)
+                })
+                .count();
+            assert!(
+                moved_bins as usize <= 2 * near_an_edge,
+                "{name}: {moved_bins} histogram counts differ, {near_an_edge} edges near a bin edge"
+            );
+        }
         assert_eq!(
             g_hist.iter().sum::<u32>(),
             cpu.histogram.iter().sum::<u32>(),
@@ -177,19 +210,33 @@ fn each_stage_matches_its_cpu_twin() {
             g_live.windows(2).all(|w| w[0] < w[1]),
             "{name}: an edge listed twice"
         );
-        let listed_once = g_live
+        let mut listed_once: Vec<u32> = g_live
             .iter()
             .filter(|e| cpu.live.binary_search(e).is_err())
-            .count()
-            + cpu
-                .live
-                .iter()
-                .filter(|e| g_live.binary_search(e).is_err())
-                .count();
-        assert!(
-            listed_once <= moved_bins as usize,
-            "{name}: {listed_once} edges listed on one side only"
-        );
+            .copied()
+            .collect();
+        listed_once.extend(cpu.live.iter().filter(|e| g_live.binary_search(e).is_err()));
+        if strict {
+            assert!(
+                listed_once.len() <= moved_bins as usize,
+                "{name}: {} edges listed on one side only",
+                listed_once.len()
+            );
+        } else {
+            // On hardware more edges change bins, some both ways (their moves cancel in the
+            // histogram: an H200 listed 10 of the double torus's on one side only, its flat
+            // faces' errors all rounding noise), so each is held to the ceiling on its own:
+            // its error within rounding of the ceiling, 1e-5 of its ends' quadrics' largest
+            // terms, as for the costs below.
+            let ceiling = f32::from_bits(gc.ceiling);
+            for &e in &listed_once {
+                let error = f32::from_bits(errors[e as usize].cost_bits);
+                assert!(
+                    (error - ceiling).abs() <= rounding[e as usize],
+                    "{name}: edge {e} of error {error} listed on one side of the ceiling {ceiling}"
+                );
+            }
+        }
         assert!(
             g_live
                 .iter()
@@ -219,16 +266,33 @@ fn each_stage_matches_its_cpu_twin() {
                 continue;
             }
             if g.cost_bits != INVALID_COST {
-                assert_eq!((g.keep, g.remove), (c.keep, c.remove), "{name}: edge {e}");
+                // Which end survives is a comparison too: on hardware two ends of (nearly) the
+                // same cost may trade places (an H200, on the icosphere's symmetric ends), and
+                // then the candidates sit at different ends; the cost still has to agree.
+                let swapped = (g.keep, g.remove) == (c.remove, c.keep);
+                if strict || !swapped {
+                    assert_eq!((g.keep, g.remove), (c.keep, c.remove), "{name}: edge {e}");
+                }
                 let (gc, cc) = (f32::from_bits(g.cost_bits), f32::from_bits(c.cost_bits));
                 assert!(
                     close(gc, cc, 1e-3) || gc.max(cc) < 1e-12 || (gc - cc).abs() <= floor(e),
                     "{name}: cost of edge {e}: {gc} vs {cc} (floor {})",
                     floor(e)
                 );
+                // On hardware the solve's rounding shows, stretched by the quadric's condition
+                // along its flattest direction: within 1% of the edge (the cost, above, holds
+                // the position to the CPU's optimum; another candidate is half an edge away).
+                let [a, b] = cpu.edges[e].map(|v| xyz(cpu.positions[v as usize]));
+                let within = if strict {
+                    1e-5
+                } else {
+                    1e-2 * length(sub(a, b))
+                };
                 assert!(
-                    (0..3).all(|k| (g.pos[k] - c.pos[k]).abs() < 1e-5),
-                    "{name}: position of edge {e}"
+                    swapped || (0..3).all(|k| (g.pos[k] - c.pos[k]).abs() < within),
+                    "{name}: position of edge {e}: {:?} on the GPU, {:?} on the CPU",
+                    g.pos,
+                    c.pos
                 );
             }
         }
@@ -245,14 +309,39 @@ fn each_stage_matches_its_cpu_twin() {
             }
         }
         cpu.candidates = g_cand;
+        // The list's length with it: where an edge was listed on one side only (hardware), the
+        // CPU's own count would leave the GPU's last listed edges out of its passes.
+        cpu.counters[CounterField::Live as usize] = g_live.len() as u32;
         cpu.live = g_live;
         // select_cost, select_id, select_win, validate, and the trim stages.
         cpu.select(&p, Selection::Ordinary).unwrap();
         let g_state = pod::<u32>(rd(Buf::EdgeState, 4 * ne));
-        assert_eq!(
-            g_state, cpu.edge_state,
-            "{name}: edge_state after selection"
-        );
+        if g_state != cpu.edge_state {
+            // Each differing edge with what decided it: its ends' locks, its listing and cost.
+            let g_lock = pod::<u32>(rd(Buf::VertexLock, 4 * nv));
+            let differ: Vec<String> = (0..ne)
+                .filter(|&e| g_state[e] != cpu.edge_state[e])
+                .take(8)
+                .map(|e| {
+                    let [a, b] = cpu.edges[e];
+                    let lock = |l: &[u32]| [l[a as usize], l[b as usize]];
+                    format!(
+                        "edge {e} ({a}, {b}): state {} on the GPU, {} on the CPU; locks {:?} and \
+                         {:?}; listed {}; cost bits {:#x}",
+                        g_state[e],
+                        cpu.edge_state[e],
+                        lock(&g_lock),
+                        lock(&cpu.vertex_lock),
+                        cpu.live.binary_search(&(e as u32)).is_ok(),
+                        cpu.candidates[e].cost_bits
+                    )
+                })
+                .collect();
+            panic!(
+                "{name}: edge_state after selection, of {ne} edges:\n{}",
+                differ.join("\n")
+            );
+        }
         // collapse relies on it (the CPU rounds check it on their own state every round).
         let shared = meshslim::rounds::cpu::select::shared_face(
             &cpu.offsets,
@@ -355,6 +444,56 @@ fn each_stage_matches_its_cpu_twin() {
     }
 }
 
+/// `gpu`'s output `g` of `input` against `cpu-parallel`'s `c`. Where the adapter rounds as the
+/// CPU (lavapipe) the same surface and colours: within 1e-4 of the diagonal, colours within 1e-3.
+/// Elsewhere a near-tie can go the other way and the rounds then take other collapses, as good:
+/// the error against the input (surface, and colour on a painted mesh) within 25% of the twin's,
+/// or 1e-6 of the diagonal. That is the spread of `cpu-parallel` itself: with every input
+/// coordinate moved by at most an ulp (11 draws), its error on the torus at 1% ranged over
+/// 0.93–1.11 of the unmoved input's, and an H200's was 1.12 of it (icosphere at 1%: 0.90–1.00,
+/// the H200 0.94).
+fn agrees_with_cpu_parallel(label: &str, input: &Mesh, g: &Mesh, c: &Mesh) {
+    let compare = |a, b| meshslim::metrics::compare(a, b, &Default::default()).unwrap();
+    let colour = |d: &meshslim::metrics::Comparison| {
+        d.appearance
+            .as_ref()
+            .and_then(|a| a.color.as_ref())
+            .map(|c| c.mean)
+    };
+    let d = compare(c, g);
+    if rounds_like_the_cpu() {
+        let apart = d.distance.two_sided.mean_rel;
+        assert!(
+            apart < 1e-4,
+            "{label}: {apart:.2e} of the diagonal from cpu-parallel"
+        );
+        if let Some(colour) = colour(&d) {
+            assert!(colour < 1e-3, "{label}: colours differ by {colour}");
+        }
+        return;
+    }
+    let (dg, dc) = (compare(input, g), compare(input, c));
+    let (eg, ec) = (
+        dg.distance.two_sided.mean_rel,
+        dc.distance.two_sided.mean_rel,
+    );
+    eprintln!(
+        "{label}: error {eg:.3e} on the GPU, {ec:.3e} on cpu-parallel, {:.2e} apart",
+        d.distance.two_sided.mean_rel
+    );
+    assert!(
+        eg <= 1.25 * ec + 1e-6,
+        "{label}: error {eg:.3e}, cpu-parallel's {ec:.3e}"
+    );
+    if let (Some(cg), Some(cc)) = (colour(&dg), colour(&dc)) {
+        eprintln!("{label}: colour error {cg:.3e} on the GPU, {cc:.3e} on cpu-parallel");
+        assert!(
+            cg <= 1.25 * cc + 1e-6,
+            "{label}: colour error {cg:.3e}, cpu-parallel's {cc:.3e}"
+        );
+    }
+}
+
 fn run(m: &Mesh, backend: Backend, ratio: f64) -> (Mesh, meshslim::SimplifyReport) {
     let mut o = SimplifyOptions::with_ratio(m.triangles.len(), ratio).unwrap();
     o.backend = backend;
@@ -378,12 +517,7 @@ fn pipeline_keeps_invariants_and_agrees_with_cpu_parallel() {
                 "{label}: face count vs cpu-parallel"
             );
             assert_eq!(gr.stop_reason, cr.stop_reason, "{label}");
-            let d = meshslim::metrics::compare(&c, &g, &Default::default()).unwrap();
-            assert!(
-                d.distance.two_sided.mean_rel < 1e-4,
-                "{label}: two-sided distance to cpu-parallel {:.2e} of the diagonal",
-                d.distance.two_sided.mean_rel
-            );
+            agrees_with_cpu_parallel(&label, &m, &g, &c);
         }
     }
 }
@@ -403,10 +537,7 @@ fn gpu_weighs_colours_like_cpu_parallel() {
         check_invariants(&label, &m, &g, &gr);
         let (c, _) = run(&m, Backend::CpuParallel, ratio);
         assert_eq!(g.triangles.len(), c.triangles.len(), "{label}");
-        let d = meshslim::metrics::compare(&c, &g, &Default::default()).unwrap();
-        assert!(d.distance.two_sided.mean_rel < 1e-4, "{label}: {d:?}");
-        let colour = d.appearance.unwrap().color.unwrap().mean;
-        assert!(colour < 1e-3, "{label}: colours differ by {colour}");
+        agrees_with_cpu_parallel(&label, &m, &g, &c);
         let off = {
             let mut o = SimplifyOptions::with_ratio(m.triangles.len(), ratio).unwrap();
             o.backend = Backend::Gpu;

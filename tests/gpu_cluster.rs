@@ -6,14 +6,14 @@ mod cluster_twins;
 mod common;
 
 use cluster_twins as twins;
-use common::{close, gpu_context, pod};
+use common::{gpu_context, pod, unit_close};
 use meshslim::Mesh;
 use meshslim::cluster::gpu::{GpuClusterMesh, GpuClusterer, Part};
 use meshslim::cluster::gpu_schedule::CBuf;
 use meshslim::cluster::grid::Grid;
 use meshslim::cluster::stages::{self, Placement};
 use meshslim::compute::common::quadric_eval;
-use meshslim::compute::types::{ClusterPlaced, Quadric, SORT_BLOCK};
+use meshslim::compute::types::{ClusterPlaced, SORT_BLOCK};
 
 /// Meshes, each with the cell sizes to cluster it at and whether to lock some vertices (every
 /// 7th: singleton keys, the fourth radix pass).
@@ -40,40 +40,6 @@ fn cases() -> Vec<(&'static str, Mesh, Vec<f32>, bool)> {
 
 fn locked_of(n: usize, lock: bool) -> Vec<bool> {
     (0..n).map(|v| lock && v % 7 == 0).collect()
-}
-
-fn check_placed(
-    label: &str,
-    g: &[ClusterPlaced],
-    c: &[ClusterPlaced],
-    gq: &[Quadric],
-    cq: &[Quadric],
-) {
-    assert_eq!(g.len(), c.len(), "{label}: clusters");
-    let mut kinds_differ = 0;
-    for k in 0..g.len() {
-        let (a, b) = (g[k], c[k]);
-        assert!(
-            (0..3).all(|i| close(a.pos[i], b.pos[i], 1e-4, 1e-3)),
-            "{label}: cluster {k} at {:?} on the GPU, {:?} on the CPU",
-            a.pos,
-            b.pos
-        );
-        if (a.attr, a.how) != (b.attr, b.how) {
-            kinds_differ += 1;
-        }
-        let scale = cq[k].q.iter().flatten().fold(0f32, |m, x| m.max(x.abs()));
-        let flat = |q: &Quadric| q.q.iter().flatten().copied().collect::<Vec<f32>>();
-        let (fa, fb) = (flat(&gq[k]), flat(&cq[k]));
-        assert!(
-            fa.iter().zip(&fb).all(|(&x, &y)| close(x, y, 1e-4, scale)),
-            "{label}: cluster {k}'s quadric {fa:?} on the GPU, {fb:?} on the CPU"
-        );
-    }
-    assert_eq!(
-        kinds_differ, 0,
-        "{label}: placements or attribute members differ"
-    );
 }
 
 #[test]
@@ -105,8 +71,8 @@ fn each_cluster_stage_matches_its_cpu_twin() {
             let normals: Vec<[f32; 4]> = pod(rd(&gpu, CBuf::FaceNormals, 16 * nf));
             for (f, (a, b)) in normals.iter().zip(&cpu.face_normals).enumerate() {
                 assert!(
-                    (0..4).all(|i| close(a[i], b[i], 1e-4, 1e-6)),
-                    "{label}: face_normals[{f}]"
+                    unit_close(a, b, 1e-4),
+                    "{label}: face_normals[{f}] {a:?} {b:?}"
                 );
             }
             gpu.set_grid(&grid);
@@ -193,12 +159,13 @@ fn each_cluster_stage_matches_its_cpu_twin() {
                 "{label}: the driver's cell_ranges"
             );
             gpu.run_part(Part::Quadrics).unwrap();
-            check_placed(
+            twins::check_placed(
                 &label,
                 &pod(rd(&gpu, CBuf::ClusterPlaced, 32 * cells)),
                 &cpu.cluster_placed,
                 &pod(rd(&gpu, CBuf::ClusterQuadric, 48 * cells)),
                 &cpu.cluster_quadric,
+                grid.h,
             );
             gpu.run_part(Part::Faces).unwrap();
             assert_eq!(
@@ -477,6 +444,18 @@ fn hybrid_on_the_gpu_writes_the_cpu_parallel_mesh() {
         assert_eq!(cg.intermediate_faces, cc.intermediate_faces);
         assert!(gpu.triangles.len().abs_diff(target) <= 2, "target {target}");
         assert_eq!(cpu.triangles, gpu.triangles, "target {target}");
-        assert_eq!(cpu.positions, gpu.positions, "target {target}");
+        if common::rounds_like_the_cpu() {
+            assert_eq!(cpu.positions, gpu.positions, "target {target}");
+            continue;
+        }
+        // Elsewhere to rounding: an H200, which fuses the solves' multiply-adds, was 6e-8 off
+        // on this unit sphere.
+        assert_eq!(cpu.positions.len(), gpu.positions.len(), "target {target}");
+        for (v, (a, b)) in cpu.positions.iter().zip(&gpu.positions).enumerate() {
+            assert!(
+                (0..3).all(|i| (a[i] - b[i]).abs() <= 1e-5),
+                "target {target}: vertex {v} at {a:?} on the CPU, {b:?} on the GPU"
+            );
+        }
     }
 }

@@ -51,37 +51,6 @@ fn rd<T: bytemuck::Pod>(g: &GpuClusterMesh, b: CBuf, n: usize) -> Vec<T> {
     bytemuck::pod_collect_to_vec(&bytes)
 }
 
-fn check_placed(
-    label: &str,
-    g: &[ClusterPlaced],
-    c: &[ClusterPlaced],
-    gq: &[Quadric],
-    cq: &[Quadric],
-) {
-    assert_eq!(g.len(), c.len(), "{label}: clusters");
-    for k in 0..g.len() {
-        let (a, b) = (g[k], c[k]);
-        assert!(
-            (0..3).all(|i| close(a.pos[i], b.pos[i], 1e-4, 1e-3)),
-            "{label}: cluster {k} at {:?} on the GPU, {:?} on the CPU",
-            a.pos,
-            b.pos
-        );
-        assert_eq!(
-            (a.attr, a.how),
-            (b.attr, b.how),
-            "{label}: cluster {k}'s placement"
-        );
-        let scale = cq[k].q.iter().flatten().fold(0f32, |m, x| m.max(x.abs()));
-        let flat = |q: &Quadric| q.q.iter().flatten().copied().collect::<Vec<f32>>();
-        let (fa, fb) = (flat(&gq[k]), flat(&cq[k]));
-        assert!(
-            fa.iter().zip(&fb).all(|(&x, &y)| close(x, y, 1e-4, scale)),
-            "{label}: cluster {k}'s quadric {fa:?} on the GPU, {fb:?} on the CPU"
-        );
-    }
-}
-
 /// Runs the sort passes `0..passes` on the GPU and checks the result against the twins' sort of
 /// the keys and values it started from; returns the sorted keys and values.
 fn sort_on_both(
@@ -155,10 +124,17 @@ fn each_floating_stage_matches_its_cpu_twin() {
         ft::fc_grades(&params, &pos, indices, &offsets, &vertex_faces, &mut want);
         let exact = grades.iter().zip(&want).filter(|(a, b)| a == b).count();
         eprintln!("{name}: {exact} of {nv} grades bit for bit");
+        // The grade is L·√((1 + cos θ)/2), L the longest edge: compared as the cosine it stands
+        // for, since near θ = 180° (a flat vertex) the root magnifies a cosine's rounding, an ulp
+        // of 1, into 2.4e-4 L. Within 32 ulps of 1: the GPU may divide to 2.5 ulps and fuse the
+        // dot product (an H200's grade of a noisy icosphere vertex: 3.5778e-5 against the CPU's
+        // 3.5662e-5, a cosine 1.4e-7 apart).
         for v in 0..nv {
+            let longest = longest_edge(&pos, &m.triangles, &offsets, &vertex_faces, v);
+            let cosine = |g: f32| 2.0 * (g as f64 / longest.max(f32::MIN_POSITIVE) as f64).powi(2);
             assert!(
-                close(grades[v], want[v], 1e-4, 1e-6),
-                "{name}: grade of {v}: {} on the GPU, {} on the CPU",
+                (cosine(grades[v]) - cosine(want[v])).abs() <= 32.0 * f32::EPSILON as f64,
+                "{name}: grade of {v}: {} on the GPU, {} on the CPU (longest edge {longest})",
                 grades[v],
                 want[v]
             );
@@ -343,12 +319,13 @@ fn each_floating_stage_matches_its_cpu_twin() {
                 &mut placed,
                 &mut quadric,
             );
-            check_placed(
+            twins::check_placed(
                 &label,
                 &rd(&gpu, CBuf::ClusterPlaced, clusters),
                 &placed,
                 &rd(&gpu, CBuf::ClusterQuadric, clusters),
                 &quadric,
+                r,
             );
 
             gpu.run_part(Part::Faces).unwrap();
@@ -397,6 +374,24 @@ fn the_floating_twins_are_the_cpu_driver() {
     }
 }
 
+/// The longest edge at `v`, which scales its grade (`floating::grade`): a grade near 0 is a
+/// square root of 1 + cos θ near 0, where a cosine's rounding (an ulp of 1) shows.
+fn longest_edge(
+    pos: &[[f32; 4]],
+    faces: &[[u32; 3]],
+    offsets: &[u32],
+    vertex_faces: &[u32],
+    v: usize,
+) -> f32 {
+    let corner = |u: u32| meshslim::compute::common::xyz(pos[u as usize]);
+    vertex_faces[offsets[v] as usize..offsets[v + 1] as usize]
+        .iter()
+        .flat_map(|&f| faces[f as usize])
+        .map(|u| meshslim::compute::common::sub(corner(u), corner(v as u32)))
+        .map(meshslim::compute::common::length)
+        .fold(0.0, f32::max)
+}
+
 /// The ranks the device makes for `pos`, against the CPU's: how many differ. The grades take a
 /// square root and divisions, which Vulkan does not round correctly everywhere (nor forbid fused
 /// multiply-adds): on lavapipe every grade of these meshes is the CPU's bit for bit, so none;
@@ -412,9 +407,11 @@ fn ranks_differing(gpu: &mut GpuClusterMesh, pos: &[[f32; 4]], faces: &[[u32; 3]
         .count()
 }
 
-/// The whole GPU build against the twins' chain: with the same ranks (lavapipe), the same
-/// rounds, clusters and faces, vertices within rounding; on a device whose ranks differ, faces
-/// within 5% of the twins'. Twice the same bits either way.
+/// The whole GPU build against the twins' chain from the device's own grades: the same rounds,
+/// clusters and faces, vertices within rounding, twice the same bits. On lavapipe those grades
+/// are the CPU's; elsewhere they may round otherwise (an H200: 2,642 of the grid's ranks
+/// differ), and a chain from the CPU's grades claims other centres (there 3,289 faces against
+/// 2,619), so the grades are compared on their own (`each_floating_stage_matches_its_cpu_twin`).
 #[test]
 fn the_gpu_floating_build_equals_the_twins_chain() {
     let Some(ctx) = gpu_context() else { return };
@@ -424,6 +421,10 @@ fn the_gpu_floating_build_equals_the_twins_chain() {
         let locked = locked_of(pos.len(), lock);
         let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
         let differ = ranks_differing(&mut gpu, &pos, &m.triangles);
+        if differ > 0 {
+            eprintln!("{name}: {differ} ranks differ from the CPU's on this device");
+        }
+        let grades: Vec<f32> = rd(&gpu, CBuf::FcGrade, pos.len());
         for r in radii {
             let label = format!("{name} at r = {r}");
             let (g, rounds) = gpu.build_floating(lo, hi, r).unwrap();
@@ -436,17 +437,8 @@ fn the_gpu_floating_build_equals_the_twins_chain() {
                     .all(|(a, b)| a.pos == b.pos && a.quadric == b.quadric),
                 "{label}: the same vertices twice, bit for bit"
             );
-            let twin = ft::run(&pos, &m.triangles, &locked, lo, hi, r);
+            let twin = ft::run_from(&pos, &m.triangles, &locked, lo, hi, r, Some(&grades));
             let t = twin.result();
-            if differ > 0 {
-                eprintln!("{label}: {differ} ranks differ from the CPU's on this device");
-                let (a, b) = (g.faces.len() as f64, t.faces.len() as f64);
-                assert!(
-                    (a - b).abs() <= 0.05 * b,
-                    "{label}: {a} faces, the twins {b}"
-                );
-                continue;
-            }
             assert_eq!(rounds, twin.rounds.len(), "{label}: rounds");
             assert_eq!(g.vertex_cluster, t.vertex_cluster, "{label}: clusters");
             assert_eq!(g.faces, t.faces, "{label}: faces");

@@ -281,6 +281,20 @@ pub fn run(
     hi: V3,
     r: f32,
 ) -> FloatBuild {
+    run_from(positions, faces, locked, lo, hi, r, None)
+}
+
+/// [`run`], from `grades` in place of `fc_grades`' when given: a device's own, so that the
+/// rest of its build, all integers and sums, can be compared with the twins' exactly.
+pub fn run_from(
+    positions: &[[f32; 4]],
+    faces: &[[u32; 3]],
+    locked: &[bool],
+    lo: V3,
+    hi: V3,
+    r: f32,
+    given: Option<&[f32]>,
+) -> FloatBuild {
     let (nv, nf) = (positions.len(), faces.len());
     let indices: &[u32] = bytemuck::cast_slice(faces);
     let csr = Csr::new(nv, faces);
@@ -303,6 +317,9 @@ pub fn run(
         &csr.vertex_faces,
         &mut grades,
     );
+    if let Some(given) = given {
+        grades.copy_from_slice(given);
+    }
     let (mut ranks, mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv], vec![0u32; nv]);
     fc_ranks(&params, &grades, &mut ranks, &mut keys, &mut vals);
     let rank_passes = twins::sort(&keys, &vals, RANK_PASSES);

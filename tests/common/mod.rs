@@ -364,10 +364,26 @@ pub fn gpu_context() -> Option<&'static meshslim::compute::context::GpuContext> 
     }
 }
 
+/// The adapter rounds every f32 operation of the WGSL as the CPU twins do: lavapipe (LLVM),
+/// which CI runs, where the tests below compare bit for bit. Hardware GPUs fuse multiply-adds and
+/// round division and square roots their own way (WGSL allows both): there a cost an ulp apart
+/// can pick another of two near-equal collapses, and the tests compare to rounding and quality.
+pub fn rounds_like_the_cpu() -> bool {
+    gpu_context().is_some_and(|c| c.adapter_name.to_lowercase().contains("llvmpipe"))
+}
+
 /// Within `tol` of the larger magnitude, or of `scale` when both are smaller (a sum's entry that
 /// cancels to near zero is as exact as the sum's largest term allows).
 pub fn close(a: f32, b: f32, tol: f32, scale: f32) -> bool {
     (a - b).abs() <= tol * a.abs().max(b.abs()).max(scale).max(1e-30)
+}
+
+/// A face's unit normal and area within `tol`: the normal's components of the vector's length
+/// (1), the area of itself. A component that cancels to near zero carries the rounding of the
+/// cross product's terms, whose size is the normal's: an H200, which fuses the cross product's
+/// multiply-adds, wrote -5.6e-9 where the CPU wrote 0.
+pub fn unit_close(a: &[f32; 4], b: &[f32; 4], tol: f32) -> bool {
+    (0..3).all(|k| (a[k] - b[k]).abs() <= tol) && close(a[3], b[3], tol, 0.0)
 }
 
 /// A GPU buffer's bytes as `T`s.
