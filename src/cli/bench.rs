@@ -14,7 +14,8 @@ use super::report::Progress;
 
 pub(super) const BENCH_AFTER_HELP: &str = "\
 Each mesh is simplified to each ratio by each backend, --repeat times, the backends taking
-turns run by run (so load from elsewhere on the machine falls on all of them alike); the table
+turns run by run (so load from elsewhere on the machine falls on all of them alike), each call
+starting from a cold cache (none inherits the data the one before it read); the table
 reports the median wall time of the simplify call, input triangles per second, the peak heap
 held during the call (counted by the binary's allocator, output included), and the two-sided
 Metro distance to the input (as 'meshslim compare'), mean and max, relative to its
