@@ -352,7 +352,7 @@ fn the_floating_twins_are_the_cpu_driver() {
         let csr = stages::Csr::new(pos.len(), &m.triangles);
         let ranks = floating::ranks(&floating::grades(&pos, &m.triangles, &csr));
         for r in radii {
-            let twin = ft::run(&pos, &m.triangles, &locked, lo, hi, r);
+            let twin = ft::run(&pos, &m.triangles, &locked, lo, hi, r, None);
             assert_eq!(
                 twin.ranks,
                 ranks.iter().map(|&x| (x >> 32) as u32).collect::<Vec<_>>(),
@@ -437,7 +437,7 @@ fn the_gpu_floating_build_equals_the_twins_chain() {
                     .all(|(a, b)| a.pos == b.pos && a.quadric == b.quadric),
                 "{label}: the same vertices twice, bit for bit"
             );
-            let twin = ft::run_from(&pos, &m.triangles, &locked, lo, hi, r, Some(&grades));
+            let twin = ft::run(&pos, &m.triangles, &locked, lo, hi, r, Some(&grades));
             let t = twin.result();
             assert_eq!(rounds, twin.rounds.len(), "{label}: rounds");
             assert_eq!(g.vertex_cluster, t.vertex_cluster, "{label}: clusters");

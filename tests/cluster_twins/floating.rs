@@ -272,21 +272,10 @@ pub struct FloatBuild {
 }
 
 /// The whole floating-cell build at nominal radius `r` through the twins, stage by stage, in
-/// the unit frame's box `[lo, hi]`.
+/// the unit frame's box `[lo, hi]`; from `given` grades in place of `fc_grades`' when given (a
+/// device's own, so that the rest of its build, all integers and sums, can be compared with the
+/// twins' exactly).
 pub fn run(
-    positions: &[[f32; 4]],
-    faces: &[[u32; 3]],
-    locked: &[bool],
-    lo: V3,
-    hi: V3,
-    r: f32,
-) -> FloatBuild {
-    run_from(positions, faces, locked, lo, hi, r, None)
-}
-
-/// [`run`], from `grades` in place of `fc_grades`' when given: a device's own, so that the
-/// rest of its build, all integers and sums, can be compared with the twins' exactly.
-pub fn run_from(
     positions: &[[f32; 4]],
     faces: &[[u32; 3]],
     locked: &[bool],
