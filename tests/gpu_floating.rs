@@ -9,7 +9,7 @@ mod common;
 
 use cluster_twins as twins;
 use cluster_twins::floating as ft;
-use common::{close, gpu_context};
+use common::{close, gpu_context, rounds_like_the_cpu};
 use meshslim::Mesh;
 use meshslim::cluster::floating::{self, UNCLAIMED};
 use meshslim::cluster::floating_gpu::FcPart;
@@ -124,6 +124,12 @@ fn each_floating_stage_matches_its_cpu_twin() {
         ft::fc_grades(&params, &pos, indices, &offsets, &vertex_faces, &mut want);
         let exact = grades.iter().zip(&want).filter(|(a, b)| a == b).count();
         eprintln!("{name}: {exact} of {nv} grades bit for bit");
+        if rounds_like_the_cpu() {
+            assert_eq!(
+                exact, nv,
+                "{name}: lavapipe's grades are the CPU's bit for bit"
+            );
+        }
         // The grade is L·√((1 + cos θ)/2), L the longest edge: compared as the cosine it stands
         // for, since near θ = 180° (a flat vertex) the root magnifies a cosine's rounding, an ulp
         // of 1, into 2.4e-4 L. Within 32 ulps of 1: the GPU may divide to 2.5 ulps and fuse the
