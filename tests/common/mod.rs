@@ -369,7 +369,11 @@ pub fn gpu_context() -> Option<&'static meshslim::compute::context::GpuContext> 
 /// round division and square roots their own way (WGSL allows both): there a cost an ulp apart
 /// can pick another of two near-equal collapses, and the tests compare to rounding and quality.
 pub fn rounds_like_the_cpu() -> bool {
-    gpu_context().is_some_and(|c| c.adapter_name.to_lowercase().contains("llvmpipe"))
+    // Asked once per face by `unit_close`: the adapter's name is looked at once per process.
+    static LAVAPIPE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *LAVAPIPE.get_or_init(|| {
+        gpu_context().is_some_and(|c| c.adapter_name.to_lowercase().contains("llvmpipe"))
+    })
 }
 
 /// Within `tol` of the larger magnitude, or of `scale` when both are smaller (a sum's entry that
