@@ -140,7 +140,7 @@ fn bad_usage_exits_2() {
     expect_code(&o, 2);
     assert!(
         String::from_utf8_lossy(&o.stderr)
-            .contains("cpu, cpu-parallel, gpu, cluster, cluster-gpu, floating-cell, floating-cell-gpu, decimate, hybrid, hybrid-gpu, meshopt, meshopt-attr-0.1, meshopt-attr-0.3, meshopt-attr-1, meshopt-sloppy"),
+            .contains("cpu, cpu-parallel, gpu, cluster, cluster-gpu, floating-cell, floating-cell-gpu, decimate, hybrid, hybrid-parallel, hybrid-gpu, meshopt, meshopt-attr-0.1, meshopt-attr-0.3, meshopt-attr-1, meshopt-sloppy"),
         "the error lists the backends"
     );
 }

@@ -84,7 +84,14 @@ pub static BACKENDS: &[BenchBackend] = &[
     },
     BenchBackend {
         name: "hybrid",
-        about: "meshslim's clustering to 2x the target + 20k faces, then the rounds (cpu-parallel)",
+        about: "meshslim's clustering to 2x the target + 20k faces, then the greedy queue (cpu)",
+        simplify: |m, faces| ours(m, faces, Method::Hybrid, Backend::Cpu),
+        device: cpu_name,
+        band: 0.0,
+    },
+    BenchBackend {
+        name: "hybrid-parallel",
+        about: "meshslim's hybrid with the rounds (cpu-parallel), the CPU twin of hybrid-gpu",
         simplify: |m, faces| ours(m, faces, Method::Hybrid, Backend::CpuParallel),
         device: cpu_name,
         band: 0.0,

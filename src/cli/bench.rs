@@ -44,8 +44,9 @@ pub struct BenchArgs {
     pub ratios: Vec<f64>,
 
     /// Backends to run, comma-separated: cpu (meshslim's greedy), cpu-parallel and gpu (its
-    /// rounds), cluster, floating-cell and hybrid (--method), each also as NAME-gpu, decimate,
-    /// meshopt (meshoptimizer's simplify), meshopt-sloppy (its clustering simplifySloppy)
+    /// rounds), cluster, floating-cell and hybrid (--method), each also as NAME-gpu,
+    /// hybrid-parallel (hybrid with the rounds, hybrid-gpu's twin), decimate, meshopt
+    /// (meshoptimizer's simplify), meshopt-sloppy (its clustering simplifySloppy)
     /// [default: all of them; the *gpu ones where there is an adapter]
     #[arg(long, value_name = "B,...", value_delimiter = ',', value_parser = parse_bench_backend)]
     pub backends: Vec<&'static crate::bench::BenchBackend>,

@@ -1,8 +1,10 @@
 //! `--method hybrid`: clustering (cells split by connectivity, clusters that pinch a
-//! non-manifold edge taken apart) to an intermediate count, then the QEM rounds to the exact
-//! target from the clusters' quadrics (Garland & Shaffer's multiphase simplification, 2002).
-//! On `--backend gpu` the rounds run on the device from the same upload; the clustering stays
-//! on the CPU on both backends: its split of cells by connectivity is a union-find, and its
+//! non-manifold edge taken apart) to an intermediate count, then QEM to the exact target from
+//! the clusters' quadrics (Garland & Shaffer's multiphase simplification, 2002). On `cpu` (the
+//! default) the second phase is the greedy queue, faster and lower in error than the rounds on
+//! the 1M scans (docs/PERFORMANCE.md, "hybrid: the greedy queue after the clusters"); on
+//! `cpu-parallel` and `gpu` it is the rounds, from the same upload on both (twins). The
+//! clustering stays on the CPU on every backend: its split of cells by connectivity is a union-find, and its
 //! repairs are worked out from the build before (docs/PERFORMANCE.md, "Speed against
 //! meshoptimizer").
 
@@ -11,9 +13,10 @@ use super::{
     Built, ClusterReport, Points, Work, check_backend, cluster_to, max_error, output, prepare,
     tally,
 };
+use crate::compute::types::Quadric;
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::options::{Method, SimplifyOptions, SimplifyReport};
+use crate::options::{Backend, Method, SimplifyOptions, SimplifyReport};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -352,66 +355,155 @@ pub(super) fn intermediate(target: usize, input: usize) -> usize {
         as usize
 }
 
+/// The backend the hybrid's second phase runs on from the clusters `phase`: the greedy queue
+/// (`cpu`) where `opts` asks for `cpu` or `auto`, there are clusters, and no appearance channel
+/// is in the cost; the rounds (`cpu-parallel`, or `gpu` when asked for) otherwise. Without
+/// clusters (a target too close to the input for them to pay) the greedy queue would be
+/// `qem`'s own, whose mean error on the small shared models (teapot, suzanne, spot) is up to
+/// 1.14× the rounds'; on painted scans at 1% the greedy's colour error was up to 1.06× the
+/// rounds' (docs/PERFORMANCE.md, "hybrid: the greedy queue after the clusters").
+pub(crate) fn second_phase(phase: Option<&Clustered>, opts: &SimplifyOptions) -> Backend {
+    match (opts.backend, phase) {
+        (Backend::Cpu | Backend::Auto, Some(c))
+            if crate::quadric::attributes::Layout::new(&c.mesh, &opts.attributes).is_none() =>
+        {
+            Backend::Cpu
+        }
+        (Backend::Gpu, _) => Backend::Gpu,
+        _ => Backend::CpuParallel,
+    }
+}
+
+/// The hybrid's first phase as the clusters give it: the clustered mesh, each of its
+/// vertices' quadrics (relative to the vertex) and its faces' input normals, in the
+/// original's frame, and the clustering's largest error.
+pub(crate) struct Clustered {
+    pub mesh: Mesh,
+    pub quadrics: Vec<Quadric>,
+    pub normals: Vec<[f32; 3]>,
+    pub frame: ([f64; 3], f64),
+    pub error: f64,
+}
+
+impl Clustered {
+    /// The rounds' upload of the clustered mesh with its quadrics and reference normals.
+    pub fn upload(&self, opts: &SimplifyOptions) -> crate::rounds::Upload {
+        crate::rounds::Upload::with_quadrics(&self.mesh, self.frame, &self.quadrics)
+            .reference_normals(&self.normals)
+            .attributes(&opts.attributes)
+    }
+
+    /// What the greedy queue takes from it: the frame and the reference normals, not the
+    /// quadrics (see [`crate::greedy::Carried`]).
+    pub fn carried(&self) -> crate::greedy::Carried<'_> {
+        crate::greedy::Carried {
+            frame: self.frame,
+            normals: &self.normals,
+        }
+    }
+}
+
+/// The hybrid's first phase: the clusters for `opts.target_faces`, or `None` where the target
+/// is so close to the input that the second phase starts from the input itself; `report`
+/// gets the clustering's figures, its seconds included.
+pub(crate) fn clustered(
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    report: &mut ClusterReport,
+) -> Result<Option<Clustered>> {
+    let t = Instant::now();
+    let intermediate = intermediate(opts.target_faces, mesh.triangles.len());
+    report.method = Method::Hybrid;
+    let out = if intermediate as f64 >= HYBRID_SKIP * mesh.triangles.len() as f64
+        || opts.target_faces == 0
+    {
+        None
+    } else {
+        let mut pts = Points::new(mesh);
+        let mut work = prepare(&mut pts, opts, true)?;
+        work.colors = super::colors::ColourSplit::of(mesh, opts.attributes.color);
+        let (grid, built, normals) =
+            cluster_repaired(&mut work, intermediate, opts.target_faces, report)?;
+        tally(report, &built);
+        report.cell_size = grid.h as f64;
+        report.intermediate_faces = Some(built.faces.len());
+        let (clustered, quadrics) = output(mesh, work.pts, &built, opts.attributes.color > 0.0);
+        Some(Clustered {
+            mesh: clustered,
+            quadrics,
+            normals,
+            frame: (work.pts.center, work.pts.scale),
+            error: max_error(&built),
+        })
+    };
+    report.seconds = t.elapsed().as_secs_f64();
+    Ok(out)
+}
+
 /// `--method hybrid`.
 pub fn simplify_hybrid(
     mesh: &Mesh,
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
-    let (up, built_error, report, opts) = hybrid_upload(mesh, opts)?;
+    let mut report = ClusterReport::default();
+    let phase = clustered(mesh, opts, &mut report)?;
     opts.cancel.check()?;
-    let (out, mut r) = rounds(&up, mesh, &opts, progress)?;
-    r.max_collapse_error = r.max_collapse_error.max(built_error);
+    let (out, mut r) = match &phase {
+        Some(c) => finish(c, mesh, opts, progress)?,
+        None => {
+            let (up, _, opts) = rounds_upload(None, mesh, opts)?;
+            rounds(&up, mesh, &opts, progress)?
+        }
+    };
+    r.input_faces = mesh.triangles.len();
+    r.input_vertices = mesh.positions.len();
     r.collapses = mesh.positions.len().saturating_sub(out.positions.len());
     r.clustering = Some(report);
     Ok((out, r))
 }
 
-/// The hybrid's first phase: the clusters for `opts.target_faces` as the rounds' upload, with
-/// their quadrics, the clustering's largest error and its report, and the options with the
-/// backend resolved (the levels of detail go on from this upload through several targets).
-pub(crate) fn hybrid_upload(
+/// The hybrid's second phase from its clusters `c` to `opts.target_faces` on the backend
+/// [`second_phase`] picks (the rounds write `mesh`'s channels); the report's largest error
+/// includes the clustering's.
+pub(super) fn finish(
+    c: &Clustered,
     mesh: &Mesh,
     opts: &SimplifyOptions,
-) -> Result<(crate::rounds::Upload, f64, ClusterReport, SimplifyOptions)> {
-    let backend = check_backend(opts)?;
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport)> {
     let opts = SimplifyOptions {
-        backend,
+        backend: second_phase(Some(c), opts),
         ..opts.clone()
     };
-    let t = Instant::now();
-    let intermediate = intermediate(opts.target_faces, mesh.triangles.len());
-    let mut report = ClusterReport {
-        method: Method::Hybrid,
-        ..Default::default()
+    let (out, mut r) = match opts.backend {
+        Backend::Cpu => crate::greedy::simplify_carried(&c.mesh, &opts, &c.carried(), progress)?,
+        _ => rounds(&c.upload(&opts), mesh, &opts, progress)?,
     };
-    let (up, built_error) = if intermediate as f64 >= HYBRID_SKIP * mesh.triangles.len() as f64
-        || opts.target_faces == 0
-    {
-        (
+    r.max_collapse_error = r.max_collapse_error.max(c.error);
+    Ok((out, r))
+}
+
+/// The rounds' upload from the hybrid's first phase (`None`: from `mesh` itself, which the
+/// second phase then starts from on every backend), with the clustering's largest error and
+/// the options with the rounds' backend (`cpu-parallel` or `gpu`).
+pub(crate) fn rounds_upload(
+    phase: Option<&Clustered>,
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+) -> Result<(crate::rounds::Upload, f64, SimplifyOptions)> {
+    let opts = SimplifyOptions {
+        backend: check_backend(opts)?,
+        ..opts.clone()
+    };
+    Ok(match phase {
+        Some(c) => (c.upload(&opts), c.error, opts),
+        None => (
             crate::rounds::Upload::new(mesh).attributes(&opts.attributes),
             0.0,
-        )
-    } else {
-        let mut pts = Points::new(mesh);
-        let mut work = prepare(&mut pts, &opts, true)?;
-        work.colors = super::colors::ColourSplit::of(mesh, opts.attributes.color);
-        let (grid, built, normals) =
-            cluster_repaired(&mut work, intermediate, opts.target_faces, &mut report)?;
-        tally(&mut report, &built);
-        report.cell_size = grid.h as f64;
-        report.intermediate_faces = Some(built.faces.len());
-        let (clustered, quadrics) = output(mesh, work.pts, &built, opts.attributes.color > 0.0);
-        let frame = (work.pts.center, work.pts.scale);
-        (
-            crate::rounds::Upload::with_quadrics(&clustered, frame, &quadrics)
-                .reference_normals(&normals)
-                .attributes(&opts.attributes),
-            max_error(&built),
-        )
-    };
-    report.seconds = t.elapsed().as_secs_f64();
-    Ok((up, built_error, report, opts))
+            opts,
+        ),
+    })
 }
 
 #[cfg(test)]

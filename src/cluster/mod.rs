@@ -25,8 +25,8 @@ pub mod stages;
 pub mod stream;
 
 pub use floating::simplify_floating;
-pub(crate) use hybrid::hybrid_upload;
 pub use hybrid::{HYBRID_EXTRA, HYBRID_FACTOR, HYBRID_MIN_SHARE, HYBRID_SKIP, simplify_hybrid};
+pub(crate) use hybrid::{clustered, rounds_upload, second_phase};
 
 use crate::compute::common::{V3, xyz};
 use crate::compute::types::Quadric;

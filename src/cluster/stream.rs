@@ -5,7 +5,8 @@
 //! them as they pass: the cells' quadrics are summed block after block and only the faces that
 //! survive are kept. Memory depends on the vertices and the output, not on the faces. The
 //! hybrid splits cells by connectivity with a union-find fed block by block, scatters its
-//! quadrics (no vertex→face lists), then runs the rounds in memory on the clustered mesh.
+//! quadrics (no vertex→face lists), then runs its second phase (the greedy queue, or the rounds
+//! on `cpu-parallel` and `gpu`) in memory on the clustered mesh.
 //!
 //! Vertex colours are carried (held per vertex, as the positions are): each cluster takes its
 //! nearest member's, as the in-memory clustering without a colour weight does; coloured scans
@@ -156,24 +157,21 @@ pub fn simplify_file_in_blocks(
         };
         return Ok((out, r));
     }
-    // The hybrid's rounds, in memory on the clustered mesh, from the clusters' quadrics.
+    // The hybrid's second phase, in memory on the clustered mesh, from the clusters' quadrics.
     progress(0.5);
     report.intermediate_faces = Some(clustered.triangles.len());
-    let up = crate::rounds::Upload::with_quadrics(&clustered, frame, &quadrics)
-        .reference_normals(&normals)
-        .attributes(&opts.attributes);
     let opts = &SimplifyOptions {
         target_faces,
-        backend: if opts.backend == Backend::Gpu {
-            Backend::Gpu
-        } else {
-            Backend::CpuParallel
-        },
         ..opts.clone()
     };
-    let (out, mut r) =
-        super::hybrid::rounds(&up, &clustered, opts, &mut |f| progress(0.5 + 0.5 * f))?;
-    r.max_collapse_error = r.max_collapse_error.max(built_error);
+    let c = super::hybrid::Clustered {
+        mesh: clustered,
+        quadrics,
+        normals,
+        frame,
+        error: built_error,
+    };
+    let (out, mut r) = super::hybrid::finish(&c, &c.mesh, opts, &mut |f| progress(0.5 + 0.5 * f))?;
     r.input_faces = input.faces;
     r.input_vertices = input.vertices;
     r.collapses = input.vertices.saturating_sub(out.positions.len());

@@ -31,6 +31,7 @@ use crate::options::{SimplifyOptions, SimplifyReport, StopReason};
 pub(crate) use evaluate::triangle_quality;
 use output::{OutputNormals, build_output};
 use partition::{Cuts, LevelStats, SECOND_LEVEL_REGIONS, partitioned_level, partitioned_stop};
+pub(crate) use prepare::Carried;
 use prepare::{Mobility, Prepared};
 use state::State;
 
@@ -61,7 +62,31 @@ pub fn simplify_greedy(
     opts: &SimplifyOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
-    let p = Prepared::new(input, opts);
+    simplify_prepared(Prepared::new(input, opts), input, opts, progress)
+}
+
+/// [`simplify_greedy`] from `input` in `carried`'s frame and with its reference normals (the
+/// hybrid's clusters).
+pub(crate) fn simplify_carried(
+    input: &Mesh,
+    opts: &SimplifyOptions,
+    carried: &Carried,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport)> {
+    simplify_prepared(
+        Prepared::carried(input, opts, carried),
+        input,
+        opts,
+        progress,
+    )
+}
+
+fn simplify_prepared(
+    p: Prepared,
+    input: &Mesh,
+    opts: &SimplifyOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport)> {
     let pinned_vertices = p
         .mobility
         .iter()
@@ -160,14 +185,19 @@ fn max_error(s: &State, levels: &LevelStats) -> f64 {
 /// one before, positions and quadrics as they are (cut into regions again while it is large),
 /// so the chain costs about what its smallest level alone does. `level` gets each level's
 /// mesh, why it stopped and the largest collapse error so far.
+/// With `carried`, the set-up takes its frame and reference normals (the hybrid's clusters).
 pub(crate) fn chain_greedy(
     input: &Mesh,
     opts: &SimplifyOptions,
+    carried: Option<&Carried>,
     targets: &[usize],
     progress: &mut dyn FnMut(f32),
     level: &mut dyn FnMut(Mesh, StopReason, f64) -> Result<()>,
 ) -> Result<()> {
-    let mut p = Prepared::new(input, opts);
+    let mut p = match carried {
+        Some(c) => Prepared::carried(input, opts, c),
+        None => Prepared::new(input, opts),
+    };
     let nf = p.faces.len();
     let need = nf.saturating_sub(*targets.last().unwrap_or(&nf)).max(1) as f32;
     let mut levels = LevelStats::default();

@@ -67,10 +67,34 @@ pub(crate) struct Prepared {
     pub attr_global: Vec<u32>,
 }
 
+/// What an earlier phase hands the greedy with its mesh (the hybrid's clusters): the frame to
+/// normalize in (the original's, so errors keep its units), and per input face the normal of
+/// the original face under it, for the flip test (a clustered face can already lean).
+///
+/// The clusters' quadrics are not carried: the queue ranks collapses by the clustered
+/// surface's own planes. Measured on the four shared scans and both 1M meshes at 10% and 1%,
+/// that gave a mean error 4–19% below the rounds' from the carried quadrics, and 3–17% below
+/// this queue's from them (docs/PERFORMANCE.md, "hybrid: the greedy queue after the
+/// clusters"); summed over a whole cell, the members' planes charge every collapse for the
+/// cell's spread of orientations, where the clustered surface only keeps what is left.
+pub(crate) struct Carried<'a> {
+    pub frame: ([f64; 3], f64),
+    pub normals: &'a [[f32; 3]],
+}
+
 impl Prepared {
     /// The set-up, with the attributes `opts.attributes` weighs in the quadrics.
     pub fn new(input: &Mesh, opts: &SimplifyOptions) -> Prepared {
-        let surface = Surface::new(input);
+        Prepared::build(input, opts, None)
+    }
+
+    /// As [`Prepared::new`], in `carried`'s frame and with its reference normals.
+    pub fn carried(input: &Mesh, opts: &SimplifyOptions, carried: &Carried) -> Prepared {
+        Prepared::build(input, opts, Some(carried))
+    }
+
+    fn build(input: &Mesh, opts: &SimplifyOptions, carried: Option<&Carried>) -> Prepared {
+        let surface = Surface::in_frame(input, carried.map(|c| c.frame));
         let layout = Layout::new(&surface.welded, &opts.attributes);
         let Surface {
             welded: mesh,
@@ -111,7 +135,15 @@ impl Prepared {
         };
         let ref_normal: Vec<[f32; 3]> = (0..faces.len())
             .into_par_iter()
-            .map(|f| plane(f).map_or([0.0; 3], |(n, _)| n.map(|x| x as f32)))
+            .map(|f| {
+                let own = plane(f).map(|(n, _)| n.map(|x| x as f32));
+                // The original face under a carried one, as the rounds' upload takes it.
+                let under = carried.and_then(|c| c.normals.get(face_origin[f] as usize));
+                match (own, under) {
+                    (Some(_), Some(&n)) if n != [0.0; 3] => n,
+                    (own, _) => own.unwrap_or([0.0; 3]),
+                }
+            })
             .collect();
         // Per vertex, in parallel: the sum of its faces' plane quadrics in face order, then the
         // constraint planes of its border and seam edges in ascending order of the other end,
@@ -302,7 +334,10 @@ impl Prepared {
         });
         // The caller's pins (a tile's border) override whatever the vertex would be.
         let mut held = vec![false; nt];
-        for &v in &opts.pin {
+        // Pins name the original's vertices, which a carried mesh does not have; `simplify`
+        // refuses pins for every method but qem.
+        debug_assert!(carried.is_none() || opts.pin.is_empty());
+        for &v in opts.pin.iter().filter(|_| carried.is_none()) {
             let t = topo[weld_remap[v as usize] as usize] as usize;
             mobility[t] = Mobility::Pinned;
             held[t] = true;

@@ -92,7 +92,7 @@ pub fn lod_chain(
                 b => b,
             };
             if backend == Backend::Cpu {
-                crate::greedy::chain_greedy(mesh, opts, &targets, progress, &mut level)?;
+                crate::greedy::chain_greedy(mesh, opts, None, &targets, progress, &mut level)?;
             } else {
                 let up = Upload::pinned(mesh, &opts.pin).attributes(&opts.attributes);
                 let o = SimplifyOptions { backend, ..first };
@@ -101,9 +101,27 @@ pub fn lod_chain(
             backend
         }
         Method::Hybrid => {
-            let (up, built, _, o) = crate::cluster::hybrid_upload(mesh, &first)?;
-            chain_rounds(&up, mesh, &o, &targets, built, progress, &mut level)?;
-            o.backend
+            let mut report = Default::default();
+            match crate::cluster::clustered(mesh, &first, &mut report)? {
+                // On `cpu` the greedy queue goes on from the clusters, as `simplify_hybrid`.
+                Some(c) if crate::cluster::second_phase(Some(&c), opts) == Backend::Cpu => {
+                    crate::greedy::chain_greedy(
+                        &c.mesh,
+                        opts,
+                        Some(&c.carried()),
+                        &targets,
+                        progress,
+                        &mut |m, stop, err| level(m, stop, err.max(c.error)),
+                    )?;
+                    Backend::Cpu
+                }
+                phase => {
+                    let (up, built, o) =
+                        crate::cluster::rounds_upload(phase.as_ref(), mesh, &first)?;
+                    chain_rounds(&up, mesh, &o, &targets, built, progress, &mut level)?;
+                    o.backend
+                }
+            }
         }
         Method::Decimate => {
             if !matches!(opts.backend, Backend::Cpu | Backend::Auto) {
