@@ -112,7 +112,8 @@ def simplify(mesh_or_vertices: Any, faces: Any = None, *, ratio: Optional[float]
 
     ``method``: ``"qem"`` (quadric edge collapse, the best surface), ``"cluster"`` and
     ``"floating-cell"`` (vertex clustering: fastest, may change topology), ``"hybrid"``
-    (clustering, then QEM: near QEM's quality faster), ``"decimate"`` (removes vertices, keeps
+    (clustering, then QEM: near QEM's quality faster; greedy on ``"cpu"``/``"auto"``, rounds on
+    ``"cpu-parallel"``/``"gpu"``), ``"decimate"`` (removes vertices, keeps
     the rest unmoved). ``backend``: ``"cpu"`` (greedy, f64), ``"cpu-parallel"``, ``"gpu"`` (any
     Vulkan/Metal/DX12 adapter), ``"auto"``. ``lock_border``: keep open borders exactly.
 
