@@ -1,12 +1,11 @@
 //! `--method hybrid`: clustering (cells split by connectivity, clusters that pinch a
-//! non-manifold edge taken apart) to an intermediate count, then QEM to the exact target from
-//! the clusters' quadrics (Garland & Shaffer's multiphase simplification, 2002). On `cpu` (the
-//! default) the second phase is the greedy queue, faster and lower in error than the rounds on
-//! the 1M scans (docs/PERFORMANCE.md, "hybrid: the greedy queue after the clusters"); on
-//! `cpu-parallel` and `gpu` it is the rounds, from the same upload on both (twins). The
-//! clustering stays on the CPU on every backend: its split of cells by connectivity is a union-find, and its
-//! repairs are worked out from the build before (docs/PERFORMANCE.md, "Speed against
-//! meshoptimizer").
+//! non-manifold edge taken apart) to an intermediate count, then QEM to the exact target
+//! (Garland & Shaffer's multiphase simplification, 2002). On `cpu` (the default) the second
+//! phase is the greedy queue on the clustered surface, faster and lower in error than the
+//! rounds (docs/PERFORMANCE.md, "Stop 37"); on `cpu-parallel` and `gpu` it is the rounds from
+//! the clusters' quadrics, the same upload on both (twins). The clustering stays on the CPU on
+//! every backend: its split of cells by connectivity is a union-find, and its repairs are
+//! worked out from the build before (docs/PERFORMANCE.md, "Speed against meshoptimizer").
 
 use super::grid::Grid;
 use super::{
@@ -360,8 +359,8 @@ pub(super) fn intermediate(target: usize, input: usize) -> usize {
 /// is in the cost; the rounds (`cpu-parallel`, or `gpu` when asked for) otherwise. Without
 /// clusters (a target too close to the input for them to pay) the greedy queue would be
 /// `qem`'s own, whose mean error on the small shared models (teapot, suzanne, spot) is up to
-/// 1.14× the rounds'; on painted scans at 1% the greedy's colour error was up to 1.06× the
-/// rounds' (docs/PERFORMANCE.md, "hybrid: the greedy queue after the clusters").
+/// 1.14× the rounds'; on painted scans at 1% the greedy's colour error was up to 1.05× the
+/// rounds' (docs/PERFORMANCE.md, "Stop 37").
 pub(crate) fn second_phase(phase: Option<&Clustered>, opts: &SimplifyOptions) -> Backend {
     match (opts.backend, phase) {
         (Backend::Cpu | Backend::Auto, Some(c))

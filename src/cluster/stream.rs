@@ -157,7 +157,8 @@ pub fn simplify_file_in_blocks(
         };
         return Ok((out, r));
     }
-    // The hybrid's second phase, in memory on the clustered mesh, from the clusters' quadrics.
+    // The hybrid's second phase, in memory on the clustered mesh (the rounds from the clusters'
+    // quadrics).
     progress(0.5);
     report.intermediate_faces = Some(clustered.triangles.len());
     let opts = &SimplifyOptions {

@@ -104,9 +104,11 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
     let simplified = if ratio < 1.0 {
         let mut opts = SimplifyOptions::with_ratio(model.up.face_count(), ratio)?;
         opts.method = method;
-        // The GPU runs the rounds and the clustering; hybrid runs on the cores, decimate on one.
+        // The GPU runs the rounds and the clustering; hybrid runs on the CPU as `simplify
+        // --method hybrid` does by default (its clustering, then the greedy queue or the
+        // rounds), decimate on one core.
         opts.backend = match method {
-            crate::Method::Hybrid => Backend::CpuParallel,
+            crate::Method::Hybrid => Backend::Cpu,
             crate::Method::Decimate => Backend::Cpu,
             _ => Backend::Gpu,
         };
