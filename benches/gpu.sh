@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The real-GPU benchmark: one prepared run for a machine with a Vulkan driver and no Rust
 # toolchain. It runs a prebuilt release binary, makes its inputs with the binary itself and
-# prints one table (every QEM backend, cluster and hybrid on cpu-parallel and gpu, meshopt; time,
-# rounds, faces, mean error), the GPU's stage times from timestamp queries and the time spent
-# outside the rounds (pipelines, upload and read-back, preparation); the same as JSON.
+# prints one table (every QEM backend, cluster and hybrid on cpu-parallel and gpu, hybrid also
+# on cpu, its default: the greedy queue after the clusters; meshopt; time, rounds, faces, mean
+# error), the GPU's stage times from timestamp queries and the time spent outside the rounds
+# (pipelines, upload and read-back, preparation); the same as JSON.
 #
 #   bash benches/gpu.sh [--quick] [--out DIR] [--repeat N] [MESH...]
 #
@@ -58,7 +59,7 @@ mkdir -p "$out"
 # The error is measured on a fixed number of samples: the default (10 per face) would spend
 # longer measuring a 5M-face scan than simplifying it.
 samples=2000000
-backends=cpu,cpu-parallel,gpu,cluster,cluster-gpu,hybrid,hybrid-gpu,meshopt,meshopt-sloppy
+backends=cpu,cpu-parallel,gpu,cluster,cluster-gpu,hybrid,hybrid-parallel,hybrid-gpu,meshopt,meshopt-sloppy
 
 echo "== $("$bin" --version) on $(nproc) cores; meshes: ${meshes[*]}; ratios: ${ratios[*]}" >&2
 start=$SECONDS
@@ -96,6 +97,8 @@ print(f"adapter: {adapter}; CPU: {machine.get('cpu')} ({machine.get('cores')} th
 
 def method_of(row):
     b = row["backend"]
+    if b == "hybrid":
+        return "hybrid", "cpu"
     for m in ("cluster", "hybrid"):
         if b.startswith(m):
             return m, ("gpu" if b.endswith("-gpu") else "cpu-parallel")
