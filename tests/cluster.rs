@@ -228,6 +228,27 @@ fn the_greedy_hybrid_does_not_depend_on_the_thread_count() {
     assert_eq!((&a.triangles, &a.positions), (&c.triangles, &c.positions));
 }
 
+/// The points' box is the input's box taken into the frame, not a pass over the points: the
+/// same bits as the least and greatest normalized coordinates, on meshes off the origin, of
+/// mixed signs and scales.
+#[test]
+fn the_points_box_is_the_least_and_greatest_point() {
+    let mut shifted = torus(1.0, 0.3, 64, 32);
+    meshslim::mesh::add_noise(&mut shifted, 0.01, 5);
+    for p in &mut shifted.positions {
+        *p = [p[0] * 1e3 + 12_345.6, p[1] * 0.37 - 7.1, p[2] * 1e-3];
+    }
+    for m in [icosphere(3), sheet(17, -2.5), shifted] {
+        let (pts, lo, hi) = meshslim::cluster::unit_frame_points(&m);
+        for i in 0..3 {
+            let low = pts.iter().map(|p| p[i]).fold(f32::INFINITY, f32::min);
+            let high = pts.iter().map(|p| p[i]).fold(f32::NEG_INFINITY, f32::max);
+            assert_eq!(lo[i].to_bits(), low.to_bits());
+            assert_eq!(hi[i].to_bits(), high.to_bits());
+        }
+    }
+}
+
 #[test]
 fn max_error_bounds_the_cell() {
     let m = icosphere(5);

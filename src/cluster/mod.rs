@@ -32,7 +32,7 @@ use crate::compute::common::{V3, xyz};
 use crate::compute::types::Quadric;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::mesh::prepare::{denormalize, frame_of, normalize};
+use crate::mesh::prepare::{denormalize, frame_of_box, normalize};
 use crate::options::{Backend, ClusterReport, Method, SimplifyOptions, SimplifyReport, StopReason};
 use grid::Grid;
 use rayon::prelude::*;
@@ -57,36 +57,36 @@ struct Points<'m> {
     stream: Option<crate::io::stream::FileFaces>,
 }
 
-/// `mesh`'s positions in the unit-diagonal frame ([`frame_of`]), w = 1, as every clustering
-/// build takes them, and their box: what the GPU tests and examples upload too.
+/// `mesh`'s positions in the unit-diagonal frame (`mesh::prepare::frame_of`), w = 1, as every
+/// clustering build takes them, and their box: what the GPU tests and examples upload too.
 pub fn unit_frame_points(mesh: &Mesh) -> (Vec<[f32; 4]>, V3, V3) {
-    let (center, scale) = frame_of(mesh);
-    points_in_frame(mesh, center, scale)
+    let bounds = mesh.bounds();
+    framed_points(mesh, bounds, frame_of_box(bounds))
 }
 
-/// `mesh`'s positions as [`unit_frame_points`] gives them, in the frame `(center, scale)`.
-fn points_in_frame(mesh: &Mesh, center: [f64; 3], scale: f64) -> (Vec<[f32; 4]>, V3, V3) {
+/// [`unit_frame_points`] in the frame `(center, scale)` of `mesh`'s `bounds`. The box is the
+/// input's box taken into the frame: `normalize` and the rounding to f32 never reverse two
+/// coordinates' order, so the least of the normalized coordinates is the normalized least
+/// one, bit for bit (the input's coordinates are finite, `Mesh::validate`), and no second pass
+/// over the points is needed (one of its three passes, on a cold cache).
+fn framed_points(
+    mesh: &Mesh,
+    bounds: Option<crate::mesh::Aabb>,
+    (center, scale): ([f64; 3], f64),
+) -> (Vec<[f32; 4]>, V3, V3) {
+    let into = |p: [f32; 3]| normalize(p, center, scale).map(|x| x as f32);
     let positions: Vec<[f32; 4]> = mesh
         .positions
         .par_iter()
         .with_min_len(4096)
         .map(|&p| {
-            let q = normalize(p, center, scale);
-            [q[0] as f32, q[1] as f32, q[2] as f32, 1.0]
+            let [x, y, z] = into(p);
+            [x, y, z, 1.0]
         })
         .collect();
-    let empty = || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    let grow = |(lo, hi): (V3, V3), (l, h): (V3, V3)| {
-        (
-            [0, 1, 2].map(|i| lo[i].min(l[i])),
-            [0, 1, 2].map(|i| hi[i].max(h[i])),
-        )
-    };
-    let (lo, hi) = positions
-        .par_iter()
-        .with_min_len(4096)
-        .fold(empty, |b, p| grow(b, (xyz(*p), xyz(*p))))
-        .reduce(empty, grow);
+    let (lo, hi) = bounds.map_or(([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]), |b| {
+        (into(b.min), into(b.max))
+    });
     (positions, lo, hi)
 }
 
@@ -99,9 +99,10 @@ impl<'m> Points<'m> {
 
     /// `mesh`'s vertices with `faces`.
     fn of(mesh: &Mesh, faces: std::borrow::Cow<'m, [[u32; 3]]>) -> Points<'m> {
-        let (center, scale) = frame_of(mesh);
-        let attr: Vec<u32> = (0..mesh.positions.len() as u32).collect();
-        let (positions, lo, hi) = points_in_frame(mesh, center, scale);
+        let attr: Vec<u32> = (0..mesh.positions.len() as u32).into_par_iter().collect();
+        let bounds = mesh.bounds();
+        let (center, scale) = frame_of_box(bounds);
+        let (positions, lo, hi) = framed_points(mesh, bounds, (center, scale));
         Points {
             positions,
             faces,

@@ -131,7 +131,12 @@ impl Surface {
 
 /// The frame of `mesh`: its box's centre, and one over its diagonal.
 pub fn frame_of(mesh: &Mesh) -> ([f64; 3], f64) {
-    match mesh.bounds() {
+    frame_of_box(mesh.bounds())
+}
+
+/// The frame of a box: its centre, and one over its diagonal.
+pub fn frame_of_box(b: Option<crate::mesh::Aabb>) -> ([f64; 3], f64) {
+    match b {
         Some(b) if b.diagonal() > 0.0 => (b.center(), 1.0 / b.diagonal()),
         Some(b) => (b.center(), 1.0),
         None => ([0.0; 3], 1.0),
