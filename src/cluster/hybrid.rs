@@ -354,21 +354,21 @@ pub(super) fn intermediate(target: usize, input: usize) -> usize {
         as usize
 }
 
-/// The backend the hybrid's second phase runs on from the clusters `phase`: the greedy queue
-/// (`cpu`) where `opts` asks for `cpu` or `auto`, there are clusters, and no appearance channel
-/// is in the cost; the rounds (`cpu-parallel`, or `gpu` when asked for) otherwise. Without
-/// clusters (a target too close to the input for them to pay) the greedy queue would be
-/// `qem`'s own, whose mean error on the small shared models (teapot, suzanne, spot) is up to
-/// 1.14× the rounds'; on painted scans at 1% the greedy's colour error was up to 1.05× the
-/// rounds' (docs/PERFORMANCE.md, "Stop 37").
-pub(crate) fn second_phase(phase: Option<&Clustered>, opts: &SimplifyOptions) -> Backend {
-    match (opts.backend, phase) {
-        (Backend::Cpu | Backend::Auto, Some(c))
+/// The backend the hybrid's second phase runs on from the clusters `c`: the greedy queue
+/// (`cpu`) where `opts` asks for `cpu` or `auto` and no appearance channel is in the cost; the
+/// rounds (`cpu-parallel`, or `gpu` when asked for) otherwise: on painted scans at 1% the
+/// greedy's colour error was up to 1.05× the rounds' (docs/PERFORMANCE.md, "Stop 37"). Without
+/// clusters (a target too close to the input for them to pay) every backend runs the rounds
+/// ([`rounds_upload`]): the greedy queue there would be `qem`'s own, whose mean error on the
+/// small shared models (teapot, suzanne, spot) is up to 1.14× the rounds'.
+pub(crate) fn second_phase(c: &Clustered, opts: &SimplifyOptions) -> Backend {
+    match opts.backend {
+        Backend::Cpu | Backend::Auto
             if crate::quadric::attributes::Layout::new(&c.mesh, &opts.attributes).is_none() =>
         {
             Backend::Cpu
         }
-        (Backend::Gpu, _) => Backend::Gpu,
+        Backend::Gpu => Backend::Gpu,
         _ => Backend::CpuParallel,
     }
 }
@@ -472,7 +472,7 @@ pub(super) fn finish(
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
     let opts = SimplifyOptions {
-        backend: second_phase(Some(c), opts),
+        backend: second_phase(c, opts),
         ..opts.clone()
     };
     let (out, mut r) = match opts.backend {

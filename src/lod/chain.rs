@@ -104,7 +104,7 @@ pub fn lod_chain(
             let mut report = Default::default();
             match crate::cluster::clustered(mesh, &first, &mut report)? {
                 // On `cpu` the greedy queue goes on from the clusters, as `simplify_hybrid`.
-                Some(c) if crate::cluster::second_phase(Some(&c), opts) == Backend::Cpu => {
+                Some(c) if crate::cluster::second_phase(&c, opts) == Backend::Cpu => {
                     crate::greedy::chain_greedy(
                         &c.mesh,
                         opts,
