@@ -183,9 +183,10 @@ pub enum MethodArg {
     /// creases), so features survive where a uniform grid cuts them; within 5% of the target,
     /// slower than cluster, topology and UV seams as cluster
     FloatingCell,
-    /// Clustering to twice the target plus 20,000 faces, then qem to the exact target with the
-    /// clusters' quadrics: near-qem error in a fraction of the time on large scans; closes UV
-    /// seams (cpu or auto: qem's greedy queue; cpu-parallel or gpu: qem's rounds)
+    /// Clustering to twice the target plus 20,000 faces, then qem to the exact target: near-qem
+    /// error in a fraction of the time on large scans; closes UV seams (cpu or auto: qem's
+    /// greedy queue on the clustered surface; cpu-parallel or gpu: qem's rounds from the
+    /// clusters' quadrics)
     Hybrid,
     /// Schroeder's vertex decimation: removes vertices and fills their holes, so the output's
     /// vertices are a subset of the input's, unmoved, with their normals, UVs and colours;
