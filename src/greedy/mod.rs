@@ -73,12 +73,8 @@ pub(crate) fn simplify_carried(
     carried: &Carried,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
-    simplify_prepared(
-        Prepared::carried(input, opts, carried),
-        input,
-        opts,
-        progress,
-    )
+    let p = Prepared::build(input, opts, Some(carried));
+    simplify_prepared(p, input, opts, progress)
 }
 
 fn simplify_prepared(
@@ -194,10 +190,7 @@ pub(crate) fn chain_greedy(
     progress: &mut dyn FnMut(f32),
     level: &mut dyn FnMut(Mesh, StopReason, f64) -> Result<()>,
 ) -> Result<()> {
-    let mut p = match carried {
-        Some(c) => Prepared::carried(input, opts, c),
-        None => Prepared::new(input, opts),
-    };
+    let mut p = Prepared::build(input, opts, carried);
     let nf = p.faces.len();
     let need = nf.saturating_sub(*targets.last().unwrap_or(&nf)).max(1) as f32;
     let mut levels = LevelStats::default();

@@ -88,12 +88,8 @@ impl Prepared {
         Prepared::build(input, opts, None)
     }
 
-    /// As [`Prepared::new`], in `carried`'s frame and with its reference normals.
-    pub fn carried(input: &Mesh, opts: &SimplifyOptions, carried: &Carried) -> Prepared {
-        Prepared::build(input, opts, Some(carried))
-    }
-
-    fn build(input: &Mesh, opts: &SimplifyOptions, carried: Option<&Carried>) -> Prepared {
+    /// As [`Prepared::new`]; with `carried`, in its frame and with its reference normals.
+    pub fn build(input: &Mesh, opts: &SimplifyOptions, carried: Option<&Carried>) -> Prepared {
         let surface = Surface::in_frame(input, carried.map(|c| c.frame));
         let layout = Layout::new(&surface.welded, &opts.attributes);
         let Surface {
