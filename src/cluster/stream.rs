@@ -117,7 +117,7 @@ pub fn simplify_file_in_blocks(
     // The hybrid's faces' input normals come with its build (the rounds measure from them).
     let (grid, built, stop, normals) = if hybrid {
         let (grid, built, normals) =
-            super::hybrid::cluster_repaired(&mut work, to, target_faces, &mut report)?;
+            super::repair::cluster_repaired(&mut work, to, target_faces, &mut report)?;
         (grid, built, StopReason::TargetReached, normals)
     } else {
         let (grid, built, stop) =

@@ -1,0 +1,564 @@
+//! The hybrid's repairs: clusters that pinch a non-manifold edge or fold a face over, found
+//! and taken apart until none is left, each repair worked out from the build before rather
+//! than built again (docs/PERFORMANCE.md, "`hybrid`: its repairs worked out, not built again").
+
+use super::grid::Grid;
+use super::{Built, ClusterReport, Work, cluster_to};
+use crate::error::Result;
+use rayon::prelude::*;
+
+/// `hybrid` takes clusters on non-manifold edges apart at most this many times.
+const MAX_REPAIRS: usize = 4;
+
+/// The clusters at either end of an edge that more than two faces share, or that two faces
+/// run the same way (a fold), sorted. The half-edges are bucketed by their lower cluster (a
+/// counting sort) and each small bucket sorted alone: sorting all of them by (edge, direction)
+/// took 0.02-0.04 s a check on the 1M scan at 10% (three checks), this 0.013-0.016 s, the
+/// same clusters on every scan and shared model at 10% and 1%.
+fn pinched_clusters(b: &Built) -> Vec<u32> {
+    let half = |i: usize| {
+        let t = b.faces[i / 3].1;
+        let (a, c) = (t[i % 3], t[(i + 1) % 3]);
+        (a.min(c), a.max(c), a < c)
+    };
+    let (order, start) =
+        crate::mesh::prepare::counting_sort(b.clusters, b.faces.len() * 3, |i| half(i).0);
+    let mut bad: Vec<u32> = (0..b.clusters)
+        .into_par_iter()
+        .with_min_len(1024)
+        .fold(
+            || (Vec::new(), Vec::new()),
+            |(mut ends, mut out): (Vec<(u32, bool)>, Vec<u32>), k| {
+                let bucket = &order[start[k] as usize..start[k + 1] as usize];
+                if bucket.len() < 2 {
+                    return (ends, out);
+                }
+                ends.clear();
+                ends.extend(bucket.iter().map(|&i| {
+                    let (_, c, forward) = half(i as usize);
+                    (c, forward)
+                }));
+                ends.sort_unstable();
+                pinched_ends(&ends, &mut |c| out.extend([k as u32, c]));
+                (ends, out)
+            },
+        )
+        .map(|(_, out)| out)
+        .reduce(Vec::new, |mut a, b| {
+            a.extend(b);
+            a
+        });
+    bad.par_sort_unstable();
+    bad.dedup();
+    bad
+}
+
+/// Of the half-edges from one cluster (`(other end, runs forward)`, sorted), the other end of
+/// each edge that more than two faces share or that two faces run the same way.
+fn pinched_ends(ends: &[(u32, bool)], pinched: &mut dyn FnMut(u32)) {
+    let mut i = 0;
+    while i < ends.len() {
+        let mut j = i + 1;
+        while j < ends.len() && ends[j].0 == ends[i].0 {
+            j += 1;
+        }
+        if j - i > 2 || (j - i == 2 && ends[i].1 == ends[i + 1].1) {
+            pinched(ends[i].0);
+        }
+        i = j;
+    }
+}
+
+/// A cluster face turned more than 60° from the input face it came from counts as folded.
+const FOLD_COS: f32 = 0.5;
+
+/// Per face of `b`: the unit normal of the input face it came from (its origin). The rounds
+/// after the clustering measure turning from these, not from the clusters' faces. A streamed
+/// input's faces are read in blocks for them; faces in memory are looked up: walking all the
+/// input's faces for the few that survive took 0.006-0.007 s a build on the 1M scan at 1%
+/// (five builds with the repairs), the lookup 0.003-0.005 s.
+fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
+    use crate::compute::common::{cross, length, scale, sub, xyz};
+    let pos = &work.pts.positions;
+    let normal = |t: &[u32; 3]| {
+        let p = t.map(|v| xyz(pos[v as usize]));
+        let c = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+        let l = length(c);
+        if l > 0.0 { scale(c, 1.0 / l) } else { [0.0; 3] }
+    };
+    if work.pts.stream.is_none() {
+        let faces = &work.pts.faces;
+        return Ok(b
+            .faces
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&(origin, _)| normal(&faces[origin as usize]))
+            .collect());
+    }
+    let mut at: Vec<u32> = Vec::new();
+    for (k, &(origin, _)) in b.faces.iter().enumerate() {
+        let o = origin as usize;
+        if o >= at.len() {
+            at.resize(o + 1, u32::MAX);
+        }
+        at[o] = k as u32;
+    }
+    let mut normals = vec![[0.0f32; 3]; b.faces.len()];
+    work.pts.blocks(&mut |first, faces| {
+        for (i, t) in faces.iter().enumerate() {
+            if let Some(&k) = at.get(first + i).filter(|&&k| k != u32::MAX) {
+                normals[k as usize] = normal(t);
+            }
+        }
+        Ok(())
+    })?;
+    Ok(normals)
+}
+
+/// The clusters of each face turned more than 60° from the input face it came from (`normals`,
+/// [`origin_normals`]), sorted: a cell can fold a sheet over, and two clusters a colour step
+/// split in one cell can stand a face on edge; the rounds after may turn a face up to
+/// `max_normal_angle_deg` further, so a face left nearly on edge here could end up flipped.
+fn folded_clusters(b: &Built, normals: &[[f32; 3]]) -> Vec<u32> {
+    let mut bad: Vec<u32> = b
+        .faces
+        .par_iter()
+        .zip(normals)
+        .filter_map(|(&(_, t), &o)| folds(b, t, o).then_some(t))
+        .flatten_iter()
+        .collect();
+    bad.par_sort_unstable();
+    bad.dedup();
+    bad
+}
+
+/// Whether the face on clusters `t` of `b` is turned more than 60° from `normal`.
+fn folds(b: &Built, t: [u32; 3], normal: [f32; 3]) -> bool {
+    use crate::compute::common::{cross, dot, length, sub};
+    let p = t.map(|k| b.placed[k as usize].pos);
+    let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+    dot(n, normal) < FOLD_COS * length(n)
+}
+
+/// [`pinched_clusters`] and [`folded_clusters`] of `b`, a repair of a build in which every
+/// cluster they found was taken apart ([`take_apart`]; `fresh`: its new singletons). Only what
+/// the repair changed is looked at, the same clusters found: a face without a new singleton
+/// was in the build before, on clusters that stayed, and so neither folded nor on an edge
+/// that pinched; an edge whose faces changed is on a face at a new singleton, so its lower end
+/// is among those faces' clusters. The two checks after the repairs took 0.010 s each on the
+/// 1M scan at 10%, looking at every face.
+fn rechecked(b: &Built, normals: &[[f32; 3]], fresh: &[bool]) -> Vec<u32> {
+    let mut touched = vec![false; b.clusters];
+    let mut bad = Vec::new();
+    for (&(_, t), &o) in b.faces.iter().zip(normals) {
+        if t.iter().any(|&k| fresh[k as usize]) {
+            for k in t {
+                touched[k as usize] = true;
+            }
+            if folds(b, t, o) {
+                bad.extend(t);
+            }
+        }
+    }
+    // (lower end, other end, runs forward) of every half-edge from a touched cluster.
+    let touched = &touched;
+    let mut half: Vec<(u32, u32, bool)> = b
+        .faces
+        .par_iter()
+        .with_min_len(4096)
+        .flat_map_iter(|&(_, t)| {
+            (0..3).filter_map(move |i| {
+                let (a, c) = (t[i], t[(i + 1) % 3]);
+                Some((a.min(c), a.max(c), a < c)).filter(|h| touched[h.0 as usize])
+            })
+        })
+        .collect();
+    half.par_sort_unstable();
+    let mut ends = Vec::new();
+    for run in half.chunk_by(|x, y| x.0 == y.0) {
+        ends.clear();
+        ends.extend(run.iter().map(|h| (h.1, h.2)));
+        pinched_ends(&ends, &mut |c| bad.extend([run[0].0, c]));
+    }
+    bad.sort_unstable();
+    bad.dedup();
+    bad
+}
+
+/// The hybrid's clustering: to at least `intermediate` faces (the rounds then go to `target`),
+/// clusters that pinch a non-manifold edge or fold a face over taken apart until none is left.
+/// Returns the grid, the build and its faces' input normals ([`origin_normals`]: the rounds'
+/// reference, read once per build since a streamed input reads its file for them).
+pub(super) fn cluster_repaired(
+    work: &mut Work,
+    intermediate: usize,
+    target: usize,
+    report: &mut ClusterReport,
+) -> Result<(Grid, Built, Vec<[f32; 3]>)> {
+    let (grid, mut built, _) = cluster_to(work, intermediate, None, Some(target), report)?;
+    let mut normals = origin_normals(work, &built)?;
+    // Splitting cells by connectivity keeps separate sheets apart, but a sheet folded inside
+    // one cell can still pinch into a non-manifold edge: take the clusters on one apart (their
+    // members each their own cluster) and build again, until none is left.
+    // The new singletons of the last repair, when it was worked out from the build before.
+    let mut fresh: Option<Vec<bool>> = None;
+    for _ in 0..MAX_REPAIRS {
+        let bad = match &fresh {
+            Some(fresh) => rechecked(&built, &normals, fresh),
+            None => {
+                let mut bad = pinched_clusters(&built);
+                bad.extend(folded_clusters(&built, &normals));
+                bad.sort_unstable();
+                bad.dedup();
+                bad
+            }
+        };
+        if bad.is_empty() {
+            break;
+        }
+        (built, fresh) = match work.gather {
+            Some(_) => {
+                let (b, f) = take_apart(work, &grid, &built, &bad);
+                (b, Some(f))
+            }
+            // Streamed: no vertex→face lists to place the new singletons by, so a whole build.
+            None => {
+                for (v, &k) in built.vertex_cluster.iter().enumerate() {
+                    if bad.binary_search(&k).is_ok() {
+                        work.locked[v] = true;
+                    }
+                }
+                (work.build(&grid)?, None)
+            }
+        };
+        normals = origin_normals(work, &built)?;
+        report.builds += 1;
+        report.repaired_clusters += bad.len();
+    }
+    Ok((grid, built, normals))
+}
+
+/// What [`Work::build`] at `grid` gives once the members of the `bad` clusters (sorted ids of
+/// `b`, the build at `grid` before) are locked, which this does too: worked out from `b`
+/// instead of built again. A cluster is one connected component of its cell, so locking its
+/// members takes it out of the cell whole; every other cluster keeps its members, its box,
+/// its placement and its place in the order the clusters are numbered in (cells in key order,
+/// a cell's clusters by root, the locked vertices last in id order). Only the new singletons
+/// are placed, and the faces at them taken again ([`faces_taken_apart`]). Measured on the 1M
+/// scan at 10%: a whole build took 0.09 s of each of the two repairs' 0.12 s. Returns the
+/// build and, per cluster, whether it is a new singleton.
+fn take_apart(work: &mut Work, grid: &Grid, b: &Built, bad: &[u32]) -> (Built, Vec<bool>) {
+    use super::stages::cluster_quadric;
+    use crate::compute::common::xyz;
+    let mut is_bad = vec![false; b.clusters];
+    for &k in bad {
+        is_bad[k as usize] = true;
+    }
+    // The locked vertices, in id order: the singleton clusters at the end of the numbering, with
+    // their placement where they were singletons before.
+    let mut singles: Vec<(u32, Option<super::stages::Placed>)> = Vec::new();
+    for (v, &k) in b.vertex_cluster.iter().enumerate() {
+        if work.locked[v] {
+            singles.push((v as u32, Some(b.placed[k as usize])));
+        } else if is_bad[k as usize] {
+            work.locked[v] = true;
+            singles.push((v as u32, None));
+        }
+    }
+    // The clusters that stay, in their order; a cell's clusters are consecutive, so counting
+    // key changes counts the cells.
+    let positions = &work.pts.positions;
+    let mut new_id = vec![u32::MAX; b.clusters];
+    let mut placed = Vec::with_capacity(b.clusters);
+    let mut cells = 0;
+    let mut last_key = None;
+    // Each cluster's cell, or `None` for one taken apart: every member of a cluster is locked
+    // or none is, and `attr` is one of them. Looked up on every core: one after another, the
+    // scattered reads took 0.008 s of a 0.021 s repair on the 1M scan at 10%.
+    let locked = &work.locked;
+    let cell: Vec<Option<u32>> = b
+        .placed
+        .par_iter()
+        .with_min_len(4096)
+        .map(|p| (!locked[p.attr as usize]).then(|| grid.key(xyz(positions[p.attr as usize]))))
+        .collect();
+    for (k, (p, key)) in b.placed.iter().zip(cell).enumerate() {
+        let Some(key) = key else {
+            continue;
+        };
+        new_id[k] = placed.len() as u32;
+        placed.push(*p);
+        if last_key != Some(key) {
+            cells += 1;
+            last_key = Some(key);
+        }
+    }
+    let kept = placed.len();
+    let surface = work
+        .surface()
+        .expect("taking clusters apart places singletons by the vertex→face lists");
+    // A singleton's box is its vertex, as `build` gives it.
+    placed.par_extend(singles.par_iter().map(|&(v, old)| {
+        old.unwrap_or_else(|| {
+            let p = xyz(positions[v as usize]);
+            cluster_quadric(&surface, &[v], p, p, p)
+        })
+    }));
+    let mut vertex_cluster: Vec<u32> = b
+        .vertex_cluster
+        .par_iter()
+        .map(|&k| new_id[k as usize])
+        .collect();
+    for (i, &(v, old)) in singles.iter().enumerate() {
+        vertex_cluster[v as usize] = (kept + i) as u32;
+        if old.is_some() {
+            new_id[b.vertex_cluster[v as usize] as usize] = (kept + i) as u32;
+        }
+    }
+    let clusters = placed.len();
+    let mut fresh = vec![false; clusters];
+    for (i, single) in singles.iter().enumerate() {
+        fresh[kept + i] = single.1.is_none();
+    }
+    let built = Built {
+        faces: faces_taken_apart(&surface, b, &new_id, &singles, &vertex_cluster, clusters),
+        placed,
+        vertex_cluster,
+        clusters,
+        cells: cells + singles.len(),
+    };
+    (built, fresh)
+}
+
+/// The faces of [`take_apart`]'s build. The new numbering keeps the order of the clusters
+/// that stay (`new_id`, `u32::MAX` for those taken apart), so a face of `b` on them keeps its
+/// place and its rotation; every other face has a new singleton (a vertex of `singles`
+/// without a placement before) at a corner, and faces that repeat one another have the same
+/// clusters, so the faces at the new singletons are deduplicated among themselves and merged
+/// in, in face order. Taking every face again was 0.013 s of a repair on the 1M scan; with
+/// this and [`origin_normals`]' lookup the hybrid at 1% took 0.334 s against 0.384 s (best of
+/// five interleaved in-process runs).
+fn faces_taken_apart(
+    s: &super::stages::Surface,
+    b: &Built,
+    new_id: &[u32],
+    singles: &[(u32, Option<super::stages::Placed>)],
+    vertex_cluster: &[u32],
+    clusters: usize,
+) -> Vec<(u32, [u32; 3])> {
+    use super::stages::{dedupe_faces, rotated};
+    let faces = s.faces;
+    let mut around: Vec<u32> = singles
+        .iter()
+        .filter(|single| single.1.is_none())
+        .flat_map(|&(v, _)| s.csr.faces_of(v).iter().copied())
+        .collect();
+    around.sort_unstable();
+    around.dedup();
+    let fresh = dedupe_faces(
+        around
+            .iter()
+            .filter_map(|&f| {
+                let t = faces[f as usize].map(|v| vertex_cluster[v as usize]);
+                Some((f, rotated(t)?))
+            })
+            .collect(),
+        clusters,
+        true,
+    );
+    let stay: Vec<(u32, [u32; 3])> = b
+        .faces
+        .par_iter()
+        .with_min_len(4096)
+        .filter_map(|&(f, t)| {
+            let t = t.map(|k| new_id[k as usize]);
+            (!t.contains(&u32::MAX)).then_some((f, t))
+        })
+        .collect();
+    let mut out = Vec::with_capacity(stay.len() + fresh.len());
+    let mut fresh = fresh.into_iter().peekable();
+    for (f, t) in stay {
+        while let Some(n) = fresh.next_if(|n| n.0 < f) {
+            out.push(n);
+        }
+        out.push((f, t));
+    }
+    out.extend(fresh);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Points, prepare};
+    use super::*;
+    use crate::options::{Method, SimplifyOptions};
+
+    /// Placements, faces, vertex clusters and the cluster and cell counts.
+    type Bits<'a> = (
+        Vec<Vec<u32>>,
+        &'a [(u32, [u32; 3])],
+        &'a [u32],
+        usize,
+        usize,
+    );
+
+    /// A build's every output as bits, to compare two builds exactly.
+    fn bits(b: &Built) -> Bits<'_> {
+        let placed = b
+            .placed
+            .iter()
+            .map(|p| {
+                let mut v: Vec<u32> = p.pos.iter().map(|x| x.to_bits()).collect();
+                v.extend(bytemuck::cast_slice::<_, u32>(std::slice::from_ref(
+                    &p.quadric,
+                )));
+                v.push(p.attr);
+                v.push(p.how as u32);
+                v
+            })
+            .collect();
+        (placed, &b.faces, &b.vertex_cluster, b.clusters, b.cells)
+    }
+
+    /// An edge with three faces pinches both its clusters, as does one that two faces run the
+    /// same way; an edge two faces run opposite ways does not.
+    /// An edge with three faces pinches both its clusters, as does one that two faces run the
+    /// same way; an edge two faces run opposite ways does not.
+    #[test]
+    fn pinched_clusters_are_three_face_edges_and_folds() {
+        let faces = [
+            [0, 1, 2],
+            [1, 0, 3],
+            [0, 1, 4],
+            [2, 3, 4],
+            [2, 3, 5],
+            [3, 6, 5],
+        ];
+        let b = Built {
+            placed: Vec::new(),
+            faces: faces
+                .iter()
+                .enumerate()
+                .map(|(f, &t)| (f as u32, t))
+                .collect(),
+            vertex_cluster: Vec::new(),
+            clusters: 7,
+            cells: 7,
+        };
+        assert_eq!(pinched_clusters(&b), [0, 1, 2, 3]);
+        // Without the third face on (0, 1) and the second face running 2 -> 3: none.
+        let b = Built {
+            faces: [faces[0], faces[1], faces[3], [3, 2, 5]]
+                .iter()
+                .enumerate()
+                .map(|(f, &t)| (f as u32, t))
+                .collect(),
+            ..b
+        };
+        assert!(pinched_clusters(&b).is_empty());
+    }
+
+    /// After a repair, looking only at what it changed finds what looking at everything finds,
+    /// repair after repair, on meshes whose clusterings pinch and fold (checked: some second
+    /// check finds clusters, so the shortcut is tried on a real repair's leftovers).
+    #[test]
+    fn rechecked_finds_what_the_whole_check_finds() {
+        let mut leftovers = 0;
+        for (seed, noise) in [(3, 0.03), (5, 0.06), (8, 0.1)] {
+            let mesh = crate::mesh::noisy_sphere(6, noise, seed);
+            let mut opts = SimplifyOptions::with_ratio(mesh.triangles.len(), 0.05).unwrap();
+            opts.method = Method::Hybrid;
+            let mut pts = Points::new(&mesh);
+            let mut work = prepare(&mut pts, &opts, true).unwrap();
+            let mut report = ClusterReport::default();
+            let target = opts.target_faces;
+            let (grid, mut built, _) =
+                cluster_to(&work, 2 * target, None, Some(target), &mut report).unwrap();
+            let whole = |b: &Built, work: &Work| {
+                let mut bad = pinched_clusters(b);
+                bad.extend(folded_clusters(b, &origin_normals(work, b).unwrap()));
+                bad.sort_unstable();
+                bad.dedup();
+                bad
+            };
+            let mut bad = whole(&built, &work);
+            assert!(!bad.is_empty(), "seed {seed}: nothing to repair");
+            for repair in 0..MAX_REPAIRS {
+                if bad.is_empty() {
+                    break;
+                }
+                let fresh;
+                (built, fresh) = take_apart(&mut work, &grid, &built, &bad);
+                bad = whole(&built, &work);
+                let normals = origin_normals(&work, &built).unwrap();
+                assert_eq!(
+                    rechecked(&built, &normals, &fresh),
+                    bad,
+                    "seed {seed}, repair {repair}"
+                );
+                leftovers += bad.len();
+            }
+        }
+        assert!(leftovers > 0, "no repair left anything to find");
+    }
+
+    /// Taking clusters apart from the build before gives, bit for bit, what building again with
+    /// their members locked gives: for any set of clusters (singletons among them), twice in a
+    /// row, on a painted sphere whose colour steps split cells, on a grid whose border is
+    /// locked from the start, and on a sphere with repeated, reversed and degenerate faces
+    /// (whose clustered faces the deduplication drops).
+    #[test]
+    fn take_apart_equals_a_whole_build() {
+        let mut painted = crate::mesh::noisy_sphere(5, 0.01, 7);
+        crate::mesh::paint(&mut painted);
+        let mut repeated = crate::mesh::noisy_sphere(5, 0.01, 9);
+        let n = repeated.triangles.len();
+        for f in (0..n).step_by(7) {
+            let [a, b, c] = repeated.triangles[f];
+            repeated.triangles.extend([[a, b, c], [a, c, b], [a, a, b]]);
+        }
+        let cases = [
+            (painted, false, 0.5),
+            (crate::mesh::grid(60), true, 0.0),
+            (repeated, false, 0.0),
+        ];
+        for (mesh, lock_border, color) in cases {
+            let mut opts = SimplifyOptions::with_ratio(mesh.triangles.len(), 0.1).unwrap();
+            opts.lock_border = lock_border;
+            opts.attributes.color = color;
+            let mut pts = Points::new(&mesh);
+            let mut work = prepare(&mut pts, &opts, true).unwrap();
+            work.colors = super::super::colors::ColourSplit::of(&mesh, color);
+            let mut report = ClusterReport::default();
+            let target = opts.target_faces;
+            let (grid, mut built, _) =
+                cluster_to(&work, 3 * target, None, Some(target), &mut report).unwrap();
+            let what = format!("{} faces, lock_border {lock_border}", mesh.triangles.len());
+            if color > 0.0 {
+                assert!(built.clusters > built.cells, "{what}: no cell was split");
+            }
+            for step in [5usize, 3] {
+                // Every step-th cluster, and every locked vertex's singleton.
+                let mut bad: Vec<u32> = (0..built.clusters as u32)
+                    .filter(|&k| k as usize % step == 1)
+                    .collect();
+                bad.extend(
+                    (0..work.locked.len())
+                        .filter(|&v| work.locked[v])
+                        .map(|v| built.vertex_cluster[v])
+                        .step_by(2),
+                );
+                bad.sort_unstable();
+                bad.dedup();
+                let (apart, _) = take_apart(&mut work, &grid, &built, &bad);
+                let whole = work.build(&grid).unwrap();
+                assert_eq!(bits(&apart), bits(&whole), "{what}: every {step}th cluster");
+                assert!(
+                    whole.clusters > built.clusters,
+                    "{what}: nothing taken apart"
+                );
+                built = whole;
+            }
+        }
+    }
+}
