@@ -1,5 +1,6 @@
 //! `meshslim bench` end to end on small built-in meshes: every requested backend × ratio has a
-//! row with every field, the plot has one series per backend, bad usage exits 2.
+//! row with every field, each of ours is held against its meshoptimizer peer under the table,
+//! the plot has one series per backend, bad usage exits 2.
 
 mod common;
 use common::{expect_code, meshslim};
@@ -50,6 +51,16 @@ fn json_and_plot_have_every_backend_at_every_ratio() {
     expect_code(&o, 0);
     let table = String::from_utf8_lossy(&o.stdout);
     assert!(table.contains("Mtri/s"), "the table is printed:\n{table}");
+    // Under it, each of our rows against its meshoptimizer peer, at both ratios.
+    for (ours, peer) in [("cpu", "meshopt"), ("cluster", "meshopt-sloppy")] {
+        let against = table
+            .lines()
+            .skip_while(|l| !l.starts_with("against meshoptimizer"))
+            .filter(|l| l.split_whitespace().nth(2) == Some(ours))
+            .filter(|l| l.split_whitespace().nth(3) == Some(peer))
+            .count();
+        assert_eq!(against, 2, "{ours} against {peer} at both ratios:\n{table}");
+    }
 
     let text = std::fs::read_to_string(dir.path().join("bench.json")).unwrap();
     let json: serde_json::Value = serde_json::from_str(&text).unwrap();

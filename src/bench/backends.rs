@@ -22,6 +22,10 @@ pub struct BenchBackend {
     /// How far above the target a result may land and still count as on target (clustering
     /// lands within 5% of it, either side).
     pub band: f64,
+    /// The meshoptimizer call it is held against under the table: `simplify` for the edge
+    /// collapses (and decimation, which also keeps the topology and the exact count),
+    /// `simplifySloppy` for the clusterings; `None` for meshoptimizer's own rows.
+    pub peer: Option<&'static str>,
 }
 
 /// Every backend `meshslim bench` knows, in the order of the table and the plot legend.
@@ -32,6 +36,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| ours(m, faces, Method::Qem, Backend::Cpu),
         device: cpu_name,
         band: 0.0,
+        peer: Some("meshopt"),
     },
     BenchBackend {
         name: "cpu-parallel",
@@ -39,6 +44,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| ours(m, faces, Method::Qem, Backend::CpuParallel),
         device: cpu_name,
         band: 0.0,
+        peer: Some("meshopt"),
     },
     BenchBackend {
         name: "gpu",
@@ -46,6 +52,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| ours(m, faces, Method::Qem, Backend::Gpu),
         device: gpu_name,
         band: 0.0,
+        peer: Some("meshopt"),
     },
     BenchBackend {
         name: "cluster",
@@ -53,6 +60,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| ours(m, faces, Method::Cluster, Backend::CpuParallel),
         device: cpu_name,
         band: crate::cluster::BAND,
+        peer: Some("meshopt-sloppy"),
     },
     BenchBackend {
         name: "cluster-gpu",
@@ -60,6 +68,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| ours(m, faces, Method::Cluster, Backend::Gpu),
         device: gpu_name,
         band: crate::cluster::BAND,
+        peer: Some("meshopt-sloppy"),
     },
     BenchBackend {
         name: "floating-cell",
@@ -67,6 +76,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| ours(m, faces, Method::FloatingCell, Backend::CpuParallel),
         device: cpu_name,
         band: crate::cluster::BAND,
+        peer: Some("meshopt-sloppy"),
     },
     BenchBackend {
         name: "floating-cell-gpu",
@@ -74,6 +84,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| ours(m, faces, Method::FloatingCell, Backend::Gpu),
         device: gpu_name,
         band: crate::cluster::BAND,
+        peer: Some("meshopt-sloppy"),
     },
     BenchBackend {
         name: "decimate",
@@ -81,6 +92,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| ours(m, faces, Method::Decimate, Backend::Cpu),
         device: cpu_name,
         band: 0.0,
+        peer: Some("meshopt"),
     },
     BenchBackend {
         name: "hybrid",
@@ -88,6 +100,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| ours(m, faces, Method::Hybrid, Backend::Cpu),
         device: cpu_name,
         band: 0.0,
+        peer: Some("meshopt"),
     },
     BenchBackend {
         name: "hybrid-parallel",
@@ -95,6 +108,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| ours(m, faces, Method::Hybrid, Backend::CpuParallel),
         device: cpu_name,
         band: 0.0,
+        peer: Some("meshopt"),
     },
     BenchBackend {
         name: "hybrid-gpu",
@@ -102,6 +116,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| ours(m, faces, Method::Hybrid, Backend::Gpu),
         device: gpu_name,
         band: 0.0,
+        peer: Some("meshopt"),
     },
     BenchBackend {
         name: "meshopt",
@@ -109,6 +124,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| Ok(meshopt_simplify(m, faces)),
         device: cpu_name,
         band: 0.0,
+        peer: None,
     },
     BenchBackend {
         name: "meshopt-attr-0.1",
@@ -116,6 +132,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| Ok(meshopt_simplify_with_attributes(m, faces, 0.1)),
         device: cpu_name,
         band: 0.0,
+        peer: None,
     },
     BenchBackend {
         name: "meshopt-attr-0.3",
@@ -123,6 +140,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| Ok(meshopt_simplify_with_attributes(m, faces, 0.3)),
         device: cpu_name,
         band: 0.0,
+        peer: None,
     },
     BenchBackend {
         name: "meshopt-attr-1",
@@ -130,6 +148,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| Ok(meshopt_simplify_with_attributes(m, faces, 1.0)),
         device: cpu_name,
         band: 0.0,
+        peer: None,
     },
     BenchBackend {
         name: "meshopt-sloppy",
@@ -137,6 +156,7 @@ pub static BACKENDS: &[BenchBackend] = &[
         simplify: |m, faces| Ok(meshopt_simplify_sloppy(m, faces)),
         device: cpu_name,
         band: 0.0,
+        peer: None,
     },
 ];
 

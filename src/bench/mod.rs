@@ -273,6 +273,7 @@ mod tests {
             simplify,
             device: cpu_name,
             band: 0.0,
+            peer: None,
         };
         let a: &'static BenchBackend = Box::leak(Box::new(backend("a", |m, f| called("a", m, f))));
         let b: &'static BenchBackend = Box::leak(Box::new(backend("b", |m, f| called("b", m, f))));
@@ -301,7 +302,7 @@ mod tests {
     }
 
     #[test]
-    fn run_without_the_counting_allocator_reports_no_peak_and_plots() {
+    fn run_without_the_counting_allocator_reports_no_peak_plots_and_holds_rows_to_peers() {
         let opts = BenchOptions {
             ratios: vec![0.5],
             repeat: 2,
@@ -329,10 +330,26 @@ mod tests {
         assert_eq!(svg.matches(r#"class="series""#).count(), backends);
         let mut table = Vec::new();
         write_table(&mut table, &report).unwrap();
-        // Header, one row per backend, then the three lines of notes under the table.
-        assert_eq!(
-            String::from_utf8(table).unwrap().lines().count(),
-            1 + backends + 3
-        );
+        let text = String::from_utf8(table).unwrap();
+        // Header, one row per backend, the three lines of notes under the table; then the rows
+        // against their peers: a blank line, a heading, a header and every backend but
+        // meshoptimizer's two.
+        assert_eq!(text.lines().count(), 1 + backends + 3 + 3 + backends - 2);
+        let row = |b: &str| report.rows.iter().find(|r| r.backend == b).unwrap();
+        let against = |b: &str| -> Vec<String> {
+            let line = text
+                .lines()
+                .find(|l| l.split_whitespace().nth(2) == Some(b))
+                .unwrap_or_else(|| panic!("no row of {b} against its peer:\n{text}"));
+            line.split_whitespace().map(str::to_string).collect()
+        };
+        for (ours, peer) in [("cpu", "meshopt"), ("cluster", "meshopt-sloppy")] {
+            let (r, p) = (row(ours), row(peer));
+            let fields = against(ours);
+            assert_eq!(fields[3], peer);
+            assert_eq!(fields[4], format!("{:.2}", p.median_s / r.median_s));
+            let error = r.mean_err_rel.unwrap() / p.mean_err_rel.unwrap();
+            assert_eq!(fields[5], format!("{error:.2}"));
+        }
     }
 }

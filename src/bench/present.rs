@@ -117,7 +117,67 @@ pub fn write_table(out: &mut impl Write, report: &Report) -> std::io::Result<()>
         "device: {} ({} cores)",
         devices.join(", "),
         report.machine.cores
-    )
+    )?;
+    write_against_peers(out, report, mesh_w, backend_w)
+}
+
+/// Under the table, each row whose peer (its backend's [`super::BenchBackend::peer`]) ran on
+/// the same mesh at the same ratio: the peer's median time over ours (above 1: ours is
+/// faster) and our mean error over the peer's (below 1: ours is closer). Nothing when no
+/// peer ran.
+fn write_against_peers(
+    out: &mut impl Write,
+    report: &Report,
+    mesh_w: usize,
+    backend_w: usize,
+) -> std::io::Result<()> {
+    let pairs: Vec<(&Row, &Row)> = report
+        .rows
+        .iter()
+        .filter_map(|r| {
+            let peer = super::backend(&r.backend)?.peer?;
+            let p = report
+                .rows
+                .iter()
+                .find(|p| p.backend == peer && p.mesh == r.mesh && p.ratio == r.ratio)?;
+            Some((r, p))
+        })
+        .collect();
+    if pairs.is_empty() {
+        return Ok(());
+    }
+    writeln!(
+        out,
+        "\nagainst meshoptimizer: speed is its median time over ours (above 1: ours is faster), \
+         error our mean error over its (below 1: ours is closer)"
+    )?;
+    let peer_w = pairs
+        .iter()
+        .map(|(_, p)| p.backend.len())
+        .max()
+        .unwrap_or(4);
+    writeln!(
+        out,
+        "{:<mesh_w$} {:>6} {:<backend_w$} {:<peer_w$} {:>6} {:>6}",
+        "mesh", "ratio", "backend", "peer", "speed", "error"
+    )?;
+    for (r, p) in pairs {
+        let error = match (r.mean_err_rel, p.mean_err_rel) {
+            (Some(ours), Some(theirs)) if theirs > 0.0 => format!("{:.2}", ours / theirs),
+            _ => "n/a".to_string(),
+        };
+        writeln!(
+            out,
+            "{:<mesh_w$} {:>6} {:<backend_w$} {:<peer_w$} {:>6.2} {:>6}",
+            r.mesh,
+            r.ratio,
+            r.backend,
+            p.backend,
+            p.median_s / r.median_s,
+            error
+        )?;
+    }
+    Ok(())
 }
 
 /// Marker shapes and colours (Okabe–Ito, safe for colour-blind readers) by index in
