@@ -72,11 +72,11 @@ fn pinched_ends(ends: &[(u32, bool)], pinched: &mut dyn FnMut(u32)) {
 /// A cluster face turned more than 60° from the input face it came from counts as folded.
 const FOLD_COS: f32 = 0.5;
 
-/// Per face of `b`: the unit normal of the input face it came from (its origin). The rounds
-/// after the clustering measure turning from these, not from the clusters' faces. A streamed
-/// input's faces are read in blocks for them; faces in memory are looked up: walking all the
-/// input's faces for the few that survive took 0.006-0.007 s a build on the 1M scan at 1%
-/// (five builds with the repairs), the lookup 0.003-0.005 s.
+/// Per face of `b`: the unit normal of the input face it came from (its origin). The second
+/// phase (the greedy queue or the rounds) measures turning from these, not from the clusters'
+/// faces. A streamed input's faces are read in blocks for them; faces in memory are looked up:
+/// walking all the input's faces for the few that survive took 0.006-0.007 s a build on the 1M
+/// scan at 1% (five builds with the repairs), the lookup 0.003-0.005 s.
 fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
     use crate::compute::common::{cross, length, scale, sub, xyz};
     let pos = &work.pts.positions;
@@ -117,7 +117,7 @@ fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
 
 /// The clusters of each face turned more than 60° from the input face it came from (`normals`,
 /// [`origin_normals`]), sorted: a cell can fold a sheet over, and two clusters a colour step
-/// split in one cell can stand a face on edge; the rounds after may turn a face up to
+/// split in one cell can stand a face on edge; the second phase may turn a face up to
 /// `max_normal_angle_deg` further, so a face left nearly on edge here could end up flipped.
 fn folded_clusters(b: &Built, normals: &[[f32; 3]]) -> Vec<u32> {
     let mut bad: Vec<u32> = b
@@ -185,10 +185,11 @@ fn rechecked(b: &Built, normals: &[[f32; 3]], fresh: &[bool]) -> Vec<u32> {
     bad
 }
 
-/// The hybrid's clustering: to at least `intermediate` faces (the rounds then go to `target`),
-/// clusters that pinch a non-manifold edge or fold a face over taken apart until none is left.
-/// Returns the grid, the build and its faces' input normals ([`origin_normals`]: the rounds'
-/// reference, read once per build since a streamed input reads its file for them).
+/// The hybrid's clustering: to at least `intermediate` faces (the second phase then goes to
+/// `target`), clusters that pinch a non-manifold edge or fold a face over taken apart until
+/// none is left. Returns the grid, the build and its faces' input normals ([`origin_normals`]:
+/// the second phase's reference for turning, read once per build since a streamed input reads
+/// its file for them).
 pub(super) fn cluster_repaired(
     work: &mut Work,
     intermediate: usize,
@@ -199,8 +200,9 @@ pub(super) fn cluster_repaired(
     let mut normals = origin_normals(work, &built)?;
     // Splitting cells by connectivity keeps separate sheets apart, but a sheet folded inside
     // one cell can still pinch into a non-manifold edge: take the clusters on one apart (their
-    // members each their own cluster) and build again, until none is left.
-    // The new singletons of the last repair, when it was worked out from the build before.
+    // members each their own cluster) and build again, until none is left. After a repair
+    // worked out from the build before, only what it changed is checked (`fresh`: its new
+    // singletons).
     let mut fresh: Option<Vec<bool>> = None;
     for _ in 0..MAX_REPAIRS {
         let bad = match &fresh {
