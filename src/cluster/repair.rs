@@ -140,13 +140,22 @@ fn folds(b: &Built, t: [u32; 3], normal: [f32; 3]) -> bool {
     dot(n, normal) < FOLD_COS * length(n)
 }
 
-/// [`pinched_clusters`] and [`folded_clusters`] of `b`, a repair of a build in which every
-/// cluster they found was taken apart ([`take_apart`]; `fresh`: its new singletons). Only what
-/// the repair changed is looked at, the same clusters found: a face without a new singleton
-/// was in the build before, on clusters that stayed, and so neither folded nor on an edge
-/// that pinched; an edge whose faces changed is on a face at a new singleton, so its lower end
-/// is among those faces' clusters. The two checks after the repairs took 0.010 s each on the
-/// 1M scan at 10%, looking at every face.
+/// [`pinched_clusters`] and [`folded_clusters`] of `b` together, sorted, each once.
+fn checked(b: &Built, normals: &[[f32; 3]]) -> Vec<u32> {
+    let mut bad = pinched_clusters(b);
+    bad.extend(folded_clusters(b, normals));
+    bad.sort_unstable();
+    bad.dedup();
+    bad
+}
+
+/// [`checked`] of `b`, a repair of a build in which every cluster it found was taken apart
+/// ([`take_apart`]; `fresh`: its new singletons). Only what the repair changed is looked at,
+/// the same clusters found: a face without a new singleton was in the build before, on
+/// clusters that stayed, and so neither folded nor on an edge that pinched; an edge whose
+/// faces changed is on a face at a new singleton, so its lower end is among those faces'
+/// clusters. The two checks after the repairs took 0.010 s each on the 1M scan at 10%, looking
+/// at every face.
 fn rechecked(b: &Built, normals: &[[f32; 3]], fresh: &[bool]) -> Vec<u32> {
     let mut touched = vec![false; b.clusters];
     let mut bad = Vec::new();
@@ -207,13 +216,7 @@ pub(super) fn cluster_repaired(
     for _ in 0..MAX_REPAIRS {
         let bad = match &fresh {
             Some(fresh) => rechecked(&built, &normals, fresh),
-            None => {
-                let mut bad = pinched_clusters(&built);
-                bad.extend(folded_clusters(&built, &normals));
-                bad.sort_unstable();
-                bad.dedup();
-                bad
-            }
+            None => checked(&built, &normals),
         };
         if bad.is_empty() {
             break;
@@ -476,13 +479,7 @@ mod tests {
             let target = opts.target_faces;
             let (grid, mut built, _) =
                 cluster_to(&work, 2 * target, None, Some(target), &mut report).unwrap();
-            let whole = |b: &Built, work: &Work| {
-                let mut bad = pinched_clusters(b);
-                bad.extend(folded_clusters(b, &origin_normals(work, b).unwrap()));
-                bad.sort_unstable();
-                bad.dedup();
-                bad
-            };
+            let whole = |b: &Built, work: &Work| checked(b, &origin_normals(work, b).unwrap());
             let mut bad = whole(&built, &work);
             assert!(!bad.is_empty(), "seed {seed}: nothing to repair");
             for repair in 0..MAX_REPAIRS {
