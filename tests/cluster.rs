@@ -36,14 +36,23 @@ fn join(a: &Mesh, b: &Mesh) -> Mesh {
 
 #[test]
 fn the_radix_sort_is_the_stable_sort_by_key() {
-    let keys: Vec<u32> = (0..5000u32)
-        .map(|i| (i.wrapping_mul(2_654_435_761) % 70_000) | ((i % 3) << 24))
-        .collect();
-    let (sorted, ids) = stages::radix_sort(&keys);
-    let mut want: Vec<u32> = (0..keys.len() as u32).collect();
-    want.sort_by_key(|&i| keys[i as usize]);
-    assert_eq!(ids, want);
-    assert!(sorted.windows(2).all(|w| w[0] <= w[1]));
+    // Few keys sort in one run, many in runs on every core; both must give the stable order.
+    for n in [5000u32, 300_001] {
+        let keys: Vec<u32> = (0..n)
+            .map(|i| (i.wrapping_mul(2_654_435_761) % 70_000) | ((i % 3) << 24))
+            .collect();
+        let (sorted, ids) = stages::radix_sort(&keys);
+        let mut want: Vec<u32> = (0..keys.len() as u32).collect();
+        want.sort_by_key(|&i| keys[i as usize]);
+        assert_eq!(ids, want, "{n} keys");
+        let want_keys: Vec<u32> = want.iter().map(|&i| keys[i as usize]).collect();
+        assert_eq!(sorted, want_keys, "{n} keys");
+    }
+    // An empty input and all-equal keys (every key in one digit of every pass).
+    assert_eq!(stages::radix_sort(&[]), (vec![], vec![]));
+    let (sorted, ids) = stages::radix_sort(&vec![7u32 << 20; 100_000]);
+    assert_eq!(ids, (0..100_000).collect::<Vec<u32>>());
+    assert!(sorted.iter().all(|&k| k == 7 << 20));
 }
 
 #[test]

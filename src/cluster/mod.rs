@@ -600,9 +600,11 @@ fn prepare<'a, 'm>(
 ) -> Result<Work<'a, 'm>> {
     // Streamed faces have no vertex→face lists: a streamed hybrid scatters its quadrics.
     let gather = (pts.stream.is_none() && (split || opts.lock_border)).then(|| {
-        let csr = Csr::new(pts.positions.len(), &pts.faces);
-        let planes = stages::face_planes(&pts.positions, &pts.faces);
-        let border = border_vertices(&csr, &pts.faces);
+        // One core's counting sort, the planes beside it: 0.050 s one after the other on the
+        // 1M scan at 10% (`hybrid` took 0.5 s), 0.013-0.024 s side by side.
+        let (p, f) = (&pts.positions, &pts.faces);
+        let (csr, planes) = rayon::join(|| Csr::new(p.len(), f), || stages::face_planes(p, f));
+        let border = border_vertices(&csr, f);
         Gather {
             csr,
             planes,

@@ -142,8 +142,10 @@ fn folds(b: &Built, t: [u32; 3], normal: [f32; 3]) -> bool {
 
 /// [`pinched_clusters`] and [`folded_clusters`] of `b` together, sorted, each once.
 fn checked(b: &Built, normals: &[[f32; 3]]) -> Vec<u32> {
-    let mut bad = pinched_clusters(b);
-    bad.extend(folded_clusters(b, normals));
+    // Side by side, since the first starts with one core's counting sort: 0.016-0.020 s one
+    // after the other on the 1M scan at 10%, 0.013-0.019 s.
+    let (mut bad, folded) = rayon::join(|| pinched_clusters(b), || folded_clusters(b, normals));
+    bad.extend(folded);
     bad.sort_unstable();
     bad.dedup();
     bad

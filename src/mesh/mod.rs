@@ -182,22 +182,30 @@ impl Mesh {
                 "{n} vertices exceed the u32 index range"
             )));
         }
+        // The first offending index, found on every core: one core took 0.002 s of each call
+        // on the 1M scan (`cluster` takes 0.09 s).
+        use rayon::prelude::*;
         if let Some(i) = self
             .positions
-            .iter()
-            .position(|p| !p.iter().all(|c| c.is_finite()))
+            .par_iter()
+            .with_min_len(1 << 14)
+            .position_first(|p| !p.iter().all(|c| c.is_finite()))
         {
             return Err(Error::InvalidMesh(format!(
                 "vertex {i} has a non-finite coordinate {:?}",
                 self.positions[i]
             )));
         }
-        for (f, t) in self.triangles.iter().enumerate() {
-            if let Some(&v) = t.iter().find(|&&v| v as usize >= n) {
-                return Err(Error::InvalidMesh(format!(
-                    "face {f} refers to vertex {v}, but the mesh has only {n} vertices"
-                )));
-            }
+        if let Some((f, v)) = self
+            .triangles
+            .par_iter()
+            .enumerate()
+            .with_min_len(1 << 14)
+            .find_map_first(|(f, t)| t.iter().find(|&&v| v as usize >= n).map(|&v| (f, v)))
+        {
+            return Err(Error::InvalidMesh(format!(
+                "face {f} refers to vertex {v}, but the mesh has only {n} vertices"
+            )));
         }
         let check_len = |name: &str, len: Option<usize>, want: usize| match len {
             Some(l) if l != want => Err(Error::InvalidMesh(format!(
