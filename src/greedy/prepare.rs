@@ -111,14 +111,6 @@ impl Prepared {
             .collect();
 
         let tf = |f: &[u32; 3]| f.map(|v| topo[v as usize]);
-        // The faces around each vertex, in face order.
-        let (corners, corner_start) =
-            counting_sort(nt, faces.len() * 3, |c| topo[faces[c / 3][c % 3] as usize]);
-        let faces_of = |v: usize| {
-            corners[corner_start[v] as usize..corner_start[v + 1] as usize]
-                .iter()
-                .map(|&c| c / 3)
-        };
         // A face's unit normal and its plane quadric (area-weighted).
         let plane = |f: usize| {
             let [p0, p1, p2] = tf(&faces[f]).map(|v| pos[v as usize]);
@@ -129,18 +121,31 @@ impl Prepared {
                 (n, Quadric::from_plane(n, -dot(n, p0), 0.5 * len))
             })
         };
-        let ref_normal: Vec<[f32; 3]> = (0..faces.len())
-            .into_par_iter()
-            .map(|f| {
-                let own = plane(f).map(|(n, _)| n.map(|x| x as f32));
-                // The original face under a carried one, as the rounds' upload takes it.
-                let under = carried.and_then(|c| c.normals.get(face_origin[f] as usize));
-                match (own, under) {
-                    (Some(_), Some(&n)) if n != [0.0; 3] => n,
-                    (own, _) => own.unwrap_or([0.0; 3]),
-                }
-            })
-            .collect();
+        // The faces around each vertex, in face order (a counting sort, mostly on one core),
+        // and beside it each face's reference normal: on the 1M scan 0.045-0.054 s one after
+        // the other, 0.030-0.037 s side by side.
+        let ((corners, corner_start), ref_normal) = rayon::join(
+            || counting_sort(nt, faces.len() * 3, |c| topo[faces[c / 3][c % 3] as usize]),
+            || -> Vec<[f32; 3]> {
+                (0..faces.len())
+                    .into_par_iter()
+                    .map(|f| {
+                        let own = plane(f).map(|(n, _)| n.map(|x| x as f32));
+                        // The original face under a carried one, as the rounds' upload takes it.
+                        let under = carried.and_then(|c| c.normals.get(face_origin[f] as usize));
+                        match (own, under) {
+                            (Some(_), Some(&n)) if n != [0.0; 3] => n,
+                            (own, _) => own.unwrap_or([0.0; 3]),
+                        }
+                    })
+                    .collect()
+            },
+        );
+        let faces_of = |v: usize| {
+            corners[corner_start[v] as usize..corner_start[v + 1] as usize]
+                .iter()
+                .map(|&c| c / 3)
+        };
         // Per vertex, in parallel: the sum of its faces' plane quadrics in face order, then the
         // constraint planes of its border and seam edges in ascending order of the other end,
         // which is the order one pass over all edges sorted by (low, high) end gives each

@@ -9,6 +9,7 @@ use super::morton::spatial_order;
 use super::weld::position_classes;
 use super::{Mesh, weld};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 
 /// The welded surface in position classes, in Morton order.
 pub struct Surface {
@@ -63,27 +64,51 @@ impl Surface {
             };
         let (class, mut representative) = spatial_order(&welded.positions, class, firsts);
         let nc = representative.len();
-        let mut kept = Vec::with_capacity(welded.triangles.len());
-        for (f, t) in welded.triangles.iter().enumerate() {
-            let [a, b, c] = t.map(|v| class[v as usize]);
-            if a != b && b != c && a != c {
-                kept.push(f as u32);
-            }
-        }
+        // The faces kept and the vertices they use, on every core: one core took 0.007 s of
+        // the greedy's set-up on the 1M scan for these passes.
+        let kept: Vec<u32> = (0..welded.triangles.len() as u32)
+            .into_par_iter()
+            .with_min_len(1 << 14)
+            .filter(|&f| {
+                let [a, b, c] = welded.triangles[f as usize].map(|v| class[v as usize]);
+                a != b && b != c && a != c
+            })
+            .collect();
         let dropped_degenerate = welded.triangles.len() - kept.len();
-        let mut used = vec![false; welded.positions.len()];
-        for &f in &kept {
+        let used: Vec<AtomicBool> = (0..welded.positions.len())
+            .into_par_iter()
+            .map(|_| AtomicBool::new(false))
+            .collect();
+        // Every store writes `true`: the result is the same whatever the order.
+        kept.par_iter().with_min_len(1 << 14).for_each(|&f| {
             for v in welded.triangles[f as usize] {
-                used[v as usize] = true;
+                used[v as usize].store(true, Relaxed);
             }
-        }
-        let mut attr_count = vec![0u32; nc];
-        for (v, &c) in class.iter().enumerate() {
-            attr_count[c as usize] += used[v] as u32;
-            if used[v] && !used[representative[c as usize] as usize] {
-                representative[c as usize] = v as u32;
+        });
+        let used: Vec<bool> = used.into_par_iter().map(AtomicBool::into_inner).collect();
+        let one_each = class.len() == nc
+            && class
+                .par_iter()
+                .enumerate()
+                .with_min_len(1 << 14)
+                .all(|(v, &c)| representative[c as usize] == v as u32);
+        let attr_count: Vec<u32> = if one_each {
+            // One vertex a class (no attributes): it counts if used, and stays its class's
+            // representative.
+            representative
+                .par_iter()
+                .map(|&v| used[v as usize] as u32)
+                .collect()
+        } else {
+            let mut attr_count = vec![0u32; nc];
+            for (v, &c) in class.iter().enumerate() {
+                attr_count[c as usize] += used[v] as u32;
+                if used[v] && !used[representative[c as usize] as usize] {
+                    representative[c as usize] = v as u32;
+                }
             }
-        }
+            attr_count
+        };
         let lowest = |f: u32| {
             welded.triangles[f as usize]
                 .map(|v| class[v as usize])
