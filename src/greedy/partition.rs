@@ -252,10 +252,9 @@ pub(super) fn partitioned_level(
     debug_assert!(total(&subs) >= lowest, "a region went below its floor");
 
     // Write the regions back into the whole mesh: moved vertices, merged quadrics, live faces.
-    // Each region's live faces are picked out on every core first (A sub-problem's faces carry
-    // their attribute vertices of the whole mesh (or, with attributes, its own, mapped back)
-    // and, as origin, their index in the whole mesh's face list); the crossing faces go first.
-    let (p_ref, face_region) = (&p, &face_region);
+    // The crossing faces first, then each region's own live faces, picked out on every core.
+    // A sub-problem's faces carry their attribute vertices of the whole mesh (or, with
+    // attributes, its own, mapped back) and, as origin, their index in the whole mesh's faces.
     let live: Vec<Vec<(u32, [u32; 3])>> = subs
         .par_iter()
         .enumerate()
