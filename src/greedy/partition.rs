@@ -12,6 +12,9 @@ pub(super) const SECOND_LEVEL_REGIONS: usize = 4;
 /// stop (see [`partitioned_level`]); a few epochs still report progress.
 const UNSTOPPABLE_LEVEL_STEP: f32 = 64.0;
 
+/// Faces per task when sorting the faces into their regions' lists.
+const REGION_LIST_CHUNK: usize = 1 << 16;
+
 /// The partitioned levels stop once the mesh is within 20% of the target.
 pub(super) fn partitioned_stop(target: usize) -> usize {
     (target as f64 * 1.2) as usize
@@ -137,11 +140,11 @@ pub(super) fn partitioned_level(
     // Chunks of the faces sorted into regions on every core, then each region's lists joined
     // in chunk order: the same lists. One core took 0.01-0.02 s for them on the 1M scan.
     let chunked: Vec<Vec<Vec<u32>>> = face_region
-        .par_chunks(1 << 16)
+        .par_chunks(REGION_LIST_CHUNK)
         .enumerate()
         .map(|(i, chunk)| {
             let mut lists: Vec<Vec<u32>> = vec![Vec::new(); regions];
-            for (f, &fr) in ((i << 16)..).zip(chunk) {
+            for (f, &fr) in (i * REGION_LIST_CHUNK..).zip(chunk) {
                 if fr != u32::MAX {
                     lists[fr as usize].push(f as u32);
                 } else {
