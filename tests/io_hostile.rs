@@ -431,3 +431,40 @@ fn writes_are_atomic_and_validated() {
     assert!(io::write(&dir.path().join("no/such/dir/x.obj"), &full_mesh()).is_err());
     assert!(err_text(io::read(&dir.path().join("missing.obj"))).contains("missing.obj"));
 }
+
+/// A mesh built in memory (not read, so no reader caught it) is checked at the library's
+/// boundary: `validate` names the first bad vertex and the first bad face, however many bad
+/// ones follow and wherever they fall among the chunks it checks on every core.
+#[test]
+fn validate_names_the_first_offender() {
+    let mut m = meshslim::mesh::grid(300);
+    let (nv, nf) = (m.positions.len(), m.triangles.len());
+    assert!(nv > 3 * (1 << 14) && nf > 3 * (1 << 14));
+    m.validate().unwrap();
+    let err = |m: &Mesh| m.validate().unwrap_err().to_string();
+    let mut bad = m.clone();
+    for (i, c) in [
+        (70_000, f32::INFINITY),
+        (40_000, f32::NAN),
+        (90_000, f32::NAN),
+    ] {
+        bad.positions[i][1] = c;
+    }
+    let msg = err(&bad);
+    assert!(msg.contains("vertex 40000 has a non-finite"), "{msg}");
+    let mut bad = m.clone();
+    bad.positions[nv - 1][2] = f32::NEG_INFINITY;
+    assert!(err(&bad).contains(&format!("vertex {}", nv - 1)));
+    let mut bad = m.clone();
+    bad.triangles[nf - 1] = [0, nv as u32 + 7, 1];
+    bad.triangles[50_001] = [1, 2, nv as u32];
+    bad.triangles[60_000] = [u32::MAX, 0, 1];
+    let msg = err(&bad);
+    assert!(
+        msg.contains(&format!("face 50001 refers to vertex {nv},")),
+        "{msg}"
+    );
+    let mut bad = m.clone();
+    bad.triangles[0] = [0, 1, nv as u32];
+    assert!(err(&bad).contains(&format!("face 0 refers to vertex {nv},")));
+}

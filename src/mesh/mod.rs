@@ -182,27 +182,45 @@ impl Mesh {
                 "{n} vertices exceed the u32 index range"
             )));
         }
-        // The first offending index, found on every core: one core took 0.002 s of each call
-        // on the 1M scan (`cluster` takes 0.09 s).
+        // The first offending index, found on every core a chunk at a time: each chunk is
+        // first checked by a plain loop the compiler vectorizes, and searched only when it
+        // fails. Per item through rayon's `position_first` this took 0.011 s on the 1M scan
+        // (`cluster` takes 0.08 s), this 0.001 s.
         use rayon::prelude::*;
+        const CHUNK: usize = 1 << 14;
+        let finite = |p: &[f32; 3]| p.iter().all(|c| c.is_finite());
         if let Some(i) = self
             .positions
-            .par_iter()
-            .with_min_len(1 << 14)
-            .position_first(|p| !p.iter().all(|c| c.is_finite()))
+            .par_chunks(CHUNK)
+            .enumerate()
+            .find_map_first(|(c, ps)| {
+                let all = ps.iter().fold(true, |ok, p| ok & finite(p));
+                (!all).then(|| {
+                    c * CHUNK + ps.iter().position(|p| !finite(p)).expect("a failed chunk")
+                })
+            })
         {
             return Err(Error::InvalidMesh(format!(
                 "vertex {i} has a non-finite coordinate {:?}",
                 self.positions[i]
             )));
         }
-        if let Some((f, v)) = self
+        if let Some(f) = self
             .triangles
-            .par_iter()
+            .par_chunks(CHUNK)
             .enumerate()
-            .with_min_len(1 << 14)
-            .find_map_first(|(f, t)| t.iter().find(|&&v| v as usize >= n).map(|&v| (f, v)))
+            .find_map_first(|(c, ts)| {
+                let top = ts.iter().fold(0u32, |m, t| m.max(t[0]).max(t[1]).max(t[2]));
+                ((top as usize) >= n).then(|| {
+                    let inside = |t: &[u32; 3]| t.iter().all(|&v| (v as usize) < n);
+                    c * CHUNK + ts.iter().position(|t| !inside(t)).expect("a failed chunk")
+                })
+            })
         {
+            let v = self.triangles[f]
+                .into_iter()
+                .find(|&v| v as usize >= n)
+                .expect("the face found has an index out of range");
             return Err(Error::InvalidMesh(format!(
                 "face {f} refers to vertex {v}, but the mesh has only {n} vertices"
             )));
