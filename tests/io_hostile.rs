@@ -437,7 +437,7 @@ fn writes_are_atomic_and_validated() {
 /// ones follow and wherever they fall among the chunks it checks on every core.
 #[test]
 fn validate_names_the_first_offender() {
-    let mut m = meshslim::mesh::grid(300);
+    let m = meshslim::mesh::grid(300);
     let (nv, nf) = (m.positions.len(), m.triangles.len());
     assert!(nv > 3 * (1 << 14) && nf > 3 * (1 << 14));
     m.validate().unwrap();
