@@ -161,14 +161,21 @@ fn checked(b: &Built, normals: &[[f32; 3]]) -> Vec<u32> {
 fn rechecked(b: &Built, normals: &[[f32; 3]], fresh: &[bool]) -> Vec<u32> {
     let mut touched = vec![false; b.clusters];
     let mut bad = Vec::new();
-    for (&(_, t), &o) in b.faces.iter().zip(normals) {
-        if t.iter().any(|&k| fresh[k as usize]) {
-            for k in t {
-                touched[k as usize] = true;
-            }
-            if folds(b, t, o) {
-                bad.extend(t);
-            }
+    // The faces at a new singleton (a few thousand), found on every core.
+    let at_fresh: Vec<u32> = b
+        .faces
+        .par_iter()
+        .enumerate()
+        .with_min_len(1 << 14)
+        .filter_map(|(i, (_, t))| t.iter().any(|&k| fresh[k as usize]).then_some(i as u32))
+        .collect();
+    for &i in &at_fresh {
+        let t = b.faces[i as usize].1;
+        for k in t {
+            touched[k as usize] = true;
+        }
+        if folds(b, t, normals[i as usize]) {
+            bad.extend(t);
         }
     }
     // (lower end, other end, runs forward) of every half-edge from a touched cluster.
@@ -262,16 +269,25 @@ fn take_apart(work: &mut Work, grid: &Grid, b: &Built, bad: &[u32]) -> (Built, V
         is_bad[k as usize] = true;
     }
     // The locked vertices, in id order: the singleton clusters at the end of the numbering, with
-    // their placement where they were singletons before.
-    let mut singles: Vec<(u32, Option<super::stages::Placed>)> = Vec::new();
-    for (v, &k) in b.vertex_cluster.iter().enumerate() {
-        if work.locked[v] {
-            singles.push((v as u32, Some(b.placed[k as usize])));
-        } else if is_bad[k as usize] {
-            work.locked[v] = true;
-            singles.push((v as u32, None));
-        }
-    }
+    // their placement where they were singletons before. Picked out on every core (an ordered
+    // collect keeps the id order).
+    let singles: Vec<(u32, Option<super::stages::Placed>)> = work
+        .locked
+        .par_iter_mut()
+        .zip(&b.vertex_cluster)
+        .enumerate()
+        .with_min_len(1 << 14)
+        .filter_map(|(v, (locked, &k))| {
+            if *locked {
+                Some((v as u32, Some(b.placed[k as usize])))
+            } else if is_bad[k as usize] {
+                *locked = true;
+                Some((v as u32, None))
+            } else {
+                None
+            }
+        })
+        .collect();
     // The clusters that stay, in their order; a cell's clusters are consecutive, so counting
     // key changes counts the cells.
     let positions = &work.pts.positions;
