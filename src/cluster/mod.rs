@@ -21,6 +21,7 @@ pub mod gpu;
 pub mod gpu_schedule;
 pub mod grid;
 mod hybrid;
+mod output;
 mod repair;
 pub mod stages;
 pub mod stream;
@@ -28,12 +29,13 @@ pub mod stream;
 pub use floating::simplify_floating;
 pub use hybrid::{HYBRID_EXTRA, HYBRID_FACTOR, HYBRID_MIN_SHARE, HYBRID_SKIP, simplify_hybrid};
 pub(crate) use hybrid::{clustered, rounds_upload, second_phase};
+use output::output;
 
 use crate::compute::common::{V3, xyz};
 use crate::compute::types::Quadric;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::mesh::prepare::{denormalize, frame_of_box, normalize};
+use crate::mesh::prepare::{frame_of_box, normalize};
 use crate::options::{Backend, ClusterReport, Method, SimplifyOptions, SimplifyReport, StopReason};
 use grid::Grid;
 use rayon::prelude::*;
@@ -460,70 +462,6 @@ fn count_at(probed: &[(f64, f64)], h: f64) -> f64 {
         }
     }
     (a * b).sqrt()
-}
-
-/// What to hand out: the mesh (vertices at the clusters, attributes of the nearest member or,
-/// with `fit_colors`, colours fitted over the cell; unused clusters dropped) and each output
-/// vertex's quadric.
-fn output(mesh: &Mesh, pts: &Points, b: &Built, fit_colors: bool) -> (Mesh, Vec<Quadric>) {
-    let mut id = vec![u32::MAX; b.clusters];
-    let mut order = Vec::new();
-    for (_, t) in &b.faces {
-        for &k in t {
-            if id[k as usize] == u32::MAX {
-                id[k as usize] = order.len() as u32;
-                order.push(k);
-            }
-        }
-    }
-    let src = |k: u32| pts.attr[b.placed[k as usize].attr as usize] as usize;
-    let mut out = mesh.clone_without_geometry();
-    out.positions = order
-        .par_iter()
-        .map(|&k| {
-            let p = &b.placed[k as usize];
-            if p.how == Placement::Single {
-                mesh.positions[src(k)]
-            } else {
-                let q = p.pos.map(|x| x as f64);
-                denormalize(q, pts.center, pts.scale)
-            }
-        })
-        .collect();
-    out.normals = mesh
-        .normals
-        .as_ref()
-        .map(|n| order.iter().map(|&k| n[src(k)]).collect());
-    out.uvs = mesh
-        .uvs
-        .as_ref()
-        .map(|n| order.iter().map(|&k| n[src(k)]).collect());
-    out.colors = fit_colors
-        .then(|| colors::cluster_colors(mesh, pts, b, &order))
-        .flatten()
-        .or_else(|| {
-            mesh.colors
-                .as_ref()
-                .map(|n| order.iter().map(|&k| n[src(k)]).collect())
-        });
-    out.triangles = b
-        .faces
-        .iter()
-        .map(|(_, t)| t.map(|k| id[k as usize]))
-        .collect();
-    out.face_materials = mesh
-        .face_materials
-        .as_ref()
-        .map(|m| b.faces.iter().map(|(f, _)| m[*f as usize]).collect());
-    out.face_groups = mesh
-        .face_groups
-        .as_ref()
-        .map(|g| b.faces.iter().map(|(f, _)| g[*f as usize]).collect());
-    let quadrics = order
-        .iter()
-        .map(|&k| b.placed[k as usize].quadric)
-        .collect();
-    (out, quadrics)
 }
 
 fn tally(report: &mut ClusterReport, b: &Built) {
