@@ -211,7 +211,8 @@ mod tests {
     use super::*;
 
     /// The border vertices are the grid's outline and none of its inside; a closed sphere has
-    /// none, and a face that repeats a vertex adds none (its edges lie on the sphere's own).
+    /// none, and a face that repeats a vertex adds none (its edges lie on the sphere's own); a
+    /// fan's centre is inside when the fan is closed.
     #[test]
     fn border_vertices_are_the_ends_of_one_face_edges() {
         let border = |m: &Mesh| {
@@ -232,6 +233,31 @@ mod tests {
         let [a, c, _] = s.triangles[0];
         s.triangles.push([a, a, c]);
         assert!(!border(&s).contains(&true));
+        // Fans around vertex 0 of 7 and 12 faces, both sides of the counting's width: closed,
+        // the centre is inside; one face short, it is on the border too.
+        for n in [7u32, 12] {
+            let mut fan = Mesh::new(
+                (0..=n)
+                    .map(|i| {
+                        let a = i as f32 * std::f32::consts::TAU / n as f32;
+                        if i == 0 {
+                            [0.0; 3]
+                        } else {
+                            [a.cos(), a.sin(), 0.1]
+                        }
+                    })
+                    .collect(),
+                (1..=n).map(|i| [0, i, i % n + 1]).collect(),
+            );
+            let rim = |centre: bool| {
+                let mut b = vec![true; n as usize + 1];
+                b[0] = centre;
+                b
+            };
+            assert_eq!(border(&fan), rim(false), "closed fan of {n}");
+            fan.triangles.pop();
+            assert_eq!(border(&fan), rim(true), "open fan of {n}");
+        }
     }
 
     /// The cells' labels are each vertex's lowest in-cell component id, the same on one thread
