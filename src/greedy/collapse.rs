@@ -96,9 +96,11 @@ impl<'a> State<'a> {
 impl<'a> State<'a> {
     /// Sets up the collapse state and queues every unique edge once, keyed by its quadric error.
     pub(super) fn new(p: Prepared, opts: &'a SimplifyOptions) -> (State<'a>, Queue) {
+        use rayon::prelude::*;
         let topo_faces: Vec<[u32; 3]> = p
             .faces
-            .iter()
+            .par_iter()
+            .with_min_len(1 << 14)
             .map(|f| f.map(|v| p.topo[v as usize]))
             .collect();
         State::with_topo_faces(p, topo_faces, opts)

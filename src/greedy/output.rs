@@ -2,6 +2,7 @@
 
 use super::prepare::Prepared;
 use crate::mesh::Mesh;
+use rayon::prelude::*;
 
 /// What the output's normals are.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -47,16 +48,25 @@ pub(crate) fn build_output(
     if let Some(at) = &p.attrs {
         at.write(&mut out);
     }
-    for (v, pos) in out.positions.iter_mut().enumerate() {
-        let t = p.topo[v] as usize;
-        // Only moved vertices go back through the frame: a round trip through f64 could shift
-        // a vertex that stayed (a locked border, a seam) by one float step.
-        if vertex_alive[t] && p.pos[t] != p.normalize(*pos) {
-            *pos = p.denormalize(p.pos[t]);
-        }
-    }
-    let live: Vec<usize> = (0..p.faces.len()).filter(|&f| face_alive[f]).collect();
-    out.triangles = live.iter().map(|&f| p.faces[f]).collect();
+    // Each vertex and face on its own, so on every core.
+    out.positions
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(1 << 14)
+        .for_each(|(v, pos)| {
+            let t = p.topo[v] as usize;
+            // Only moved vertices go back through the frame: a round trip through f64 could
+            // shift a vertex that stayed (a locked border, a seam) by one float step.
+            if vertex_alive[t] && p.pos[t] != p.normalize(*pos) {
+                *pos = p.denormalize(p.pos[t]);
+            }
+        });
+    let live: Vec<usize> = (0..p.faces.len())
+        .into_par_iter()
+        .with_min_len(1 << 14)
+        .filter(|&f| face_alive[f])
+        .collect();
+    out.triangles = live.par_iter().map(|&f| p.faces[f]).collect();
     let origin = |f: usize| p.face_origin[f] as usize;
     out.face_materials = p
         .mesh
