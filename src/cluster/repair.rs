@@ -161,7 +161,7 @@ fn checked(b: &Built, normals: &[[f32; 3]]) -> Vec<u32> {
 fn rechecked(b: &Built, normals: &[[f32; 3]], fresh: &[bool]) -> Vec<u32> {
     let mut touched = vec![false; b.clusters];
     let mut bad = Vec::new();
-    // The faces at a new singleton (a few thousand), found on every core.
+    // The faces at a new singleton, picked out on every core.
     let at_fresh: Vec<u32> = b
         .faces
         .par_iter()
