@@ -78,14 +78,7 @@ const FOLD_COS: f32 = 0.5;
 /// walking all the input's faces for the few that survive took 0.006-0.007 s a build on the 1M
 /// scan at 1% (five builds with the repairs), the lookup 0.003-0.005 s.
 fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
-    use crate::compute::common::{cross, length, scale, sub, xyz};
-    let pos = &work.pts.positions;
-    let normal = |t: &[u32; 3]| {
-        let p = t.map(|v| xyz(pos[v as usize]));
-        let c = cross(sub(p[1], p[0]), sub(p[2], p[0]));
-        let l = length(c);
-        if l > 0.0 { scale(c, 1.0 / l) } else { [0.0; 3] }
-    };
+    let normal = |t: &[u32; 3]| unit_normal(&work.pts.positions, t);
     if work.pts.stream.is_none() {
         let faces = &work.pts.faces;
         return Ok(b
@@ -113,6 +106,16 @@ fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
         Ok(())
     })?;
     Ok(normals)
+}
+
+/// The unit normal of the face on points `t` (zero for a degenerate face): one input face's
+/// entry of [`origin_normals`].
+fn unit_normal(positions: &[[f32; 4]], t: &[u32; 3]) -> [f32; 3] {
+    use crate::compute::common::{cross, length, scale, sub, xyz};
+    let p = t.map(|v| xyz(positions[v as usize]));
+    let c = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+    let l = length(c);
+    if l > 0.0 { scale(c, 1.0 / l) } else { [0.0; 3] }
 }
 
 /// The clusters of each face turned more than 60° from the input face it came from (`normals`,
@@ -157,8 +160,10 @@ fn checked(b: &Built, normals: &[[f32; 3]]) -> Vec<u32> {
 /// clusters that stayed, and so neither folded nor on an edge that pinched; an edge whose
 /// faces changed is on a face at a new singleton, so its lower end is among those faces'
 /// clusters. The two checks after the repairs took 0.010 s each on the 1M scan at 10%, looking
-/// at every face.
-fn rechecked(b: &Built, normals: &[[f32; 3]], fresh: &[bool]) -> Vec<u32> {
+/// at every face. `normal` gives a face's input normal by its index in `b.faces`: only the
+/// faces at new singletons are asked (of 250k, 25k after the first repair of the 1M scan at
+/// 10%), so no repair's normals are worked out for every face but the last one's.
+fn rechecked(b: &Built, normal: impl Fn(usize) -> [f32; 3], fresh: &[bool]) -> Vec<u32> {
     let mut touched = vec![false; b.clusters];
     let mut bad = Vec::new();
     // The faces at a new singleton, picked out on every core.
@@ -174,7 +179,7 @@ fn rechecked(b: &Built, normals: &[[f32; 3]], fresh: &[bool]) -> Vec<u32> {
         for k in t {
             touched[k as usize] = true;
         }
-        if folds(b, t, normals[i as usize]) {
+        if folds(b, t, normal(i as usize)) {
             bad.extend(t);
         }
     }
@@ -206,8 +211,8 @@ fn rechecked(b: &Built, normals: &[[f32; 3]], fresh: &[bool]) -> Vec<u32> {
 /// The hybrid's clustering: to at least `intermediate` faces (the second phase then goes to
 /// `target`), clusters that pinch a non-manifold edge or fold a face over taken apart until
 /// none is left. Returns the grid, the build and its faces' input normals ([`origin_normals`]:
-/// the second phase's reference for turning, read once per build since a streamed input reads
-/// its file for them).
+/// the second phase's reference for turning, worked out for the first build, for each whole
+/// build again and for the last build, since a streamed input reads its file for them).
 pub(super) fn cluster_repaired(
     work: &mut Work,
     intermediate: usize,
@@ -215,7 +220,9 @@ pub(super) fn cluster_repaired(
     report: &mut ClusterReport,
 ) -> Result<(Grid, Built, Vec<[f32; 3]>)> {
     let (grid, mut built, _) = cluster_to(work, intermediate, None, Some(target), report)?;
-    let mut normals = origin_normals(work, &built)?;
+    // The faces' input normals for the build in `built`; `None` after a repair worked out from
+    // the build before, whose check asks only for its new faces' normals.
+    let mut normals = Some(origin_normals(work, &built)?);
     // Splitting cells by connectivity keeps separate sheets apart, but a sheet folded inside
     // one cell can still pinch into a non-manifold edge: take the clusters on one apart (their
     // members each their own cluster) and build again, until none is left. After a repair
@@ -223,9 +230,20 @@ pub(super) fn cluster_repaired(
     // singletons).
     let mut fresh: Option<Vec<bool>> = None;
     for _ in 0..MAX_REPAIRS {
-        let bad = match &fresh {
-            Some(fresh) => rechecked(&built, &normals, fresh),
-            None => checked(&built, &normals),
+        let bad = match (&fresh, &normals) {
+            (Some(fresh), _) => {
+                // Repairs worked out from the build before need the vertex→face lists, which
+                // only faces in memory have.
+                assert!(
+                    work.pts.stream.is_none(),
+                    "a streamed build was taken apart"
+                );
+                let (faces, pos) = (&work.pts.faces, &work.pts.positions);
+                let origin = |i: usize| &faces[built.faces[i].0 as usize];
+                rechecked(&built, |i| unit_normal(pos, origin(i)), fresh)
+            }
+            (None, Some(normals)) => checked(&built, normals),
+            (None, None) => unreachable!("a whole build's normals are worked out with it"),
         };
         if bad.is_empty() {
             break;
@@ -245,10 +263,17 @@ pub(super) fn cluster_repaired(
                 (work.build(&grid)?, None)
             }
         };
-        normals = origin_normals(work, &built)?;
+        normals = match fresh {
+            Some(_) => None,
+            None => Some(origin_normals(work, &built)?),
+        };
         report.builds += 1;
         report.repaired_clusters += bad.len();
     }
+    let normals = match normals {
+        Some(normals) => normals,
+        None => origin_normals(work, &built)?,
+    };
     Ok((grid, built, normals))
 }
 
@@ -509,7 +534,7 @@ mod tests {
                 bad = whole(&built, &work);
                 let normals = origin_normals(&work, &built).unwrap();
                 assert_eq!(
-                    rechecked(&built, &normals, &fresh),
+                    rechecked(&built, |i| normals[i], &fresh),
                     bad,
                     "seed {seed}, repair {repair}"
                 );
