@@ -54,6 +54,23 @@ impl Queue {
         }
     }
 
+    /// [`Queue::push`] of every entry of `parts`, each bucket's room made once first: grown
+    /// entry by entry, the buckets were copied into new blocks again and again.
+    pub(crate) fn push_all(&mut self, parts: &[Vec<(u32, u32, u32, u32)>]) {
+        let mut count = vec![0usize; BUCKETS];
+        for &(key, ..) in parts.iter().flatten() {
+            if u64::from(key) >= self.active_end {
+                count[(key >> BUCKET_SHIFT) as usize] += 1;
+            }
+        }
+        for (bucket, &n) in self.buckets.iter_mut().zip(&count) {
+            bucket.reserve(n);
+        }
+        for &(key, a, b, stamp) in parts.iter().flatten() {
+            self.push(key, a, b, stamp);
+        }
+    }
+
     /// The entry with the smallest key; when a new bucket comes up, only its entries that are
     /// still `current` are kept.
     pub(crate) fn pop(
@@ -177,5 +194,48 @@ mod tests {
         }
         assert_eq!(n, keys.len().div_ceil(2));
         assert!(q.is_empty());
+    }
+
+    /// Pushing parts at once gives back what pushing each entry gives, into a fresh queue and
+    /// into one being drained (entries below the bucket being taken go to its heap).
+    #[test]
+    fn push_all_equals_pushing_each_entry() {
+        let entry = |i: u32| {
+            let key = (1.0 + (i.wrapping_mul(2_654_435_761) % 613) as f32 * 1e-2).to_bits();
+            (key >> (i % 4), i % 5, i, i % 3)
+        };
+        let parts: Vec<Vec<(u32, u32, u32, u32)>> = (0..7u32)
+            .map(|p| (p * 300..p * 300 + 100 + 37 * p).map(entry).collect())
+            .collect();
+        let (mut one, mut all) = (Queue::new(), Queue::new());
+        for &(k, a, b, s) in parts.iter().flatten() {
+            one.push(k, a, b, s);
+        }
+        all.push_all(&parts);
+        let mut taken = 0;
+        loop {
+            let e = one.pop(|_, _, _| true);
+            assert_eq!(e, all.pop(|_, _, _| true));
+            let Some((key, ..)) = e else { break };
+            taken += 1;
+            if taken == 50 {
+                // Mid-drain: some of these fall below the bucket being taken.
+                let late: Vec<Vec<_>> = vec![(5000..5100).map(entry).collect(), vec![]];
+                for &(k, a, b, s) in late.iter().flatten() {
+                    one.push(k.max(key), a, b, s);
+                }
+                let late: Vec<Vec<_>> = late
+                    .into_iter()
+                    .map(|p| {
+                        p.into_iter()
+                            .map(|(k, a, b, s)| (k.max(key), a, b, s))
+                            .collect()
+                    })
+                    .collect();
+                all.push_all(&late);
+            }
+        }
+        assert!(taken > 150, "only {taken} entries came out");
+        assert!(one.is_empty() && all.is_empty());
     }
 }
