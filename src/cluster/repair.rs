@@ -160,9 +160,9 @@ fn checked(b: &Built, normals: &[[f32; 3]]) -> Vec<u32> {
 /// clusters that stayed, and so neither folded nor on an edge that pinched; an edge whose
 /// faces changed is on a face at a new singleton, so its lower end is among those faces'
 /// clusters. The two checks after the repairs took 0.010 s each on the 1M scan at 10%, looking
-/// at every face. `normal` gives a face's input normal by its index in `b.faces`: only the
-/// faces at new singletons are asked (of 250k, 25k after the first repair of the 1M scan at
-/// 10%), so no repair's normals are worked out for every face but the last one's.
+/// at every face. `normal` gives a face's input normal by its index in `b.faces`; only the
+/// faces at new singletons are asked for theirs, so after a repair only the last build's
+/// normals are worked out for every face.
 fn rechecked(b: &Built, normal: impl Fn(usize) -> [f32; 3], fresh: &[bool]) -> Vec<u32> {
     let mut touched = vec![false; b.clusters];
     let mut bad = Vec::new();
@@ -318,7 +318,7 @@ fn take_apart(work: &mut Work, grid: &Grid, b: &Built, bad: &[u32]) -> (Built, V
     let positions = &work.pts.positions;
     let mut new_id = vec![u32::MAX; b.clusters];
     // Room for the singletons too: growing past `b.clusters` copied every placement into a
-    // new block (on the 1M scan at 10%, 8% of a `hybrid` call's page faults, both repairs).
+    // new block (on the 1M scan at 10%, that copy took 8% of a `hybrid` call's page faults).
     let mut placed = Vec::with_capacity(b.clusters + singles.len());
     let mut cells = 0;
     let mut last_key = None;
