@@ -3,7 +3,9 @@
 //! than built again (docs/PERFORMANCE.md, "`hybrid`: its repairs worked out, not built again").
 
 use super::grid::Grid;
+use super::stages::face_plane;
 use super::{Built, ClusterReport, Work, cluster_to};
+use crate::compute::common::xyz;
 use crate::error::Result;
 use rayon::prelude::*;
 
@@ -76,16 +78,15 @@ const FOLD_COS: f32 = 0.5;
 /// phase (the greedy queue or the rounds) measures turning from these, not from the clusters'
 /// faces. A streamed input's faces are read in blocks for them; faces in memory are looked up:
 /// walking all the input's faces for the few that survive took 0.006-0.007 s a build on the 1M
-/// scan at 1% (five builds with the repairs), the lookup 0.003-0.005 s.
+/// scan at 1% (five builds with the repairs), the lookup 0.003-0.005 s. Faces in memory have
+/// their planes already (the gather's), whose normals are these.
 fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
-    let normal = |t: &[u32; 3]| unit_normal(&work.pts.positions, t);
-    if work.pts.stream.is_none() {
-        let faces = &work.pts.faces;
+    if work.gather.is_some() {
         return Ok(b
             .faces
             .par_iter()
             .with_min_len(4096)
-            .map(|&(origin, _)| normal(&faces[origin as usize]))
+            .map(|&(origin, _)| input_normal(work, origin))
             .collect());
     }
     let mut at: Vec<u32> = Vec::new();
@@ -100,7 +101,7 @@ fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
     work.pts.blocks(&mut |first, faces| {
         for (i, t) in faces.iter().enumerate() {
             if let Some(&k) = at.get(first + i).filter(|&&k| k != u32::MAX) {
-                normals[k as usize] = normal(t);
+                normals[k as usize] = xyz(face_plane(&work.pts.positions, t));
             }
         }
         Ok(())
@@ -108,14 +109,14 @@ fn origin_normals(work: &Work, b: &Built) -> Result<Vec<[f32; 3]>> {
     Ok(normals)
 }
 
-/// The unit normal of the face on points `t` (zero for a degenerate face): one input face's
-/// entry of [`origin_normals`].
-fn unit_normal(positions: &[[f32; 4]], t: &[u32; 3]) -> [f32; 3] {
-    use crate::compute::common::{cross, length, scale, sub, xyz};
-    let p = t.map(|v| xyz(positions[v as usize]));
-    let c = cross(sub(p[1], p[0]), sub(p[2], p[0]));
-    let l = length(c);
-    if l > 0.0 { scale(c, 1.0 / l) } else { [0.0; 3] }
+/// The unit normal of input face `origin` (zero for a degenerate face), from the gather's
+/// planes: one entry of [`origin_normals`] for faces in memory.
+fn input_normal(work: &Work, origin: u32) -> [f32; 3] {
+    let g = work
+        .gather
+        .as_ref()
+        .expect("faces in memory have the gather's planes");
+    xyz(g.planes[origin as usize])
 }
 
 /// The clusters of each face turned more than 60° from the input face it came from (`normals`,
@@ -232,15 +233,9 @@ pub(super) fn cluster_repaired(
     for _ in 0..MAX_REPAIRS {
         let bad = match (&fresh, &normals) {
             (Some(fresh), _) => {
-                // Repairs worked out from the build before need the vertex→face lists, which
-                // only faces in memory have.
-                assert!(
-                    work.pts.stream.is_none(),
-                    "a streamed build was taken apart"
-                );
-                let (faces, pos) = (&work.pts.faces, &work.pts.positions);
-                let origin = |i: usize| &faces[built.faces[i].0 as usize];
-                rechecked(&built, |i| unit_normal(pos, origin(i)), fresh)
+                // Repairs worked out from the build before need the vertex→face lists, so the
+                // gather's planes are there.
+                rechecked(&built, |i| input_normal(work, built.faces[i].0), fresh)
             }
             (None, Some(normals)) => checked(&built, normals),
             (None, None) => unreachable!("a whole build's normals are worked out with it"),
@@ -288,7 +283,6 @@ pub(super) fn cluster_repaired(
 /// build and, per cluster, whether it is a new singleton.
 fn take_apart(work: &mut Work, grid: &Grid, b: &Built, bad: &[u32]) -> (Built, Vec<bool>) {
     use super::stages::cluster_quadric;
-    use crate::compute::common::xyz;
     let mut is_bad = vec![false; b.clusters];
     for &k in bad {
         is_bad[k as usize] = true;

@@ -60,18 +60,21 @@ pub fn face_planes(positions: &[[f32; 4]], faces: &[[u32; 3]]) -> Vec<[f32; 4]> 
     faces
         .par_iter()
         .with_min_len(4096)
-        .map(|t| {
-            let p = t.map(|v| xyz(positions[v as usize]));
-            let c = cross(sub(p[1], p[0]), sub(p[2], p[0]));
-            let l = length(c);
-            if l > 0.0 {
-                let n = scale(c, 1.0 / l);
-                [n[0], n[1], n[2], 0.5 * l]
-            } else {
-                [0.0; 4]
-            }
-        })
+        .map(|t| face_plane(positions, t))
         .collect()
+}
+
+/// One face's entry of [`face_planes`].
+pub fn face_plane(positions: &[[f32; 4]], t: &[u32; 3]) -> [f32; 4] {
+    let p = t.map(|v| xyz(positions[v as usize]));
+    let c = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+    let l = length(c);
+    if l > 0.0 {
+        let n = scale(c, 1.0 / l);
+        [n[0], n[1], n[2], 0.5 * l]
+    } else {
+        [0.0; 4]
+    }
 }
 
 /// `cell_keys`: per vertex, the Morton key of its cell, or [`SINGLETON`] for a locked vertex.
