@@ -579,6 +579,11 @@ fn border_vertices(csr: &Csr, faces: &[[u32; 3]]) -> Vec<bool> {
         .with_min_len(1024)
         .map_init(Vec::new, |others: &mut Vec<u32>, v| {
             others.clear();
+            if (v as usize + BORDER_AHEAD) < csr.offsets.len() - 1 {
+                for &f in csr.faces_of(v + BORDER_AHEAD as u32) {
+                    crate::cache::prefetch(faces, f as usize);
+                }
+            }
             for &f in csr.faces_of(v) {
                 let t = faces[f as usize];
                 for (i, &u) in t.iter().enumerate() {
@@ -604,6 +609,12 @@ fn border_vertices(csr: &Csr, faces: &[[u32; 3]]) -> Vec<bool> {
         })
         .collect()
 }
+
+/// How many vertices ahead [`border_vertices`] asks the cache for a vertex's faces: the 1M
+/// scan's faces are not in vertex order, so each list reads scattered faces. Measured on the
+/// 1M scan at 10% (`hybrid`, two cores, median of 15 calls): 0.024 s without, 0.018 s 8 ahead,
+/// 0.020 s 16 ahead.
+const BORDER_AHEAD: usize = 8;
 
 /// Neighbour entries (two per face) up to which [`border_vertices`] counts without sorting:
 /// eight faces around a vertex.
