@@ -398,13 +398,13 @@ fn take_apart(work: &mut Work, grid: &Grid, b: Built, bad: &[u32]) -> (Built, Ve
 }
 
 /// The faces of [`take_apart`]'s build. The new numbering keeps the order of the clusters
-/// that stay (`new_id`, `u32::MAX` for those taken apart), so a face of `b` on them keeps its
-/// place and its rotation; every other face has a new singleton (a vertex of `singles`
-/// without a placement before) at a corner, and faces that repeat one another have the same
-/// clusters, so the faces at the new singletons are deduplicated among themselves and merged
-/// in, in face order. Taking every face again was 0.013 s of a repair on the 1M scan; with
-/// this and [`origin_normals`]' lookup the hybrid at 1% took 0.334 s against 0.384 s (best of
-/// five interleaved in-process runs).
+/// that stay (`new_id`, `u32::MAX` for those taken apart), so a face of the build before
+/// (`faces_before`, whose block this reuses) on them keeps its place and its rotation; every
+/// other face has a new singleton (a vertex of `singles` without a placement before) at a
+/// corner, and faces that repeat one another have the same clusters, so the faces at the new
+/// singletons are deduplicated among themselves and merged in, in face order. Taking every
+/// face again was 0.013 s of a repair on the 1M scan; with this and [`origin_normals`]' lookup
+/// the hybrid at 1% took 0.334 s against 0.384 s (best of five interleaved in-process runs).
 fn faces_taken_apart(
     s: &super::stages::Surface,
     faces_before: Vec<(u32, [u32; 3])>,
@@ -444,8 +444,12 @@ fn faces_taken_apart(
     out.resize(stay + fresh.len(), (0, [0; 3]));
     let (mut i, mut j) = (stay, fresh.len());
     for w in (0..out.len()).rev() {
+        // Once the fresh faces are all placed, the rest already stand where they belong.
+        if j == 0 {
+            break;
+        }
         // Face ids are distinct (a face at a new singleton did not stay): larger id last.
-        if j == 0 || (i > 0 && out[i - 1].0 > fresh[j - 1].0) {
+        if i > 0 && out[i - 1].0 > fresh[j - 1].0 {
             out[w] = out[i - 1];
             i -= 1;
         } else {
