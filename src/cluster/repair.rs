@@ -329,14 +329,10 @@ fn take_apart(work: &mut Work, grid: &Grid, b: Built, bad: &[u32]) -> (Built, Ve
         .with_min_len(4096)
         .map(|p| (!locked[p.attr as usize]).then(|| grid.key(xyz(positions[p.attr as usize]))))
         .collect();
-    // Room for the singletons first (glibc grows a large block by remapping its pages, not
-    // copying them), then the placements that stay moved down in their order. With them
-    // copied into a new block, that and the lookups above took 0.010-0.012 s of a repair on
-    // the 1M scan at 10%; in place, a repair's median fell from 0.0158 to 0.0140 s.
-    let room = singles
-        .len()
-        .saturating_sub(before - cell.iter().flatten().count());
-    placed.reserve(room);
+    // The placements that stay moved down in their order (`par_extend` below makes the
+    // singletons' room at once). With them copied into a new block, that and the lookups above
+    // took 0.010-0.012 s of a repair on the 1M scan at 10%; in place, a repair's median fell
+    // from 0.0158 to 0.0140 s.
     let (mut kept, mut cells, mut last_key) = (0, 0, None);
     for (k, key) in cell.into_iter().enumerate() {
         let Some(key) = key else {
@@ -414,7 +410,7 @@ fn faces_taken_apart(
     clusters: usize,
 ) -> Vec<(u32, [u32; 3])> {
     use super::stages::{dedupe_faces, rotated};
-    let (faces, input) = (faces_before, s.faces);
+    let input = s.faces;
     let mut around: Vec<u32> = singles
         .iter()
         .filter(|single| single.1.is_none())
@@ -435,7 +431,7 @@ fn faces_taken_apart(
     );
     // The faces that stay, renumbered where they are, then the fresh ones merged in from the
     // back: the merge reads and writes the one block.
-    let mut out = faces;
+    let mut out = faces_before;
     out.par_iter_mut()
         .with_min_len(4096)
         .for_each(|(_, t)| *t = t.map(|k| new_id[k as usize]));
