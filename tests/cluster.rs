@@ -36,21 +36,40 @@ fn join(a: &Mesh, b: &Mesh) -> Mesh {
 
 #[test]
 fn the_radix_sort_is_the_stable_sort_by_key() {
-    // Few keys sort in one run, many in runs on every core; both must give the stable order.
+    // Few keys sort in one run, many in runs on every core; both must give the stable order,
+    // whatever the passes the largest key asks for (none, one, two, three), with
+    // singletons, which sort after every cell, among the keys.
+    fn scrambled(i: u32, modulo: u32) -> u32 {
+        i.wrapping_mul(2_654_435_761) % modulo
+    }
+    type KeyOf = fn(u32) -> u32;
+    let sets: [(&str, KeyOf); 5] = [
+        ("26-bit", |i| scrambled(i, 70_000) | ((i % 3) << 24)),
+        ("24-bit", |i| scrambled(i, 1 << 24)),
+        ("11-bit", |i| scrambled(i, 2048)),
+        ("all zero", |_| 0),
+        ("singletons among 20-bit", |i| {
+            if i % 7 == 3 {
+                stages::SINGLETON
+            } else {
+                scrambled(i, 1 << 20)
+            }
+        }),
+    ];
     for n in [5000u32, 300_001] {
-        let keys: Vec<u32> = (0..n)
-            .map(|i| (i.wrapping_mul(2_654_435_761) % 70_000) | ((i % 3) << 24))
-            .collect();
-        let (sorted, ids) = stages::radix_sort(&keys);
-        let mut want: Vec<u32> = (0..keys.len() as u32).collect();
-        want.sort_by_key(|&i| keys[i as usize]);
-        assert_eq!(ids, want, "{n} keys");
-        let want_keys: Vec<u32> = want.iter().map(|&i| keys[i as usize]).collect();
-        assert_eq!(sorted, want_keys, "{n} keys");
+        for (name, key) in sets {
+            let keys: Vec<u32> = (0..n).map(key).collect();
+            let (sorted, ids) = stages::radix_sort(keys.clone());
+            let mut want: Vec<u32> = (0..keys.len() as u32).collect();
+            want.sort_by_key(|&i| keys[i as usize]);
+            assert_eq!(ids, want, "{n} {name} keys");
+            let want_keys: Vec<u32> = want.iter().map(|&i| keys[i as usize]).collect();
+            assert_eq!(sorted, want_keys, "{n} {name} keys");
+        }
     }
     // An empty input and all-equal keys (every key in one digit of every pass).
-    assert_eq!(stages::radix_sort(&[]), (vec![], vec![]));
-    let (sorted, ids) = stages::radix_sort(&vec![7u32 << 20; 100_000]);
+    assert_eq!(stages::radix_sort(vec![]), (vec![], vec![]));
+    let (sorted, ids) = stages::radix_sort(vec![7u32 << 20; 100_000]);
     assert_eq!(ids, (0..100_000).collect::<Vec<u32>>());
     assert!(sorted.iter().all(|&k| k == 7 << 20));
 }
@@ -68,10 +87,10 @@ fn a_grid_of_countable_cells_keeps_the_faces_between_them() {
     // Shift the grid by half a vertex spacing so no vertex sits on a cell wall.
     let g = Grid::new([-1.0 / 16.0, -1.0 / 16.0, 0.0], [1.0, 1.0, 0.0], 0.27);
     let keys = stages::cell_keys(&g, &positions, &vec![false; positions.len()]);
-    let (sorted, members) = stages::radix_sort(&keys);
-    let cells = stages::cell_ranges(&sorted, members);
+    let (sorted, members) = stages::radix_sort(keys);
+    let mut cells = stages::cell_ranges(&sorted, members);
     assert_eq!(cells.key.len(), 16, "4 x 4 occupied cells");
-    let clusters = stages::Clusters::whole_cells(&cells);
+    let clusters = stages::Clusters::whole_cells(&mut cells);
     let faces = stages::cluster_faces(
         &m.triangles,
         &clusters.vertex_cluster,

@@ -116,7 +116,7 @@ fn each_cluster_stage_matches_its_cpu_twin() {
                 );
             }
             // The sort is the CPU driver's stable sort by (key, id).
-            let (sorted, members) = stages::radix_sort(&cpu.keys.0);
+            let (sorted, members) = stages::radix_sort(cpu.keys.0.clone());
             let last = match cpu.passes.last() {
                 Some(p) => (&p.1, &p.2),
                 None => (&cpu.keys.0, &cpu.keys.1),
@@ -227,9 +227,9 @@ fn driver_build(
     grid: &Grid,
 ) -> meshslim::cluster::gpu::ClusterBuild {
     let keys = stages::cell_keys(grid, pos, locked);
-    let (sorted, members) = stages::radix_sort(&keys);
-    let cells = stages::cell_ranges(&sorted, members);
-    let clusters = stages::Clusters::whole_cells(&cells);
+    let (sorted, members) = stages::radix_sort(keys);
+    let mut cells = stages::cell_ranges(&sorted, members);
+    let clusters = stages::Clusters::whole_cells(&mut cells);
     let boxes: Vec<([f32; 3], [f32; 3])> = (0..clusters.len())
         .map(|k| {
             let key = cells.key[clusters.cell[k] as usize];

@@ -173,7 +173,7 @@ pub fn claim(
     // Two centres are independent beyond the sum of their radii, at most twice the largest.
     let grid = hash_grid(lo, hi, r);
     let keys = stages::cell_keys(&grid, positions, &vec![false; n]);
-    let (sorted, members) = stages::radix_sort(&keys);
+    let (sorted, members) = stages::radix_sort(keys);
     let mut cells = stages::cell_ranges(&sorted, members);
     // Each cell's members by rank, highest first: a vertex looking for one that outranks it
     // stops at the first that does not.

@@ -272,7 +272,7 @@ mod tests {
         let (positions, lo, hi) = super::super::unit_frame_points(&m);
         let grid = Grid::new(lo, hi, 0.04);
         let keys = cell_keys(&grid, &positions, &vec![false; positions.len()]);
-        let (sorted, members) = radix_sort(&keys);
+        let (sorted, members) = radix_sort(keys);
         let cells = cell_ranges(&sorted, members);
         let labels = |threads: usize| {
             rayon::ThreadPoolBuilder::new()

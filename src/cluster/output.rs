@@ -26,7 +26,7 @@ pub(super) fn output(
             }
         }
     }
-    let src = |k: u32| pts.attr[b.placed[k as usize].attr as usize] as usize;
+    let src = |k: u32| b.placed[k as usize].attr as usize;
     let mut out = mesh.clone_without_geometry();
     out.positions = order
         .par_iter()

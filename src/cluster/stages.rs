@@ -87,23 +87,28 @@ pub fn cell_keys(grid: &Grid, positions: &[[f32; 4]], locked: &[bool]) -> Vec<u3
         .collect()
 }
 
-/// `radix_sort`: the vertex ids `0..n` ordered by key, stable (so by (key, id)): least
-/// significant digit first, as many passes as the largest key needs. The order is unique, so
-/// this is the GPU's result whatever the digit: the GPU sorts 8 bits a pass (tests/cluster_twins
-/// has its pass-for-pass twin), this 11 (2,048 counters stay in the L1 cache): 2 passes for the 1M
-/// scan's 22-bit keys at 10%, where 8-bit digits took 3.
+/// `radix_sort`: the vertex ids `0..n` ordered by key, stable (so by (key, id)), and the keys
+/// in that order: least significant digit first, as many passes as the largest key needs. The
+/// order is unique, so this is the GPU's result whatever the digit: the GPU sorts 8 bits a pass
+/// (tests/cluster_twins has its pass-for-pass twin), this 11 (2,048 counters stay in the L1
+/// cache): 2 passes for the 1M meshes' 17-18-bit keys at 1%, where 8-bit digits take 3 (their
+/// 23-24-bit keys at 10% take 3 either way; two of 12 bits were no faster).
 ///
 /// Each pass runs on every core: the keys are cut into [`RADIX_CHUNKS`] runs, each counts its
 /// digits, and each then writes its keys, in order, into its own slice of every digit's range
 /// (the digit's slices in run order): stable, so the same order. The 1M scan's cell keys at
 /// 10%: 0.008-0.015 s on one core, 0.006-0.009 s on two. (1M keys in random order, whose
 /// scatter is bound by memory rather than by a core, sorted no faster this way.)
-pub fn radix_sort(keys: &[u32]) -> (Vec<u32>, Vec<u32>) {
+/// The first pass reads `keys` where they are, each id its index, and their block is the
+/// second pass's target: copying them out first wrote 2 MB more of fresh pages on the 1M
+/// meshes, each 4 KiB a fault (about 2.7 µs on the 2-core VM).
+pub fn radix_sort(keys: Vec<u32>) -> (Vec<u32>, Vec<u32>) {
     let n = keys.len();
     let max = keys.par_iter().copied().max().unwrap_or(0);
     let bits = 32 - max.leading_zeros();
-    let mut k: Vec<u32> = keys.par_iter().copied().collect();
-    let mut v: Vec<u32> = (0..n as u32).into_par_iter().collect();
+    let mut k = keys;
+    // The ids, `0..n` before the first pass, which writes them (so nothing is held here).
+    let mut v: Vec<u32> = Vec::new();
     let mut k2 = vec![0u32; n];
     let mut v2 = vec![0u32; n];
     const DIGIT: u32 = 11;
@@ -115,7 +120,11 @@ pub fn radix_sort(keys: &[u32]) -> (Vec<u32>, Vec<u32>) {
         RADIX_CHUNKS
     };
     let run = n.div_ceil(runs).max(1);
-    for pass in 0..bits.div_ceil(DIGIT) {
+    let passes = bits.div_ceil(DIGIT);
+    if passes == 0 {
+        return (k, (0..n as u32).into_par_iter().collect());
+    }
+    for pass in 0..passes {
         let shift = DIGIT * pass;
         let digit = |x: u32| ((x >> shift) & MASK) as usize;
         let counts: Vec<Vec<usize>> = k
@@ -140,12 +149,15 @@ pub fn radix_sort(keys: &[u32]) -> (Vec<u32>, Vec<u32>) {
                 (krest, vrest) = (kt, vt);
             }
         }
+        let ids = &v;
         k.par_chunks(run)
-            .zip(v.par_chunks(run))
+            .enumerate()
             .zip(outs)
-            .for_each(|((ks, vs), mut out)| {
+            .for_each(|((r, ks), mut out)| {
                 let mut at = vec![0usize; D];
-                for (&x, &id) in ks.iter().zip(vs) {
+                for (j, &x) in ks.iter().enumerate() {
+                    let i = r * run + j;
+                    let id = if pass == 0 { i as u32 } else { ids[i] };
                     let d = digit(x);
                     out[d].0[at[d]] = x;
                     out[d].1[at[d]] = id;
@@ -154,6 +166,9 @@ pub fn radix_sort(keys: &[u32]) -> (Vec<u32>, Vec<u32>) {
             });
         std::mem::swap(&mut k, &mut k2);
         std::mem::swap(&mut v, &mut v2);
+        if pass == 0 && passes > 1 {
+            v2 = vec![0u32; n];
+        }
     }
     (k, v)
 }
@@ -347,12 +362,13 @@ pub struct Clusters {
 }
 
 impl Clusters {
-    /// One cluster per cell.
-    pub fn whole_cells(cells: &Cells) -> Clusters {
+    /// One cluster per cell: the cells' per-vertex list moves here (`cells.vertex_cell` is left
+    /// empty), where a copy wrote 2 MB of fresh pages on a 1M-face mesh.
+    pub fn whole_cells(cells: &mut Cells) -> Clusters {
         Clusters {
             cell: (0..cells.key.len() as u32).collect(),
             root: vec![u32::MAX; cells.key.len()],
-            vertex_cluster: cells.vertex_cell.clone(),
+            vertex_cluster: std::mem::take(&mut cells.vertex_cell),
         }
     }
 

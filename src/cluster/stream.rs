@@ -206,7 +206,7 @@ fn output(
                 let p = b.placed[k as usize].pos.map(|x| x as f64);
                 positions.push(denormalize(p, pts.center, pts.scale));
                 if let Some(c) = colors {
-                    out_colors.push(c[pts.attr[b.placed[k as usize].attr as usize] as usize]);
+                    out_colors.push(c[b.placed[k as usize].attr as usize]);
                 }
                 quadrics.push(b.placed[k as usize].quadric);
             }
