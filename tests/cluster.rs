@@ -37,15 +37,16 @@ fn join(a: &Mesh, b: &Mesh) -> Mesh {
 #[test]
 fn the_radix_sort_is_the_stable_sort_by_key() {
     // Few keys sort in one run, many in runs on every core; both must give the stable order,
-    // whatever the passes the largest key asks for (none, one, two, three), with
-    // singletons, which sort after every cell, among the keys.
+    // whatever the passes the largest key asks for (none, one, two, three; a singleton's key
+    // has bit 31, so with singletons among the keys, three).
     fn scrambled(i: u32, modulo: u32) -> u32 {
         i.wrapping_mul(2_654_435_761) % modulo
     }
     type KeyOf = fn(u32) -> u32;
-    let sets: [(&str, KeyOf); 5] = [
+    let sets: [(&str, KeyOf); 6] = [
         ("26-bit", |i| scrambled(i, 70_000) | ((i % 3) << 24)),
         ("24-bit", |i| scrambled(i, 1 << 24)),
+        ("20-bit", |i| scrambled(i, 1 << 20)),
         ("11-bit", |i| scrambled(i, 2048)),
         ("all zero", |_| 0),
         ("singletons among 20-bit", |i| {
