@@ -136,6 +136,7 @@ impl<'a> State<'a> {
             max_collapse_err2: 0.0,
             seeded_at: 0,
             refills: 0,
+            one_thread: false,
             hit_max_error: false,
         };
         let mut heap = Queue::new();
@@ -154,32 +155,36 @@ impl<'a> State<'a> {
     fn queue_all_edges(&self, heap: &mut Queue) {
         use rayon::prelude::*;
         let n = self.p.pos.len();
-        let parts: Vec<Vec<(u32, u32, u32, u32)>> = (0..n.div_ceil(QUEUE_BLOCK))
-            .into_par_iter()
-            .map_init(Vec::new, |nbrs: &mut Vec<u32>, block| {
-                let vertices = block * QUEUE_BLOCK..((block + 1) * QUEUE_BLOCK).min(n);
-                // A closed surface has about three edges a vertex (E ≈ 3V), each queued from
-                // its lower end; room left unused is never written.
-                let mut out = Vec::with_capacity(vertices.len() * 7 / 2);
-                for a in vertices.map(|a| a as u32) {
-                    nbrs.clear();
-                    for &f in self.vert_faces.get(a as usize) {
-                        let t = self.topo_faces[f as usize];
-                        if t[0] != DEAD {
-                            nbrs.extend(t.into_iter().filter(|&u| u > a));
-                        }
-                    }
-                    nbrs.sort_unstable();
-                    nbrs.dedup();
-                    for &b in nbrs.iter() {
-                        if let Some((_, _, _, err)) = self.placement(a, b) {
-                            out.push((key(err), a, b, self.stamp(a, b)));
-                        }
+        let block = |nbrs: &mut Vec<u32>, block: usize| {
+            let vertices = block * QUEUE_BLOCK..((block + 1) * QUEUE_BLOCK).min(n);
+            // A closed surface has about three edges a vertex (E ≈ 3V), each queued from its
+            // lower end; room left unused is never written.
+            let mut out = Vec::with_capacity(vertices.len() * 7 / 2);
+            for a in vertices.map(|a| a as u32) {
+                nbrs.clear();
+                for &f in self.vert_faces.get(a as usize) {
+                    let t = self.topo_faces[f as usize];
+                    if t[0] != DEAD {
+                        nbrs.extend(t.into_iter().filter(|&u| u > a));
                     }
                 }
-                out
-            })
-            .collect();
+                nbrs.sort_unstable();
+                nbrs.dedup();
+                for &b in nbrs.iter() {
+                    if let Some((_, _, _, err)) = self.placement(a, b) {
+                        out.push((key(err), a, b, self.stamp(a, b)));
+                    }
+                }
+            }
+            out
+        };
+        let blocks = 0..n.div_ceil(QUEUE_BLOCK);
+        let parts: Vec<Vec<(u32, u32, u32, u32)>> = if self.one_thread {
+            let mut nbrs = Vec::new();
+            blocks.map(|b| block(&mut nbrs, b)).collect()
+        } else {
+            blocks.into_par_iter().map_init(Vec::new, block).collect()
+        };
         heap.push_all(&parts);
     }
 

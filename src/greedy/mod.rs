@@ -13,10 +13,12 @@
 //! [`simplify_greedy`] here drives the parts: `prepare` (welding, the Morton order, quadrics and
 //! vertex mobility), `state` (the collapse state and the faces around each vertex), `queue` (the
 //! bucket queue and its keys), `evaluate` (placement and the checks on one edge), `collapse`
-//! (applying collapses, the run to a target), `partition` (the partitioned levels), `output`
+//! (applying collapses, the run to a target), `partition` (the partitioned levels), `epochs`
+//! (their rising cost ceilings, run without a barrier after each), `output`
 //! (the output mesh) and `vec` (f64 vector helpers).
 
 mod collapse;
+mod epochs;
 mod evaluate;
 pub(crate) mod output;
 mod partition;

@@ -116,6 +116,9 @@ pub(super) struct State<'a> {
     pub(super) seeded_at: usize,
     /// Times the queue was filled again.
     pub(super) refills: usize,
+    /// Refills queue the edges on this thread alone: a partitioned level's region, which runs
+    /// on a thread that rayon's pool may not be free to help (see `epochs`).
+    pub(super) one_thread: bool,
     pub(super) max_collapse_err2: f64,
     pub(super) hit_max_error: bool,
 }
