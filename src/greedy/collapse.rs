@@ -38,6 +38,10 @@ impl<'a> State<'a> {
             for i in 0..3 {
                 if self.topo_faces[fu][i] == c.remove {
                     self.topo_faces[fu][i] = c.keep;
+                    // Debug builds keep the corners too, for `attr_face` to check against.
+                    if self.faces_follow_topo && !cfg!(debug_assertions) {
+                        continue;
+                    }
                     let old = self.p.faces[fu][i];
                     let (_, new) = c
                         .attr_map
@@ -119,6 +123,7 @@ impl<'a> State<'a> {
         let nf = p.faces.len();
         assert_eq!(topo_faces.len(), nf, "one topological face per face");
         let vert_faces = VertFaces::new(nt, &topo_faces);
+        let faces_follow_topo = !p.seam.contains(&true);
         let s = State {
             opts,
             p,
@@ -137,6 +142,7 @@ impl<'a> State<'a> {
             seeded_at: 0,
             refills: 0,
             one_thread: false,
+            faces_follow_topo,
             hit_max_error: false,
         };
         let mut heap = Queue::new();
@@ -264,5 +270,55 @@ impl<'a> State<'a> {
             }
         }
         false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On a mesh without seams, collapses that leave the faces' corners to
+    /// [`State::sync_faces`] end with the corners that collapses writing them give; a mesh
+    /// with a seam (a vertex with two UVs) has its corners written by every collapse.
+    #[test]
+    fn synced_corners_are_the_written_ones() {
+        let m = crate::mesh::noisy_sphere(5, 0.01, 7);
+        let opts = SimplifyOptions::with_ratio(m.triangles.len(), 0.1).unwrap();
+        let run = |follow: bool| {
+            let (mut s, mut heap) = State::new(Prepared::new(&m, &opts), &opts);
+            assert!(
+                s.faces_follow_topo,
+                "no vertex of the sphere has two attribute vertices"
+            );
+            s.faces_follow_topo = follow;
+            s.run(&mut heap, opts.target_faces, u32::MAX, &mut |_| {});
+            s.sync_faces();
+            let live: Vec<[u32; 3]> = (0..s.p.faces.len())
+                .filter(|&f| s.face_alive[f])
+                .map(|f| {
+                    assert_eq!(s.attr_face(f), s.p.faces[f]);
+                    s.p.faces[f]
+                })
+                .collect();
+            (s.collapses, live)
+        };
+        let written = run(false);
+        assert!(written.0 > 0 && written.1.len() <= opts.target_faces);
+        assert_eq!(run(true), written);
+
+        // Vertex 0 split in two by UV: its first face takes the copy.
+        let mut seamed = m.clone();
+        seamed.uvs = Some(vec![[0.0, 0.0]; m.positions.len()]);
+        seamed.positions.push(m.positions[0]);
+        seamed.uvs.as_mut().unwrap().push([1.0, 0.0]);
+        let copy = (seamed.positions.len() - 1) as u32;
+        let f = m.triangles.iter().position(|t| t.contains(&0)).unwrap();
+        for v in &mut seamed.triangles[f] {
+            if *v == 0 {
+                *v = copy;
+            }
+        }
+        let (s, _) = State::new(Prepared::new(&seamed, &opts), &opts);
+        assert!(!s.faces_follow_topo);
     }
 }

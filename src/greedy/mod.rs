@@ -94,10 +94,11 @@ fn simplify_prepared(
     let target = opts.target_faces;
     let need = nf.saturating_sub(target).max(1) as f32;
     let mut levels = LevelStats::default();
-    let s = reduce(p, opts, &mut levels, &mut |faces| {
+    let mut s = reduce(p, opts, &mut levels, &mut |faces| {
         progress((nf - faces) as f32 / need)
     })?;
     progress(1.0);
+    s.sync_faces();
 
     let stop_reason = stop_reason(&s, &levels);
     let out = build_output(
@@ -202,9 +203,10 @@ pub(crate) fn chain_greedy(
             target_faces: target,
             ..opts.clone()
         };
-        let s = reduce(p, &opts, &mut levels, &mut |faces| {
+        let mut s = reduce(p, &opts, &mut levels, &mut |faces| {
             progress((nf - faces) as f32 / need)
         })?;
+        s.sync_faces();
         err2 = err2.max(s.max_collapse_err2);
         let out = build_output(
             &s.p,

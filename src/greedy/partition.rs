@@ -282,7 +282,7 @@ pub(super) fn partitioned_level(
                 .filter_map(|(sf, &alive)| {
                     let gf = st.p.face_origin[sf];
                     (alive && face_region[gf as usize] == r as u32)
-                        .then(|| (gf, to_whole(st.p.faces[sf])))
+                        .then(|| (gf, to_whole(st.attr_face(sf))))
                 })
                 .collect()
         })
