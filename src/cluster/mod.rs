@@ -21,6 +21,7 @@ pub mod gpu;
 pub mod gpu_schedule;
 pub mod grid;
 mod hybrid;
+mod labels;
 mod output;
 mod repair;
 pub mod stages;

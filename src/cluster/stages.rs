@@ -6,6 +6,7 @@
 
 use super::grid::Grid;
 pub use super::grid::SINGLETON;
+pub use super::labels::{CellUnion, cell_labels, cell_labels_where};
 use crate::cache::{AHEAD, prefetch};
 use crate::compute::common::{
     V3, add, cross, dot, length, quadric_add, quadric_eval, quadric_from_plane, quadric_shift,
@@ -13,7 +14,6 @@ use crate::compute::common::{
 };
 use crate::compute::types::Quadric;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// The vertex→face lists (CSR): `faces_of(v) = vertex_faces[offsets[v]..offsets[v + 1]]`, each
 /// list in increasing face order, the order the GPU's `adjacency_sort` leaves.
@@ -213,142 +213,6 @@ pub fn cell_ranges(sorted_keys: &[u32], members: Vec<u32>) -> Cells {
         members,
         vertex_cell,
         key,
-    }
-}
-
-/// `cell_labels`: each vertex's label becomes the lowest vertex id of its connected component
-/// inside its cell, components joined by the edges of faces and by coincident vertices (an
-/// unwelded seam's two sides are one surface). Separate sheets of the surface that pass
-/// through one cell, or a sheet that passes through it twice, keep separate labels.
-///
-/// On the CPU a union-find that always hangs the larger root under the smaller, so each root
-/// is its component's lowest id: the fixed point the GPU reaches by rounds of taking the least
-/// label over in-cell neighbours and pointer jumping. Those rounds took 0.18 s on the 1M scan
-/// on two cores, a sequential union-find a tenth of it.
-pub fn cell_labels(cells: &Cells, faces: &[[u32; 3]], positions: &[[f32; 4]]) -> Vec<u32> {
-    cell_labels_where(cells, faces, positions, |_, _| true)
-}
-
-/// [`cell_labels`] joining only the edges `join` allows (the hybrid's: no colour step).
-pub fn cell_labels_where(
-    cells: &Cells,
-    faces: &[[u32; 3]],
-    positions: &[[f32; 4]],
-    join: impl Fn(u32, u32) -> bool + Sync,
-) -> Vec<u32> {
-    let u = CellUnion::new(cells.vertex_cell.len());
-    u.join_faces_where(cells, faces, join);
-    u.labels(cells, positions)
-}
-
-/// [`cell_labels`] fed its faces a block at a time (a streamed file's).
-///
-/// The faces are joined on every core at once: a link is a compare-and-swap that hangs a root
-/// under a smaller root only while it is still a root, so links only ever point to smaller
-/// ids (no cycle can form) and no join is lost; whatever order the threads join in, each root
-/// ends as its component's lowest id, so the labels are the same on any number of threads.
-/// (Anderson & Woll, "Wait-free parallel algorithms for the union-find problem", 1991.)
-/// Sequentially, with the coincident members' sorts, this was 0.024 s of a build on the 1M
-/// scan at 10% and 0.047-0.052 s at 1%; on two cores 0.019-0.024 s and 0.023-0.024 s.
-pub struct CellUnion {
-    parent: Vec<AtomicU32>,
-}
-
-impl CellUnion {
-    pub fn new(n: usize) -> CellUnion {
-        CellUnion {
-            parent: (0..n as u32).into_par_iter().map(AtomicU32::new).collect(),
-        }
-    }
-
-    /// The root of `v`'s tree, halving the path on the way (each node then points to its
-    /// grandparent: still an ancestor, whatever other threads link meanwhile).
-    fn find(&self, mut v: u32) -> u32 {
-        loop {
-            let p = self.parent[v as usize].load(Relaxed);
-            if p == v {
-                return v;
-            }
-            let g = self.parent[p as usize].load(Relaxed);
-            if g != p {
-                self.parent[v as usize].store(g, Relaxed);
-            }
-            v = g;
-        }
-    }
-
-    fn union(&self, a: u32, b: u32) {
-        let (mut a, mut b) = (a, b);
-        loop {
-            (a, b) = (self.find(a), self.find(b));
-            if a == b {
-                return;
-            }
-            let (lo, hi) = (a.min(b), a.max(b));
-            // Linked only if `hi` is still a root; else another thread linked it first and the
-            // roots are found again.
-            if self.parent[hi as usize]
-                .compare_exchange(hi, lo, Relaxed, Relaxed)
-                .is_ok()
-            {
-                return;
-            }
-        }
-    }
-
-    /// Joins the corners of each face that share a cell.
-    pub fn join_faces(&self, cells: &Cells, faces: &[[u32; 3]]) {
-        self.join_faces_where(cells, faces, |_, _| true)
-    }
-
-    /// [`CellUnion::join_faces`] over the edges `join` allows.
-    pub fn join_faces_where(
-        &self,
-        cells: &Cells,
-        faces: &[[u32; 3]],
-        join: impl Fn(u32, u32) -> bool + Sync,
-    ) {
-        let cell = &cells.vertex_cell;
-        faces.par_iter().with_min_len(4096).for_each(|t| {
-            for i in 0..3 {
-                let (a, b) = (t[i], t[(i + 1) % 3]);
-                if cell[a as usize] == cell[b as usize] && join(a, b) {
-                    self.union(a, b);
-                }
-            }
-        });
-    }
-
-    /// Joins coincident members of each cell, then each vertex's label (its component's
-    /// lowest id).
-    pub fn labels(self, cells: &Cells, positions: &[[f32; 4]]) -> Vec<u32> {
-        // Coincident members of a cell: sorted by position, equal neighbours joined.
-        let bits = |v: u32| {
-            let p = positions[v as usize];
-            [p[0], p[1], p[2]].map(|x| if x == 0.0 { 0 } else { x.to_bits() })
-        };
-        (0..cells.key.len())
-            .into_par_iter()
-            .with_min_len(256)
-            .for_each_init(Vec::new, |run: &mut Vec<u32>, c| {
-                let members = &cells.members[cells.start[c] as usize..cells.start[c + 1] as usize];
-                if members.len() < 2 {
-                    return;
-                }
-                run.clear();
-                run.extend_from_slice(members);
-                run.sort_unstable_by_key(|&v| (bits(v), v));
-                for w in run.windows(2) {
-                    if bits(w[0]) == bits(w[1]) {
-                        self.union(w[0], w[1]);
-                    }
-                }
-            });
-        (0..self.parent.len() as u32)
-            .into_par_iter()
-            .with_min_len(4096)
-            .map(|v| self.find(v))
-            .collect()
     }
 }
 
