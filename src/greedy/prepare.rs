@@ -160,7 +160,7 @@ impl Prepared {
             .into_par_iter()
             .map_init(
                 || (Vec::new(), Vec::new()),
-                |(edges, fan): &mut (Vec<(u32, u32, u32)>, Vec<u32>), v| {
+                |(edges, fan): &mut (Vec<u64>, Vec<u32>), v| {
                     let mut q = Quadric::default();
                     for f in faces_of(v) {
                         if let Some((_, fq)) = plane(f as usize) {
@@ -173,14 +173,23 @@ impl Prepared {
                         Mobility::Free
                     };
                     let mut border = false;
-                    // The edges at v with their faces (and each face's place among v's faces),
-                    // in face order within an edge: 1 face for a border, 2 for a manifold edge,
-                    // more for a non-manifold one.
+                    // The edges at v, each with the place of its face among v's faces (so in
+                    // face order within an edge): 1 face for a border, 2 for a manifold edge,
+                    // more for a non-manifold one. Packed `other end << 32 | place` and sorted
+                    // as one integer: the order of (other end, face, place) triples, since the
+                    // places follow the faces. This per-vertex pass on the 1M scan at 10%
+                    // (two cores, median of 15): 0.0996 s sorting triples, 0.0965 s this.
                     let vt = v as u32;
+                    let face_at =
+                        |i: u64| corners[corner_start[v] as usize + i as u32 as usize] / 3;
                     edges.clear();
                     for (i, f) in faces_of(v).enumerate() {
                         let t = tf(&faces[f as usize]);
-                        edges.extend(t.into_iter().filter(|&u| u != vt).map(|u| (u, f, i as u32)));
+                        edges.extend(
+                            t.into_iter()
+                                .filter(|&u| u != vt)
+                                .map(|u| (u as u64) << 32 | i as u64),
+                        );
                     }
                     edges.sort_unstable();
                     // v's faces joined across its manifold edges: the fans around v.
@@ -196,10 +205,10 @@ impl Prepared {
                     let mut i = 0;
                     while i < edges.len() {
                         let mut j = i + 1;
-                        while j < edges.len() && edges[j].0 == edges[i].0 {
+                        while j < edges.len() && edges[j] >> 32 == edges[i] >> 32 {
                             j += 1;
                         }
-                        let u = edges[i].0;
+                        let u = (edges[i] >> 32) as u32;
                         let (a, b) = (vt.min(u), vt.max(u));
                         let (pa, pb) = (pos[a as usize], pos[b as usize]);
                         match j - i {
@@ -208,7 +217,7 @@ impl Prepared {
                                 // Hoppe's boundary constraint: a plane through the edge,
                                 // perpendicular to its face, weighted by the squared edge length
                                 // so it scales like an area.
-                                let t = tf(&faces[edges[i].1 as usize]);
+                                let t = tf(&faces[face_at(edges[i]) as usize]);
                                 let [p0, p1, p2] = t.map(|v| pos[v as usize]);
                                 let fnrm = cross(sub(p1, p0), sub(p2, p0));
                                 if let Some(c) = edge_constraint(pa, pb, fnrm, opts.border_weight) {
@@ -216,8 +225,9 @@ impl Prepared {
                                 }
                             }
                             2 => {
-                                let (f1, f2) = (edges[i].1, edges[i + 1].1);
-                                let (r1, r2) = (root(fan, edges[i].2), root(fan, edges[i + 1].2));
+                                let (f1, f2) = (face_at(edges[i]), face_at(edges[i + 1]));
+                                let (r1, r2) =
+                                    (root(fan, edges[i] as u32), root(fan, edges[i + 1] as u32));
                                 fan[r1.max(r2) as usize] = r1.min(r2);
                                 // A seam edge (the faces disagree on an endpoint's attribute
                                 // vertex) gets a constraint plane like a border, so the seam
