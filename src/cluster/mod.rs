@@ -2,7 +2,8 @@
 //! cell placed at its minimum inside the cell, Lindstrom 2000 and Lindstrom & Silva 2001) and
 //! `hybrid` (clustering to an intermediate count, then the QEM rounds with each cluster's
 //! quadric carried over, Garland & Shaffer 2002). Every stage is a map, a sort or a gather
-//! (stages.rs); the grid's size is searched by counting passes (grid.rs).
+//! (stages.rs; `cell_labels`, the split by connectivity, in labels.rs); the grid's size is
+//! searched by counting passes (grid.rs).
 //!
 //! Attributes are not kept apart: a cluster's vertex takes the UV and normal of its member
 //! nearest to it, so UV seams inside a cell close (as meshoptimizer's sloppy simplifier's do),
@@ -21,6 +22,7 @@ pub mod gpu;
 pub mod gpu_schedule;
 pub mod grid;
 mod hybrid;
+// The `cell_labels` stage (the connectivity split), re-exported by stages.
 mod labels;
 mod output;
 mod repair;
