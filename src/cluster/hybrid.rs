@@ -265,7 +265,8 @@ mod tests {
     /// trees at once.
     #[test]
     fn cell_labels_are_the_same_on_any_thread_count() {
-        use super::super::stages::{cell_keys, cell_labels, cell_ranges, radix_sort};
+        use super::super::labels::cell_labels;
+        use super::super::stages::{cell_keys, cell_ranges, radix_sort};
         let mut m = crate::mesh::noisy_sphere(6, 0.02, 11);
         // Two sides of a seam: coincident vertices, joined by position.
         m.positions.push(m.positions[0]);

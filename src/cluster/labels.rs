@@ -1,5 +1,5 @@
-//! The `cell_labels` stage (re-exported by [`super::stages`], whose twins it belongs with): the
-//! connected components of each cell's members, by a union-find on every core.
+//! The `cell_labels` stage, one of the clustering stages beside those of [`super::stages`]:
+//! the connected components of each cell's members, by a union-find on every core.
 
 use super::stages::Cells;
 use rayon::prelude::*;

@@ -22,7 +22,7 @@ pub mod gpu;
 pub mod gpu_schedule;
 pub mod grid;
 mod hybrid;
-// The `cell_labels` stage (the connectivity split), re-exported by stages.
+// The `cell_labels` stage (the connectivity split), beside stages.rs's.
 mod labels;
 mod output;
 mod repair;
@@ -186,18 +186,18 @@ impl Work<'_, '_> {
         let mut cells: Cells = stages::cell_ranges(&sorted, members);
         let (clusters, label) = if self.split {
             let label = match (&self.gather, &self.colors) {
-                (Some(_), Some(c)) => stages::cell_labels_where(
+                (Some(_), Some(c)) => labels::cell_labels_where(
                     &cells,
                     &self.pts.faces,
                     &self.pts.positions,
                     c.joins(grid.h),
                 ),
                 (Some(_), None) => {
-                    stages::cell_labels(&cells, &self.pts.faces, &self.pts.positions)
+                    labels::cell_labels(&cells, &self.pts.faces, &self.pts.positions)
                 }
                 // Streamed: the union-find fed block by block.
                 (None, _) => {
-                    let u = stages::CellUnion::new(cells.vertex_cell.len());
+                    let u = labels::CellUnion::new(cells.vertex_cell.len());
                     self.pts.blocks(&mut |_, faces| {
                         u.join_faces(&cells, faces);
                         Ok(())

@@ -6,7 +6,6 @@
 
 use super::grid::Grid;
 pub use super::grid::SINGLETON;
-pub use super::labels::{CellUnion, cell_labels, cell_labels_where};
 use crate::cache::{AHEAD, prefetch};
 use crate::compute::common::{
     V3, add, cross, dot, length, quadric_add, quadric_eval, quadric_from_plane, quadric_shift,
