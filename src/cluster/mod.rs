@@ -22,8 +22,8 @@ pub mod gpu;
 pub mod gpu_schedule;
 pub mod grid;
 mod hybrid;
-// The `cell_labels` stage (the connectivity split), beside stages.rs's.
-mod labels;
+// The `cell_labels` stage (the connectivity split), public like the other stages in stages.rs.
+pub mod labels;
 mod output;
 mod repair;
 pub mod stages;
