@@ -260,6 +260,37 @@ mod tests {
         }
     }
 
+    /// The gather tests its members for the border itself: a vertex's quadric gains border
+    /// planes (with a border weight) at the grid's outline and nowhere inside it.
+    #[test]
+    fn the_gather_adds_border_planes_at_the_outline_only() {
+        use super::super::stages::{Csr, Surface, cluster_quadric, face_planes};
+        let g = crate::mesh::grid(9);
+        let (positions, _, _) = super::super::unit_frame_points(&g);
+        let csr = Csr::new(positions.len(), &g.triangles);
+        let planes = face_planes(&positions, &g.triangles);
+        let b = g.bounds().unwrap();
+        let quadric = |v: usize, border_weight: f32| {
+            let s = Surface {
+                positions: &positions,
+                faces: &g.triangles,
+                planes: &planes,
+                csr: &csr,
+                border_weight,
+            };
+            let p = super::super::xyz(positions[v]);
+            cluster_quadric(&s, &[v as u32], p, p, p).quadric
+        };
+        let mut outline = 0;
+        for (v, p) in g.positions.iter().enumerate() {
+            let on_outline = (0..2).any(|k| p[k] == b.min[k] || p[k] == b.max[k]);
+            outline += on_outline as usize;
+            let differs = quadric(v, 1.0).q != quadric(v, 0.0).q;
+            assert_eq!(differs, on_outline, "vertex {v} at {p:?}");
+        }
+        assert_eq!(outline, 4 * 9);
+    }
+
     /// The cells' labels are each vertex's lowest in-cell component id, the same on one thread
     /// and on eight, where big cells (tens of vertices each) make the threads link the same
     /// trees at once.

@@ -145,8 +145,8 @@ struct Built {
 
 struct Work<'a, 'm> {
     pts: &'a Points<'m>,
-    /// `hybrid`: the vertex→face lists, face planes and border vertices its gather and its
-    /// connectivity split read; `cluster` scatters its quadrics without them.
+    /// `hybrid`: the vertex→face lists and face planes its gather and its connectivity split
+    /// read; `cluster` scatters its quadrics without them.
     gather: Option<Gather>,
     /// `hybrid`: cells split into their connected components.
     split: bool,
@@ -163,7 +163,6 @@ struct Work<'a, 'm> {
 struct Gather {
     csr: Csr,
     planes: Vec<[f32; 4]>,
-    border: Vec<bool>,
 }
 
 impl Work<'_, '_> {
@@ -276,7 +275,6 @@ impl Work<'_, '_> {
             faces: &self.pts.faces,
             planes: &g.planes,
             csr: &g.csr,
-            border: &g.border,
             border_weight: self.border_weight,
         })
     }
@@ -530,7 +528,7 @@ fn area(pts: &Points) -> Result<(f64, usize)> {
     Ok((sum * count as f64 / sampled.max(1) as f64, count))
 }
 
-/// `split` (hybrid): build the vertex→face lists, face planes and border vertices.
+/// `split` (hybrid): build the vertex→face lists and face planes.
 fn prepare<'a, 'm>(
     pts: &'a mut Points<'m>,
     opts: &SimplifyOptions,
@@ -542,12 +540,7 @@ fn prepare<'a, 'm>(
         // 1M scan at 10% (`hybrid` took 0.5 s), 0.013-0.024 s side by side.
         let (p, f) = (&pts.positions, &pts.faces);
         let (csr, planes) = rayon::join(|| Csr::new(p.len(), f), || stages::face_planes(p, f));
-        let border = border_vertices(&csr, f);
-        Gather {
-            csr,
-            planes,
-            border,
-        }
+        Gather { csr, planes }
     });
     let (area, faces) = area(pts)?;
     pts.area = area;
@@ -555,7 +548,7 @@ fn prepare<'a, 'm>(
         s.faces = faces;
     }
     let locked = match &gather {
-        Some(g) if opts.lock_border => g.border.clone(),
+        Some(g) if opts.lock_border => border_vertices(&g.csr, &pts.faces),
         _ => vec![false; pts.positions.len()],
     };
     Ok(Work {
@@ -569,43 +562,20 @@ fn prepare<'a, 'm>(
     })
 }
 
-/// Vertices on an edge of one face: a neighbour that only one of the vertex's faces holds.
-/// The neighbours are listed once per face and sorted, and a run of one is a border edge;
-/// counting each neighbour's faces through the face list took 0.018-0.029 s on the 1M scan,
-/// this 0.009-0.018 s, the same vertices on both scans and every shared model.
+/// Vertices on an edge of one face ([`stages::on_border`]), for `--lock-border`: the gather
+/// tests its members itself, with their faces at hand
+/// ([`stages::cluster_quadric`]).
 fn border_vertices(csr: &Csr, faces: &[[u32; 3]]) -> Vec<bool> {
     (0..csr.offsets.len() as u32 - 1)
         .into_par_iter()
         .with_min_len(1024)
-        .map_init(Vec::new, |others: &mut Vec<u32>, v| {
-            others.clear();
+        .map(|v| {
             if (v as usize + BORDER_AHEAD) < csr.offsets.len() - 1 {
                 for &f in csr.faces_of(v + BORDER_AHEAD as u32) {
                     crate::cache::prefetch(faces, f as usize);
                 }
             }
-            for &f in csr.faces_of(v) {
-                let t = faces[f as usize];
-                for (i, &u) in t.iter().enumerate() {
-                    // A face counts once for each vertex it holds, however often it holds it.
-                    if u != v && !t[..i].contains(&u) {
-                        others.push(u);
-                    }
-                }
-            }
-            if others.len() <= SMALL_FAN {
-                // Most vertices: each neighbour counted against a fixed-width row, which the
-                // compiler vectorizes. On the 1M scan at 10% the small sorts fell from 6.5% to
-                // 5.0% of `hybrid`'s samples. The padding is no vertex (ids < vertex count).
-                let mut row = [u32::MAX; SMALL_FAN];
-                row[..others.len()].copy_from_slice(others);
-                others
-                    .iter()
-                    .any(|&u| row.iter().filter(|&&w| w == u).count() == 1)
-            } else {
-                others.sort_unstable();
-                others.chunk_by(|a, b| a == b).any(|run| run.len() == 1)
-            }
+            stages::on_border(faces, csr.faces_of(v), v)
         })
         .collect()
 }
@@ -615,10 +585,6 @@ fn border_vertices(csr: &Csr, faces: &[[u32; 3]]) -> Vec<bool> {
 /// 1M scan at 10% (`hybrid`, two cores, median of 15 calls): 0.024 s without, 0.018 s 8 ahead,
 /// 0.020 s 16 ahead.
 const BORDER_AHEAD: usize = 8;
-
-/// Neighbour entries (two per face) up to which [`border_vertices`] counts without sorting:
-/// eight faces around a vertex.
-const SMALL_FAN: usize = 16;
 
 /// The backend a clustering method runs on: the GPU when asked (`auto` takes the CPU: on
 /// lavapipe a build is several times slower, docs/PERFORMANCE.md), else the CPU's cores.

@@ -217,8 +217,8 @@ pub fn fc_quadrics(
     cluster_placed: &mut [ClusterPlaced], // per cluster
     cluster_quadric: &mut [Quadric],      // per cluster
 ) {
-    let (csr, border) = twins::gather_lists(cluster, offsets, vertex_faces);
-    let surface = twins::gather_surface(cluster, positions, indices, face_normals, &csr, &border);
+    let csr = twins::gather_lists(offsets, vertex_faces);
+    let surface = twins::gather_surface(cluster, positions, indices, face_normals, &csr);
     for k in 0..cell_head[cluster.vertex_count as usize] as usize {
         let members = &sort_vals[cell_start[k] as usize..cell_start[k + 1] as usize];
         let centre = fc_centre[members[0] as usize] as usize;

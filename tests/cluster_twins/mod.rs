@@ -145,8 +145,8 @@ pub fn cluster_quadrics(
     cluster_quadric: &mut [Quadric],      // per cell
 ) {
     let grid = grid_of(cluster);
-    let (csr, border) = gather_lists(cluster, offsets, vertex_faces);
-    let surface = gather_surface(cluster, positions, indices, face_normals, &csr, &border);
+    let csr = gather_lists(offsets, vertex_faces);
+    let surface = gather_surface(cluster, positions, indices, face_normals, &csr);
     for k in 0..cell_head[cluster.vertex_count as usize] as usize {
         let members = &sort_vals[cell_start[k] as usize..cell_start[k + 1] as usize];
         let (lo, hi) = if cell_key[k] == SINGLETON {
@@ -162,36 +162,28 @@ pub fn cluster_quadrics(
     }
 }
 
-/// The vertex→face lists of the GPU's buffers, and no border (the GPU gathers no border
-/// planes): what [`gather_surface`] borrows.
-pub(super) fn gather_lists(
-    cluster: &ClusterParams,
-    offsets: &[u32],
-    vertex_faces: &[u32],
-) -> (Csr, Vec<bool>) {
-    let csr = Csr {
+/// The vertex→face lists of the GPU's buffers: what [`gather_surface`] borrows.
+pub(super) fn gather_lists(offsets: &[u32], vertex_faces: &[u32]) -> Csr {
+    Csr {
         offsets: offsets.to_vec(),
         vertex_faces: vertex_faces.to_vec(),
-    };
-    (csr, vec![false; cluster.vertex_count as usize])
+    }
 }
 
 /// The surface the gathering twins (`cluster_quadrics`, `fc_quadrics`) read, on the GPU's
-/// buffers as slices.
+/// buffers as slices, without border planes (the GPU gathers none).
 pub(super) fn gather_surface<'a>(
     cluster: &ClusterParams,
     positions: &'a [[f32; 4]],
     indices: &'a [u32],
     face_normals: &'a [[f32; 4]],
     csr: &'a Csr,
-    border: &'a [bool],
 ) -> Surface<'a> {
     Surface {
         positions,
         faces: bytemuck::cast_slice(&indices[..3 * cluster.face_count as usize]),
         planes: face_normals,
         csr,
-        border,
         border_weight: 0.0,
     }
 }
