@@ -562,9 +562,8 @@ fn prepare<'a, 'm>(
     })
 }
 
-/// Vertices on an edge of one face ([`stages::on_border`]), for `--lock-border`: the gather
-/// tests its members itself, with their faces at hand
-/// ([`stages::cluster_quadric`]).
+/// Vertices on an edge of one face ([`stages::on_border`]), for `--lock-border`'s locks; the
+/// gather ([`stages::cluster_quadric`]) tests its members itself, with their faces at hand.
 fn border_vertices(csr: &Csr, faces: &[[u32; 3]]) -> Vec<bool> {
     (0..csr.offsets.len() as u32 - 1)
         .into_par_iter()
