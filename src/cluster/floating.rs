@@ -358,7 +358,7 @@ pub(super) fn floating_on(
     let backend = check_backend(opts)?;
     let t = Instant::now();
     let mut pts = Points::new(mesh);
-    let mut work = prepare(&mut pts, opts, false)?;
+    let mut work = prepare(&mut pts, opts, false, None)?;
     // On the GPU the mesh and its buffers stay on the device between the search's builds, and
     // the ranks are made there on the first.
     let ranks = if let Some(sim) = on {

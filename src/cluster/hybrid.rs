@@ -119,7 +119,7 @@ pub(crate) fn clustered(
         None
     } else {
         let mut pts = Points::new(mesh);
-        let mut work = prepare(&mut pts, opts, true)?;
+        let mut work = prepare(&mut pts, opts, true, Some(intermediate))?;
         work.colors = super::colors::ColourSplit::of(mesh, opts.attributes.color);
         let (grid, built, normals) =
             cluster_repaired(&mut work, intermediate, opts.target_faces, report)?;
@@ -333,5 +333,78 @@ mod tests {
         for _ in 0..4 {
             assert_eq!(labels(8), one);
         }
+    }
+    /// The cells are the runs of equal sorted keys, a singleton key a cell per vertex, found
+    /// alike on one thread and on eight over enough keys for many tasks; each vertex's cell
+    /// holds it.
+    #[test]
+    fn cell_ranges_are_the_runs_of_equal_keys_on_any_thread_count() {
+        use super::super::grid::SINGLETON;
+        use super::super::stages::{cell_ranges, radix_sort};
+        let keys: Vec<u32> = (0..100_000u32)
+            .map(|i| match i.wrapping_mul(2_654_435_761) % 97 {
+                0 => SINGLETON,
+                k => k * 31 + i % 7,
+            })
+            .collect();
+        let (sorted, members) = radix_sort(keys.clone());
+        let on = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| cell_ranges(&sorted, members.clone()))
+        };
+        let one = on(1);
+        // One pass, as the cells are defined.
+        let mut start = vec![];
+        for i in 0..sorted.len() {
+            if i == 0 || sorted[i] != sorted[i - 1] || sorted[i] == SINGLETON {
+                start.push(i as u32);
+            }
+        }
+        let key: Vec<u32> = start.iter().map(|&i| sorted[i as usize]).collect();
+        start.push(sorted.len() as u32);
+        assert_eq!(one.start, start);
+        assert_eq!(one.key, key);
+        assert!(key.iter().filter(|&&k| k == SINGLETON).count() > 500);
+        for c in 0..key.len() {
+            for &m in &one.members[start[c] as usize..start[c + 1] as usize] {
+                assert_eq!(one.vertex_cell[m as usize], c as u32);
+                assert_eq!(keys[m as usize], key[c]);
+            }
+        }
+        let eight = on(8);
+        assert_eq!(
+            (eight.start, eight.key, eight.vertex_cell),
+            (one.start, one.key, one.vertex_cell)
+        );
+    }
+
+    /// The probes the hybrid counts beside its vertex→face lists are those `cluster_to` counts
+    /// itself, and the build from them is the same.
+    #[test]
+    fn probes_beside_the_lists_equal_the_probes_after() {
+        let m = crate::mesh::noisy_sphere(6, 0.02, 5);
+        let opts = SimplifyOptions::with_ratio(m.triangles.len(), 0.2).unwrap();
+        let target = opts.target_faces;
+        let (mut early_pts, mut late_pts) = (Points::new(&m), Points::new(&m));
+        let early = prepare(&mut early_pts, &opts, true, Some(target)).unwrap();
+        let late = prepare(&mut late_pts, &opts, true, None).unwrap();
+        assert!(late.probed.is_none());
+        let (t, probes) = early.probed.clone().expect("probed beside the lists");
+        assert_eq!(t, target);
+        let after = super::super::probe(late.pts, late.pts.area, &late.locked, target).unwrap();
+        assert_eq!(probes, after);
+        assert_eq!(early.pts.area, late.pts.area);
+        let built = |w: &super::super::Work| {
+            let mut report = ClusterReport::default();
+            let (grid, b, _) =
+                super::super::cluster_to(w, target, None, None, &mut report).unwrap();
+            (grid.h, b.faces, b.vertex_cluster, report.sizes_counted)
+        };
+        let (a, b) = (built(&early), built(&late));
+        assert!(!a.1.is_empty());
+        assert_eq!(a, b);
     }
 }

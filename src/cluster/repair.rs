@@ -283,6 +283,8 @@ pub(super) fn cluster_repaired(
 /// build and, per cluster, whether it is a new singleton.
 fn take_apart(work: &mut Work, grid: &Grid, b: Built, bad: &[u32]) -> (Built, Vec<bool>) {
     use super::stages::cluster_quadric;
+    // The probes counted these vertices unlocked.
+    work.probed = None;
     // The build's arrays are rewritten where they are: copies into fresh blocks paid for every
     // page they touched (see `placed` below).
     let Built {
@@ -538,7 +540,7 @@ mod tests {
             let mut opts = SimplifyOptions::with_ratio(mesh.triangles.len(), 0.05).unwrap();
             opts.method = Method::Hybrid;
             let mut pts = Points::new(&mesh);
-            let mut work = prepare(&mut pts, &opts, true).unwrap();
+            let mut work = prepare(&mut pts, &opts, true, None).unwrap();
             let mut report = ClusterReport::default();
             let target = opts.target_faces;
             let (grid, mut built, _) =
@@ -590,7 +592,7 @@ mod tests {
             opts.lock_border = lock_border;
             opts.attributes.color = color;
             let mut pts = Points::new(&mesh);
-            let mut work = prepare(&mut pts, &opts, true).unwrap();
+            let mut work = prepare(&mut pts, &opts, true, None).unwrap();
             work.colors = super::super::colors::ColourSplit::of(&mesh, color);
             let mut report = ClusterReport::default();
             let target = opts.target_faces;

@@ -190,29 +190,53 @@ pub struct Cells {
 }
 
 pub fn cell_ranges(sorted_keys: &[u32], members: Vec<u32>) -> Cells {
-    let n = sorted_keys.len();
-    let mut start = Vec::with_capacity(n / 4 + 1);
-    let mut key = Vec::with_capacity(n / 4);
-    for i in 0..n {
-        // A singleton key is one cell per vertex.
-        if i == 0 || sorted_keys[i] != sorted_keys[i - 1] || sorted_keys[i] == SINGLETON {
-            start.push(i as u32);
-            key.push(sorted_keys[i]);
-        }
-    }
+    use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+    let (n, k) = (sorted_keys.len(), sorted_keys);
+    // The cells found and their members marked on every core (an ordered collect keeps the
+    // starts rising): on one core this took 0.0030 s of `hybrid` on the 1M scan at 10%, on
+    // two 0.0022 s (medians of 21 calls).
+    let mut start: Vec<u32> = (0..n as u32)
+        .into_par_iter()
+        .with_min_len(RANGES_MIN_LEN)
+        .filter(|&i| {
+            let i = i as usize;
+            // A singleton key is one cell per vertex.
+            i == 0 || k[i] != k[i - 1] || k[i] == SINGLETON
+        })
+        .collect();
+    let key: Vec<u32> = start.par_iter().map(|&i| k[i as usize]).collect();
     start.push(n as u32);
-    let mut vertex_cell = vec![0u32; n];
-    for c in 0..key.len() {
-        for &m in &members[start[c] as usize..start[c + 1] as usize] {
-            vertex_cell[m as usize] = c as u32;
-        }
-    }
+    // Each cell writes its members' entries: `members` is a permutation (the sort's ids), so
+    // every entry is written once, by one cell.
+    let cell: Vec<AtomicU32> = (0..n).into_par_iter().map(|_| AtomicU32::new(0)).collect();
+    (0..key.len())
+        .into_par_iter()
+        .with_min_len(RANGES_MIN_LEN / 4)
+        .for_each(|c| {
+            for &m in &members[start[c] as usize..start[c + 1] as usize] {
+                cell[m as usize].store(c as u32, Relaxed);
+            }
+        });
     Cells {
         start,
         members,
-        vertex_cell,
+        vertex_cell: into_u32s(cell),
         key,
     }
+}
+
+/// Vertices per task in [`cell_ranges`].
+const RANGES_MIN_LEN: usize = 1 << 14;
+
+/// `v`'s values, in its block: no second pass and no fresh pages.
+fn into_u32s(v: Vec<std::sync::atomic::AtomicU32>) -> Vec<u32> {
+    let mut v = std::mem::ManuallyDrop::new(v);
+    let (ptr, len, cap) = (v.as_mut_ptr(), v.len(), v.capacity());
+    // SAFETY: `AtomicU32` has the size, alignment and bit validity of `u32` (std documents
+    // it), so the block `v` owned (never freed: `ManuallyDrop`) holds `len` valid `u32`s in an
+    // allocation of `cap` of them with the same layout, which the new `Vec` now owns alone;
+    // nothing else can reach the atomics, as `v` was taken by value.
+    unsafe { Vec::from_raw_parts(ptr.cast::<u32>(), len, cap) }
 }
 
 /// The clusters: a cell whole, or (split by connectivity) one in-cell component of it.

@@ -90,7 +90,7 @@ pub fn simplify_file_in_blocks(
     };
     pts.stream = Some(FileFaces::new(path, block));
     // The area pass counts the faces too: --ratio needs the count.
-    let mut work = prepare(&mut pts, opts, hybrid)?;
+    let mut work = prepare(&mut pts, opts, hybrid, None)?;
     let faces = work.pts.face_count();
     let target_faces = match target {
         Target::Faces(n) => n,
