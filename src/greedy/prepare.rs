@@ -111,34 +111,39 @@ impl Prepared {
             .collect();
 
         let tf = |f: &[u32; 3]| f.map(|v| topo[v as usize]);
-        // A face's unit normal and its plane quadric (area-weighted).
-        let plane = |f: usize| {
+        // A face's plane: its unit normal, offset and twice its area, no area for a face
+        // without a normal.
+        let plane = |f: usize| -> [f64; 5] {
             let [p0, p1, p2] = tf(&faces[f]).map(|v| pos[v as usize]);
             let c = cross(sub(p1, p0), sub(p2, p0));
             let len = norm(c);
-            (len > 0.0).then(|| {
+            if len > 0.0 {
                 let n = c.map(|x| x / len);
-                (n, Quadric::from_plane(n, -dot(n, p0), 0.5 * len))
-            })
+                [n[0], n[1], n[2], -dot(n, p0), len]
+            } else {
+                [0.0; 5]
+            }
         };
         // The faces around each vertex, in face order (a counting sort, mostly on one core),
-        // and beside it each face's reference normal: on the 1M scan 0.045-0.054 s one after
-        // the other, 0.030-0.037 s side by side.
-        let ((corners, corner_start), ref_normal) = rayon::join(
+        // and beside it each face's plane and reference normal: on the 1M scan 0.045-0.054 s
+        // one after the other, 0.030-0.037 s side by side.
+        let ((corners, corner_start), (ref_normal, planes)) = rayon::join(
             || counting_sort(nt, faces.len() * 3, |c| topo[faces[c / 3][c % 3] as usize]),
-            || -> Vec<[f32; 3]> {
+            || -> (Vec<[f32; 3]>, Vec<[f64; 5]>) {
                 (0..faces.len())
                     .into_par_iter()
                     .map(|f| {
-                        let own = plane(f).map(|(n, _)| n.map(|x| x as f32));
+                        let plane = plane(f);
+                        let own = (plane[4] > 0.0).then(|| [0, 1, 2].map(|k| plane[k] as f32));
                         // The original face under a carried one, as the rounds' upload takes it.
                         let under = carried.and_then(|c| c.normals.get(face_origin[f] as usize));
-                        match (own, under) {
+                        let normal = match (own, under) {
                             (Some(_), Some(&n)) if n != [0.0; 3] => n,
                             (own, _) => own.unwrap_or([0.0; 3]),
-                        }
+                        };
+                        (normal, plane)
                     })
-                    .collect()
+                    .unzip()
             },
         );
         let faces_of = |v: usize| {
@@ -149,9 +154,12 @@ impl Prepared {
         // Per vertex, in parallel: the sum of its faces' plane quadrics in face order, then the
         // constraint planes of its border and seam edges in ascending order of the other end,
         // which is the order one pass over all edges sorted by (low, high) end gives each
-        // vertex; so the sums do not depend on the thread count. Each face's plane and each
-        // constraint is computed once per vertex that needs it: cheaper than one 88-byte
-        // quadric per face written out and read back, and, measured on the 1M scan, the
+        // vertex; so the sums do not depend on the thread count. Each face's plane is read
+        // from the reference normals' pass (40 bytes a face) and its quadric made per vertex:
+        // cheaper than one 88-byte quadric per face written out and read back, and than the
+        // plane worked out again at each corner (`hybrid` on the 1M scan at 10%: this set-up
+        // 0.0390 -> 0.0348 s, medians of 21 calls; `cpu` 0.191 -> 0.184 s, of 9). Each
+        // constraint is computed once per vertex that needs it. Measured on the 1M scan, the
         // sequential pass over all edges with a union-find over all corners took 0.12 s.
         // Straight into the three arrays: collecting tuples and copying them out took 0.027 s,
         // on one core, of the 0.25 s set-up of the 1M scan.
@@ -163,8 +171,9 @@ impl Prepared {
                 |(edges, fan): &mut (Vec<u64>, Vec<u32>), v| {
                     let mut q = Quadric::default();
                     for f in faces_of(v) {
-                        if let Some((_, fq)) = plane(f as usize) {
-                            q.add(&fq);
+                        let [n0, n1, n2, d, len] = planes[f as usize];
+                        if len > 0.0 {
+                            q.add(&Quadric::from_plane([n0, n1, n2], d, 0.5 * len));
                         }
                     }
                     let mut mobility = if attr_count[v] > 1 {
@@ -280,6 +289,7 @@ impl Prepared {
                 },
             )
             .unzip();
+        drop(planes);
         let attrs = layout.map(|layout| {
             let mut at = Attributes::new(&mesh, layout);
             let stride = at.layout.stride();
