@@ -334,6 +334,7 @@ mod tests {
             assert_eq!(labels(8), one);
         }
     }
+
     /// The cells are the runs of equal sorted keys, a singleton key a cell per vertex, found
     /// alike on one thread and on eight over enough keys for many tasks; each vertex's cell
     /// holds it.
