@@ -398,13 +398,13 @@ mod tests {
         let after = super::super::probe(late.pts, late.pts.area, &late.locked, target).unwrap();
         assert_eq!(probes, after);
         assert_eq!(early.pts.area, late.pts.area);
-        let built = |w: &super::super::Work| {
+        let built = |w: &super::super::Work, probes| {
             let mut report = ClusterReport::default();
             let (grid, b, _) =
-                super::super::cluster_to(w, target, None, None, &mut report).unwrap();
+                super::super::cluster_to(w, target, None, None, probes, &mut report).unwrap();
             (grid.h, b.faces, b.vertex_cluster, report.sizes_counted)
         };
-        let (a, b) = (built(&early), built(&late));
+        let (a, b) = (built(&early, Some(probes)), built(&late, None));
         assert!(!a.1.is_empty());
         assert_eq!(a, b);
     }

@@ -154,8 +154,8 @@ struct Work<'a, 'm> {
     /// Per point: clustered with nobody (a locked border; a hybrid cluster that made a
     /// non-manifold edge, taken apart).
     locked: Vec<bool>,
-    /// The target and its probes, counted beside the vertex→face lists ([`prepare`]);
-    /// [`cluster_to`] probes itself without them.
+    /// The target and its probes, counted beside the vertex→face lists ([`prepare`]) for the
+    /// first `cluster_to`, which takes them.
     probed: Option<(usize, Probes)>,
     /// `--backend gpu`: the points on the device, each build run there by the same stages.
     gpu: Option<std::sync::Mutex<gpu::GpuClusterMesh<'a>>>,
@@ -319,20 +319,21 @@ const MAX_BUILDS: usize = 6;
 
 /// Clusters to about `target` faces: within [`BAND`] of it, or (`floor`, the hybrid) at least
 /// `floor`. `--max-error` caps the cell so that no vertex moves farther than it. One counting
-/// pass fits faces against cell size (a power law, faces ∝ h⁻² on a surface); then
-/// [`land`].
+/// pass fits faces against cell size (a power law, faces ∝ h⁻² on a surface), unless `probes`
+/// come counted already; then [`land`].
 fn cluster_to(
     work: &Work,
     target: usize,
     max_error: Option<f64>,
     floor: Option<usize>,
+    probes: Option<Probes>,
     report: &mut ClusterReport,
 ) -> Result<(Grid, Built, StopReason)> {
     let pts = work.pts;
     let (lo, hi) = (pts.lo, pts.hi);
-    let (h0, probed) = match &work.probed {
-        Some((t, probes)) if *t == target => probes.clone(),
-        _ => probe(pts, pts.area, &work.locked, target)?,
+    let (h0, probed) = match probes {
+        Some(probes) => probes,
+        None => probe(pts, pts.area, &work.locked, target)?,
     };
     report.sizes_counted += probed.len();
     let first = grid::fit(&probed, target.max(1) as f64).unwrap_or(h0);
@@ -734,8 +735,14 @@ fn cluster_on(
         method: Method::Cluster,
         ..Default::default()
     };
-    let (grid, built, stop) =
-        cluster_to(&work, opts.target_faces, opts.max_error, None, &mut report)?;
+    let (grid, built, stop) = cluster_to(
+        &work,
+        opts.target_faces,
+        opts.max_error,
+        None,
+        None,
+        &mut report,
+    )?;
     opts.cancel.check()?;
     progress(0.9);
     tally(&mut report, &built);

@@ -220,7 +220,12 @@ pub(super) fn cluster_repaired(
     target: usize,
     report: &mut ClusterReport,
 ) -> Result<(Grid, Built, Vec<[f32; 3]>)> {
-    let (grid, mut built, _) = cluster_to(work, intermediate, None, Some(target), report)?;
+    // The probes the preparation counted for this target, beside its vertex→face lists.
+    let probes = work
+        .probed
+        .take()
+        .and_then(|(t, p)| (t == intermediate).then_some(p));
+    let (grid, mut built, _) = cluster_to(work, intermediate, None, Some(target), probes, report)?;
     // The faces' input normals for the build in `built`; `None` after a repair worked out from
     // the build before, whose check asks only for its new faces' normals.
     let mut normals = Some(origin_normals(work, &built)?);
@@ -283,8 +288,6 @@ pub(super) fn cluster_repaired(
 /// build and, per cluster, whether it is a new singleton.
 fn take_apart(work: &mut Work, grid: &Grid, b: Built, bad: &[u32]) -> (Built, Vec<bool>) {
     use super::stages::cluster_quadric;
-    // The probes counted these vertices unlocked.
-    work.probed = None;
     // The build's arrays are rewritten where they are: copies into fresh blocks paid for every
     // page they touched (see `placed` below).
     let Built {
@@ -544,7 +547,7 @@ mod tests {
             let mut report = ClusterReport::default();
             let target = opts.target_faces;
             let (grid, mut built, _) =
-                cluster_to(&work, 2 * target, None, Some(target), &mut report).unwrap();
+                cluster_to(&work, 2 * target, None, Some(target), None, &mut report).unwrap();
             let whole = |b: &Built, work: &Work| checked(b, &origin_normals(work, b).unwrap());
             let mut bad = whole(&built, &work);
             assert!(!bad.is_empty(), "seed {seed}: nothing to repair");
@@ -597,7 +600,7 @@ mod tests {
             let mut report = ClusterReport::default();
             let target = opts.target_faces;
             let (grid, mut built, _) =
-                cluster_to(&work, 3 * target, None, Some(target), &mut report).unwrap();
+                cluster_to(&work, 3 * target, None, Some(target), None, &mut report).unwrap();
             let what = format!("{} faces, lock_border {lock_border}", mesh.triangles.len());
             if color > 0.0 {
                 assert!(built.clusters > built.cells, "{what}: no cell was split");

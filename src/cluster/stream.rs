@@ -121,7 +121,7 @@ pub fn simplify_file_in_blocks(
         (grid, built, StopReason::TargetReached, normals)
     } else {
         let (grid, built, stop) =
-            cluster_to(&work, target_faces, opts.max_error, None, &mut report)?;
+            cluster_to(&work, target_faces, opts.max_error, None, None, &mut report)?;
         (grid, built, stop, Vec::new())
     };
     opts.cancel.check()?;
