@@ -240,6 +240,15 @@ impl Work<'_, '_> {
             .into_par_iter()
             .with_min_len(256)
             .map_init(Vec::new, |members, k| {
+                // A cluster's members lie anywhere in the points: a later cluster's asked of the
+                // cache while this one is placed. `cluster` on the 1M scan at 10%: 0.0083 ->
+                // 0.0075 s for the placements (three rounds of 15 calls each way, turn about).
+                if let Some(&c) = clusters.cell.get(k + PLACE_AHEAD) {
+                    let (a, b) = (cells.start[c as usize], cells.start[c as usize + 1]);
+                    for &m in &cells.members[a as usize..b as usize] {
+                        crate::cache::prefetch(&self.pts.positions, m as usize);
+                    }
+                }
                 members.clear();
                 members.extend(clusters.members(&cells, label.as_deref(), k));
                 let ((lo, hi), o) = (boxes[k], centre(k));
@@ -268,6 +277,9 @@ impl Work<'_, '_> {
         })
     }
 }
+
+/// How many clusters ahead the placements ask for a cluster's members' positions.
+const PLACE_AHEAD: usize = 2;
 
 impl Work<'_, '_> {
     /// What [`stages::cluster_quadric`] reads; `None` without vertex→face lists (`cluster`).
