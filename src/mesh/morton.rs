@@ -11,8 +11,22 @@ pub(crate) fn spatial_order(
     topo: Vec<u32>,
     firsts: Vec<u32>,
 ) -> (Vec<u32>, Vec<u32>) {
+    // The classes in (code, class) order: a stable radix sort of the codes gives it, ties in
+    // class order. The 1M scan's 537k classes (the greedy's set-up, `cpu` at 10%, two cores,
+    // 8 calls each way, turn about): 0.026 s sorting (code, class) pairs, 0.017 s this.
+    let (_, order) = crate::cluster::stages::radix_sort(codes(positions, &firsts));
+    let mut rank = vec![0u32; firsts.len()];
+    for (new, &old) in order.iter().enumerate() {
+        rank[old as usize] = new as u32;
+    }
+    let firsts = order.par_iter().map(|&old| firsts[old as usize]).collect();
+    (topo.par_iter().map(|&t| rank[t as usize]).collect(), firsts)
+}
+
+/// Each class's Morton code: its first vertex's position on a 1024³ grid over their box.
+fn codes(positions: &[[f32; 3]], firsts: &[u32]) -> Vec<u32> {
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for &v in &firsts {
+    for &v in firsts {
         let p = positions[v as usize];
         lo = [0, 1, 2].map(|i| lo[i].min(p[i]));
         hi = [0, 1, 2].map(|i| hi[i].max(p[i]));
@@ -26,18 +40,7 @@ pub(crate) fn spatial_order(
         let q = |i: usize| (((p[i] - lo[i]) / spread) * 1023.0) as u32;
         morton3(q(0), q(1), q(2))
     };
-    let mut keyed: Vec<(u32, u32)> = (0..firsts.len() as u32)
-        .into_par_iter()
-        .map(|c| (code(firsts[c as usize]), c))
-        .collect();
-    keyed.par_sort_unstable();
-    let order: Vec<u32> = keyed.into_iter().map(|(_, c)| c).collect();
-    let mut rank = vec![0u32; firsts.len()];
-    for (new, &old) in order.iter().enumerate() {
-        rank[old as usize] = new as u32;
-    }
-    let firsts = order.par_iter().map(|&old| firsts[old as usize]).collect();
-    (topo.par_iter().map(|&t| rank[t as usize]).collect(), firsts)
+    firsts.par_iter().map(|&v| code(v)).collect()
 }
 
 /// The Morton code of a cell with coordinates below 1024: the low 10 bits of x, y and z
@@ -53,4 +56,40 @@ pub(crate) fn morton3(x: u32, y: u32, z: u32) -> u32 {
         (x | (x << 2)) & 0x09249249
     };
     part(x) | (part(y) << 1) | (part(z) << 2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The classes come out in (code, class) order, ties in class order, and each vertex's
+    /// class is renumbered by that order: checked against a plain sort of the pairs on enough
+    /// classes for the radix sort's parallel passes, many of them sharing a code.
+    #[test]
+    fn classes_in_code_then_class_order() {
+        // 120,000 vertices scattered over a 20³ lattice (so most codes repeat), 70,000
+        // classes, each with a first vertex and the vertices' classes in scrambled order.
+        let (nv, n) = (120_000u32, 70_000u32);
+        let positions: Vec<[f32; 3]> = (0..nv)
+            .map(|v| {
+                let h = v.wrapping_mul(2_654_435_761);
+                [h % 20, (h >> 8) % 20, (h >> 16) % 20].map(|c| c as f32 * 0.37 - 2.0)
+            })
+            .collect();
+        let firsts: Vec<u32> = (0..n).map(|c| (c * 7_919) % nv).collect();
+        let topo: Vec<u32> = (0..nv).map(|v| (v * 104_729) % n).collect();
+        let codes = codes(&positions, &firsts);
+        let mut pairs: Vec<(u32, u32)> = codes.iter().copied().zip(0..).collect();
+        pairs.sort_unstable();
+        assert!(pairs.windows(2).filter(|w| w[0].0 == w[1].0).count() > n as usize / 2);
+        let (ranked, ordered) = spatial_order(&positions, topo.clone(), firsts.clone());
+        let want: Vec<u32> = pairs.iter().map(|&(_, c)| firsts[c as usize]).collect();
+        assert_eq!(ordered, want);
+        let mut rank = vec![0u32; n as usize];
+        for (r, &(_, c)) in pairs.iter().enumerate() {
+            rank[c as usize] = r as u32;
+        }
+        let want: Vec<u32> = topo.iter().map(|&c| rank[c as usize]).collect();
+        assert_eq!(ranked, want);
+    }
 }
