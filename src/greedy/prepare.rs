@@ -163,6 +163,7 @@ impl Prepared {
         // sequential pass over all edges with a union-find over all corners took 0.12 s.
         // Straight into the three arrays: collecting tuples and copying them out took 0.027 s,
         // on one core, of the 0.25 s set-up of the 1M scan.
+        let seamless = !attr_count.par_iter().any(|&c| c > 1);
         let (mut quadrics, (mut mobility, border)): (Vec<Quadric>, (Vec<Mobility>, Vec<bool>)) = (0
             ..nt)
             .into_par_iter()
@@ -174,6 +175,20 @@ impl Prepared {
                         let [n0, n1, n2, d, len] = planes[f as usize];
                         if len > 0.0 {
                             q.add(&Quadric::from_plane([n0, n1, n2], d, 0.5 * len));
+                        }
+                    }
+                    // Most vertices are inside a surface without seams: their edges need no
+                    // sorting, since they add no constraint plane. The 1M scan at 10% (`cpu`,
+                    // two cores, 8 calls each way, turn about): this pass 0.073 -> 0.064 s.
+                    if seamless {
+                        let around = faces_of(v).map(|f| tf(&faces[f as usize]));
+                        if let Some(fans) = interior_fans(around, v as u32, fan) {
+                            let mobility = if fans > 1 {
+                                Mobility::Pinned
+                            } else {
+                                Mobility::Free
+                            };
+                            return (q, (mobility, false));
                         }
                     }
                     let mut mobility = if attr_count[v] > 1 {
@@ -204,13 +219,6 @@ impl Prepared {
                     // v's faces joined across its manifold edges: the fans around v.
                     fan.clear();
                     fan.extend(0..faces_of(v).len() as u32);
-                    let root = |fan: &mut Vec<u32>, mut x: u32| {
-                        while fan[x as usize] != x {
-                            fan[x as usize] = fan[fan[x as usize] as usize];
-                            x = fan[x as usize];
-                        }
-                        x
-                    };
                     let mut i = 0;
                     while i < edges.len() {
                         let mut j = i + 1;
@@ -235,9 +243,7 @@ impl Prepared {
                             }
                             2 => {
                                 let (f1, f2) = (face_at(edges[i]), face_at(edges[i + 1]));
-                                let (r1, r2) =
-                                    (root(fan, edges[i] as u32), root(fan, edges[i + 1] as u32));
-                                fan[r1.max(r2) as usize] = r1.min(r2);
+                                join(fan, edges[i] as u32, edges[i + 1] as u32);
                                 // A seam edge (the faces disagree on an endpoint's attribute
                                 // vertex) gets a constraint plane like a border, so the seam
                                 // keeps its course.
@@ -276,7 +282,7 @@ impl Prepared {
                     }
                     // A vertex whose faces form more than one fan (a bow-tie) is pinned:
                     // collapsing around it cannot keep the surface's topology well defined.
-                    if (0..fan.len() as u32).filter(|&x| root(fan, x) == x).count() > 1 {
+                    if fan_count(fan) > 1 {
                         mobility = Mobility::Pinned;
                     }
                     if opts.lock_border && border {
@@ -515,6 +521,70 @@ impl Prepared {
     }
 }
 
+/// Neighbour entries (two per face) up to which [`interior_fans`] works on a fixed-width row:
+/// eight faces around a vertex.
+const FAN_ROW: usize = 16;
+
+/// The number of fans `v`'s faces `around` (topological, each holding `v` once) make when
+/// every neighbour is on exactly two of them: no border, seam or non-manifold edge at `v`, so
+/// its set-up adds no constraint plane. `None` otherwise, or beyond [`FAN_ROW`] entries.
+/// Counted against a fixed-width row (which the compiler vectorizes) instead of sorting the
+/// entries; the fans are the same sets whatever order their faces are joined in.
+fn interior_fans(
+    around: impl Iterator<Item = [u32; 3]>,
+    v: u32,
+    fan: &mut Vec<u32>,
+) -> Option<usize> {
+    // Padded with no vertex: ids are below the vertex count.
+    let mut row = [u32::MAX; FAN_ROW];
+    let mut n = 0;
+    for t in around {
+        for u in t {
+            if u != v {
+                *row.get_mut(n)? = u;
+                n += 1;
+            }
+        }
+    }
+    if !row[..n]
+        .iter()
+        .all(|&u| row.iter().filter(|&&w| w == u).count() == 2)
+    {
+        return None;
+    }
+    // Entries 2i and 2i + 1 are face i's.
+    fan.clear();
+    fan.extend(0..(n / 2) as u32);
+    for j in 0..n {
+        if let Some(k) = (j + 1..n).find(|&k| row[k] == row[j]) {
+            join(fan, j as u32 / 2, k as u32 / 2);
+        }
+    }
+    Some(fan_count(fan))
+}
+
+/// The root of `x` in the union-find `fan` (halving the path on the way).
+fn fan_root(fan: &mut [u32], mut x: u32) -> u32 {
+    while fan[x as usize] != x {
+        fan[x as usize] = fan[fan[x as usize] as usize];
+        x = fan[x as usize];
+    }
+    x
+}
+
+/// Joins the sets of faces `a` and `b` in `fan` (the lower root stays).
+fn join(fan: &mut [u32], a: u32, b: u32) {
+    let (a, b) = (fan_root(fan, a), fan_root(fan, b));
+    fan[a.max(b) as usize] = a.min(b);
+}
+
+/// The number of sets (fans) in `fan`.
+fn fan_count(fan: &mut [u32]) -> usize {
+    (0..fan.len() as u32)
+        .filter(|&x| fan_root(fan, x) == x)
+        .count()
+}
+
 /// Hoppe's edge constraint: the plane through edge (pa, pb) perpendicular to the surface
 /// (normal `surface`), weighted by the squared edge length so it scales like a face area.
 fn edge_constraint(pa: [f64; 3], pb: [f64; 3], surface: [f64; 3], weight: f64) -> Option<Quadric> {
@@ -525,4 +595,120 @@ fn edge_constraint(pa: [f64; 3], pb: [f64; 3], surface: [f64; 3], weight: f64) -
         let n = n.map(|x| x / l);
         Quadric::from_plane(n, -dot(n, pa), weight * dot(e, e))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Faces around vertex 0: each fan a ring of `ring` new neighbours, closed (the last face
+    /// back to the first neighbour) or open (a border at both ends).
+    fn fans(spec: &[(usize, bool)]) -> Vec<[u32; 3]> {
+        let mut next = 1u32;
+        let mut out = Vec::new();
+        for &(ring, closed) in spec {
+            let first = next;
+            let faces = if closed { ring } else { ring - 1 };
+            for i in 0..faces as u32 {
+                let a = first + i;
+                let b = if i + 1 == ring as u32 { first } else { a + 1 };
+                out.push([0, a, b]);
+            }
+            next += ring as u32;
+        }
+        out
+    }
+
+    /// The fans of vertex 0 counted with a sorted edge list: each neighbour's faces, `None`
+    /// unless every neighbour is on exactly two, else the components of faces joined across
+    /// their shared neighbours.
+    fn sorted_fans(around: &[[u32; 3]]) -> Option<usize> {
+        let mut edges: Vec<(u32, usize)> = Vec::new();
+        for (i, t) in around.iter().enumerate() {
+            edges.extend(t.iter().filter(|&&u| u != 0).map(|&u| (u, i)));
+        }
+        edges.sort_unstable();
+        let mut set: Vec<usize> = (0..around.len()).collect();
+        for run in edges.chunk_by(|a, b| a.0 == b.0) {
+            if run.len() != 2 {
+                return None;
+            }
+            let (a, b) = (set[run[0].1], set[run[1].1]);
+            set.iter_mut().filter(|s| **s == b).for_each(|s| *s = a);
+        }
+        set.sort_unstable();
+        set.dedup();
+        Some(set.len())
+    }
+
+    /// The row's count equals the sorted list's: closed fans (one, two or three at a vertex),
+    /// open fans and a mix (borders), an edge on three faces, and the row's limit of eight
+    /// faces, past which it leaves the vertex to the sorted path.
+    #[test]
+    fn interior_fans_equal_the_sorted_count() {
+        let mut nonmanifold = fans(&[(4, true)]);
+        nonmanifold.push([0, 1, 9]);
+        let cases = [
+            (fans(&[(6, true)]), Some(1)),
+            (fans(&[(8, true)]), Some(1)),
+            (fans(&[(3, true), (3, true)]), Some(2)),
+            (fans(&[(3, true), (5, true)]), Some(2)),
+            (
+                fans(&[(3, true), (3, true)]).into_iter().rev().collect(),
+                Some(2),
+            ),
+            (fans(&[(6, false)]), None),
+            (fans(&[(3, true), (4, false)]), None),
+            (nonmanifold, None),
+            (fans(&[(9, true)]), None),
+            (fans(&[(3, true), (3, true), (3, true)]), None),
+        ];
+        let mut fan = Vec::new();
+        for (around, want) in cases {
+            let got = interior_fans(around.iter().copied(), 0, &mut fan);
+            assert_eq!(got, want, "{around:?}");
+            if around.len() <= FAN_ROW / 2 {
+                assert_eq!(got, sorted_fans(&around), "{around:?}");
+            } else {
+                // Beyond the row: the sorted path's count stands (three fans of three).
+                assert!(sorted_fans(&around).is_some_and(|n| n >= 1));
+            }
+        }
+    }
+
+    /// A vertex where closed fans meet is pinned and one with a single closed fan is free,
+    /// with few faces (the row) and with many (the sorted path); no vertex of a closed
+    /// surface is a border.
+    #[test]
+    fn fans_meeting_at_a_vertex_pin_it() {
+        for ring in [3, 6] {
+            // Two closed cones with apex 0, each capped by a fan around a centre vertex.
+            let mut triangles = fans(&[(ring, true), (ring, true)]);
+            for cone in 0..2u32 {
+                let first = 1 + cone * ring as u32;
+                let centre = 1 + 2 * ring as u32 + cone;
+                for i in 0..ring as u32 {
+                    let a = first + i;
+                    let b = first + (i + 1) % ring as u32;
+                    triangles.push([centre, b, a]);
+                }
+            }
+            let mut positions = vec![[0.0f32; 3]];
+            for cone in 0..2 {
+                let z = if cone == 0 { 1.0 } else { -1.0 };
+                for i in 0..ring {
+                    let a = i as f32 * std::f32::consts::TAU / ring as f32;
+                    positions.push([a.cos(), a.sin(), z]);
+                }
+            }
+            positions.extend([[0.0, 0.0, 1.5], [0.0, 0.0, -1.5]]);
+            let m = Mesh::new(positions, triangles);
+            let p = Prepared::new(&m, &SimplifyOptions::with_faces(4));
+            let apex = p.topo[0] as usize;
+            assert_eq!(p.mobility[apex], Mobility::Pinned, "ring {ring}");
+            let free = (0..p.pos.len()).filter(|&v| v != apex);
+            assert!(free.clone().all(|v| p.mobility[v] == Mobility::Free));
+            assert!(!p.border.contains(&true));
+        }
+    }
 }
