@@ -642,36 +642,33 @@ mod tests {
     }
 
     /// The row's count equals the sorted list's: closed fans (one, two or three at a vertex),
-    /// open fans and a mix (borders), an edge on three faces, and the row's limit of eight
-    /// faces, past which it leaves the vertex to the sorted path.
+    /// open fans and a mix (borders), an edge on three faces. Past eight faces the row gives
+    /// way (`None`) and the sorted count stands.
     #[test]
     fn interior_fans_equal_the_sorted_count() {
         let mut nonmanifold = fans(&[(4, true)]);
         nonmanifold.push([0, 1, 9]);
+        let two_reversed: Vec<[u32; 3]> = fans(&[(3, true), (3, true)]).into_iter().rev().collect();
+        // (faces around vertex 0, the row's answer, the sorted count)
         let cases = [
-            (fans(&[(6, true)]), Some(1)),
-            (fans(&[(8, true)]), Some(1)),
-            (fans(&[(3, true), (3, true)]), Some(2)),
-            (fans(&[(3, true), (5, true)]), Some(2)),
-            (
-                fans(&[(3, true), (3, true)]).into_iter().rev().collect(),
-                Some(2),
-            ),
-            (fans(&[(6, false)]), None),
-            (fans(&[(3, true), (4, false)]), None),
-            (nonmanifold, None),
-            (fans(&[(9, true)]), None),
-            (fans(&[(3, true), (3, true), (3, true)]), None),
+            (fans(&[(6, true)]), Some(1), Some(1)),
+            (fans(&[(8, true)]), Some(1), Some(1)),
+            (fans(&[(3, true), (3, true)]), Some(2), Some(2)),
+            (fans(&[(3, true), (5, true)]), Some(2), Some(2)),
+            (two_reversed, Some(2), Some(2)),
+            (fans(&[(6, false)]), None, None),
+            (fans(&[(3, true), (4, false)]), None, None),
+            (nonmanifold, None, None),
+            (fans(&[(9, true)]), None, Some(1)),
+            (fans(&[(3, true), (3, true), (3, true)]), None, Some(3)),
         ];
         let mut fan = Vec::new();
-        for (around, want) in cases {
+        for (around, row, sorted) in cases {
+            assert_eq!(sorted_fans(&around), sorted, "{around:?}");
             let got = interior_fans(around.iter().copied(), 0, &mut fan);
-            assert_eq!(got, want, "{around:?}");
+            assert_eq!(got, row, "{around:?}");
             if around.len() <= FAN_ROW / 2 {
-                assert_eq!(got, sorted_fans(&around), "{around:?}");
-            } else {
-                // Beyond the row: the sorted path's count stands (three fans of three).
-                assert!(sorted_fans(&around).is_some_and(|n| n >= 1));
+                assert_eq!(got, sorted, "{around:?}");
             }
         }
     }
@@ -706,8 +703,8 @@ mod tests {
             let p = Prepared::new(&m, &SimplifyOptions::with_faces(4));
             let apex = p.topo[0] as usize;
             assert_eq!(p.mobility[apex], Mobility::Pinned, "ring {ring}");
-            let free = (0..p.pos.len()).filter(|&v| v != apex);
-            assert!(free.clone().all(|v| p.mobility[v] == Mobility::Free));
+            let mut others = (0..p.pos.len()).filter(|&v| v != apex);
+            assert!(others.all(|v| p.mobility[v] == Mobility::Free));
             assert!(!p.border.contains(&true));
         }
     }
