@@ -7,6 +7,7 @@
 mod generate;
 pub(crate) mod morton;
 pub mod prepare;
+pub mod sort;
 pub(crate) mod topology;
 pub(crate) mod weld;
 

@@ -14,7 +14,7 @@ pub(crate) fn spatial_order(
     // The classes in (code, class) order: a stable radix sort of the codes gives it, ties in
     // class order. The 1M scan's 537k classes (the greedy's set-up, `cpu` at 10%, two cores,
     // 8 calls each way, turn about): 0.026 s sorting (code, class) pairs, 0.017 s this.
-    let (_, order) = crate::cluster::stages::radix_sort(codes(positions, &firsts));
+    let (_, order) = super::sort::radix_sort(codes(positions, &firsts));
     let mut rank = vec![0u32; firsts.len()];
     for (new, &old) in order.iter().enumerate() {
         rank[old as usize] = new as u32;
