@@ -156,26 +156,19 @@ fn checked(b: &Built, normals: &[[f32; 3]]) -> Vec<u32> {
 }
 
 /// [`checked`] of `b`, a repair of a build in which every cluster it found was taken apart
-/// ([`take_apart`]; `fresh`: its new singletons). Only what the repair changed is looked at,
-/// the same clusters found: a face without a new singleton was in the build before, on
-/// clusters that stayed, and so neither folded nor on an edge that pinched; an edge whose
-/// faces changed is on a face at a new singleton, so its lower end is among those faces'
-/// clusters. The two checks after the repairs took 0.010 s each on the 1M scan at 10%, looking
-/// at every face. `normal` gives a face's input normal by its index in `b.faces`; only the
-/// faces at new singletons are asked for theirs, so after a repair only the last build's
-/// normals are worked out for every face.
-fn rechecked(b: &Built, normal: impl Fn(usize) -> [f32; 3], fresh: &[bool]) -> Vec<u32> {
+/// ([`take_apart`]; `at_fresh`: the indices of its faces at a new singleton). Only what the
+/// repair changed is looked at, the same clusters found: a face without a new singleton was in
+/// the build before, on clusters that stayed, and so neither folded nor on an edge that
+/// pinched; an edge whose faces changed is on a face at a new singleton, so both its ends are
+/// among those faces' clusters (an edge between two of them that no such face holds only lost
+/// faces, and was not pinched before). The two checks after the repairs took 0.010 s each on
+/// the 1M scan at 10%, looking at every face. `normal` gives a face's input normal by its
+/// index in `b.faces`; only the faces at new singletons are asked for theirs, so after a
+/// repair only the last build's normals are worked out for every face.
+fn rechecked(b: &Built, normal: impl Fn(usize) -> [f32; 3], at_fresh: &[u32]) -> Vec<u32> {
     let mut touched = vec![false; b.clusters];
     let mut bad = Vec::new();
-    // The faces at a new singleton, picked out on every core.
-    let at_fresh: Vec<u32> = b
-        .faces
-        .par_iter()
-        .enumerate()
-        .with_min_len(1 << 14)
-        .filter_map(|(i, (_, t))| t.iter().any(|&k| fresh[k as usize]).then_some(i as u32))
-        .collect();
-    for &i in &at_fresh {
+    for &i in at_fresh {
         let t = b.faces[i as usize].1;
         for k in t {
             touched[k as usize] = true;
@@ -184,25 +177,31 @@ fn rechecked(b: &Built, normal: impl Fn(usize) -> [f32; 3], fresh: &[bool]) -> V
             bad.extend(t);
         }
     }
-    // (lower end, other end, runs forward) of every half-edge from a touched cluster.
+    // Every half-edge between two touched clusters as one word, (lower end, other end, runs
+    // forward) from the top bit down, sorted. With those from a touched lower end to any
+    // cluster, as tuples, and the faces at new singletons picked out of all, the check after
+    // the first repair took 0.0068 s on the 1M scan at 10% (`hybrid`), now 0.0033-0.0053 s.
+    assert!(b.clusters <= 1 << 31, "cluster ids fit 31 bits");
     let touched = &touched;
-    let mut half: Vec<(u32, u32, bool)> = b
+    let mut half: Vec<u64> = b
         .faces
         .par_iter()
         .with_min_len(4096)
         .flat_map_iter(|&(_, t)| {
             (0..3).filter_map(move |i| {
                 let (a, c) = (t[i], t[(i + 1) % 3]);
-                Some((a.min(c), a.max(c), a < c)).filter(|h| touched[h.0 as usize])
+                (touched[a as usize] && touched[c as usize]).then(|| {
+                    (u64::from(a.min(c)) << 33) | (u64::from(a.max(c)) << 1) | u64::from(a < c)
+                })
             })
         })
         .collect();
     half.par_sort_unstable();
     let mut ends = Vec::new();
-    for run in half.chunk_by(|x, y| x.0 == y.0) {
+    for run in half.chunk_by(|x, y| x >> 33 == y >> 33) {
         ends.clear();
-        ends.extend(run.iter().map(|h| (h.1, h.2)));
-        pinched_ends(&ends, &mut |c| bad.extend([run[0].0, c]));
+        ends.extend(run.iter().map(|&h| ((h >> 1) as u32, h & 1 == 1)));
+        pinched_ends(&ends, &mut |c| bad.extend([(run[0] >> 33) as u32, c]));
     }
     bad.sort_unstable();
     bad.dedup();
@@ -234,7 +233,7 @@ pub(super) fn cluster_repaired(
     // members each their own cluster) and build again, until none is left. After a repair
     // worked out from the build before, only what it changed is checked (`fresh`: its new
     // singletons).
-    let mut fresh: Option<Vec<bool>> = None;
+    let mut fresh: Option<Vec<u32>> = None;
     for _ in 0..MAX_REPAIRS {
         let bad = match (&fresh, &normals) {
             (Some(fresh), _) => {
@@ -285,8 +284,8 @@ pub(super) fn cluster_repaired(
 /// a cell's clusters by root, the locked vertices last in id order). Only the new singletons
 /// are placed, and the faces at them taken again ([`faces_taken_apart`]). Measured on the 1M
 /// scan at 10%: a whole build took 0.09 s of each of the two repairs' 0.12 s. Returns the
-/// build and, per cluster, whether it is a new singleton.
-fn take_apart(work: &mut Work, grid: &Grid, b: Built, bad: &[u32]) -> (Built, Vec<bool>) {
+/// build and the indices of its faces at a new singleton, rising.
+fn take_apart(work: &mut Work, grid: &Grid, b: Built, bad: &[u32]) -> (Built, Vec<u32>) {
     use super::stages::cluster_quadric;
     // The build's arrays are rewritten where they are: copies into fresh blocks paid for every
     // page they touched (see `placed` below).
@@ -374,25 +373,22 @@ fn take_apart(work: &mut Work, grid: &Grid, b: Built, bad: &[u32]) -> (Built, Ve
         vertex_cluster[v as usize] = (kept + i) as u32;
     }
     let clusters = placed.len();
-    let mut fresh = vec![false; clusters];
-    for (i, single) in singles.iter().enumerate() {
-        fresh[kept + i] = single.1.is_none();
-    }
+    let (faces, at_fresh) = faces_taken_apart(
+        &surface,
+        faces,
+        &new_id,
+        &singles,
+        &vertex_cluster,
+        clusters,
+    );
     let built = Built {
-        faces: faces_taken_apart(
-            &surface,
-            faces,
-            &new_id,
-            &singles,
-            &vertex_cluster,
-            clusters,
-        ),
+        faces,
         placed,
         vertex_cluster,
         clusters,
         cells: cells + singles.len(),
     };
-    (built, fresh)
+    (built, at_fresh)
 }
 
 /// Of the cells of clusters `0..first_single` of a build (`placed`; a cell's clusters are
@@ -437,6 +433,7 @@ fn cells_taken(
 /// singletons are deduplicated among themselves and merged in, in face order. Taking every
 /// face again was 0.013 s of a repair on the 1M scan; with this and [`origin_normals`]' lookup
 /// the hybrid at 1% took 0.334 s against 0.384 s (best of five interleaved in-process runs).
+/// Returns the faces and the indices of those at a new singleton, rising.
 fn faces_taken_apart(
     s: &super::stages::Surface,
     faces_before: Vec<(u32, [u32; 3])>,
@@ -444,7 +441,7 @@ fn faces_taken_apart(
     singles: &[(u32, Option<super::stages::Placed>)],
     vertex_cluster: &[u32],
     clusters: usize,
-) -> Vec<(u32, [u32; 3])> {
+) -> (Vec<(u32, [u32; 3])>, Vec<u32>) {
     use super::stages::{dedupe_faces, rotated};
     let input = s.faces;
     let mut around: Vec<u32> = singles
@@ -475,6 +472,7 @@ fn faces_taken_apart(
     let stay = out.len();
     out.resize(stay + fresh.len(), (0, [0; 3]));
     let (mut i, mut j) = (stay, fresh.len());
+    let mut at_fresh = Vec::with_capacity(fresh.len());
     for w in (0..out.len()).rev() {
         // Once the fresh faces are all placed, the rest already stand where they belong.
         if j == 0 {
@@ -486,10 +484,12 @@ fn faces_taken_apart(
             i -= 1;
         } else {
             out[w] = fresh[j - 1];
+            at_fresh.push(w as u32);
             j -= 1;
         }
     }
-    out
+    at_fresh.reverse();
+    (out, at_fresh)
 }
 
 #[cfg(test)]
@@ -586,12 +586,12 @@ mod tests {
                 if bad.is_empty() {
                     break;
                 }
-                let fresh;
-                (built, fresh) = take_apart(&mut work, &grid, built, &bad);
+                let at_fresh;
+                (built, at_fresh) = take_apart(&mut work, &grid, built, &bad);
                 bad = whole(&built, &work);
                 let normals = origin_normals(&work, &built).unwrap();
                 assert_eq!(
-                    rechecked(&built, |i| normals[i], &fresh),
+                    rechecked(&built, |i| normals[i], &at_fresh),
                     bad,
                     "seed {seed}, repair {repair}"
                 );
@@ -651,8 +651,19 @@ mod tests {
                 bad.sort_unstable();
                 bad.dedup();
                 let before = built.clusters;
-                let (apart, _) = take_apart(&mut work, &grid, built, &bad);
+                let was_locked = work.locked.clone();
+                let (apart, at_fresh) = take_apart(&mut work, &grid, built, &bad);
                 let whole = work.build(&grid).unwrap();
+                // The faces at a new singleton: a cluster of a vertex locked just now.
+                let mut fresh = vec![false; whole.clusters];
+                for (v, &k) in whole.vertex_cluster.iter().enumerate() {
+                    fresh[k as usize] |= work.locked[v] && !was_locked[v];
+                }
+                let expected: Vec<u32> = (0..whole.faces.len() as u32)
+                    .filter(|&i| whole.faces[i as usize].1.iter().any(|&k| fresh[k as usize]))
+                    .collect();
+                assert!(!expected.is_empty(), "{what}: no face at a new singleton");
+                assert_eq!(at_fresh, expected, "{what}: the faces at new singletons");
                 assert_eq!(
                     bits(&apart),
                     bits(&whole),
