@@ -231,8 +231,8 @@ pub(super) fn cluster_repaired(
     // Splitting cells by connectivity keeps separate sheets apart, but a sheet folded inside
     // one cell can still pinch into a non-manifold edge: take the clusters on one apart (their
     // members each their own cluster) and build again, until none is left. After a repair
-    // worked out from the build before, only what it changed is checked (`fresh`: its new
-    // singletons).
+    // worked out from the build before, only what it changed is checked (`fresh`: the indices
+    // of its faces at new singletons).
     let mut fresh: Option<Vec<u32>> = None;
     for _ in 0..MAX_REPAIRS {
         let bad = match (&fresh, &normals) {
