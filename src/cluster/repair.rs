@@ -402,18 +402,14 @@ fn cells_taken(
     first_single: usize,
 ) -> usize {
     let key = |k: usize| grid.key(xyz(positions[placed[k].attr as usize]));
-    let bad: Vec<usize> = bad
-        .iter()
-        .map(|&k| k as usize)
-        .take_while(|&k| k < first_single)
-        .collect();
+    let bad = &bad[..bad.partition_point(|&k| (k as usize) < first_single)];
     let (mut taken, mut i) = (0, 0);
     while i < bad.len() {
-        let (first, cell) = (bad[i], key(bad[i]));
-        let mut last = first;
+        let first = bad[i] as usize;
+        let (cell, mut last) = (key(first), first);
         i += 1;
-        while i < bad.len() && bad[i] == last + 1 && key(bad[i]) == cell {
-            last = bad[i];
+        while i < bad.len() && bad[i] as usize == last + 1 && key(last + 1) == cell {
+            last += 1;
             i += 1;
         }
         let alone_before = first == 0 || key(first - 1) != cell;
