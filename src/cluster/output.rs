@@ -16,16 +16,7 @@ pub(super) fn output(
     b: &Built,
     fit_colors: bool,
 ) -> (Mesh, Vec<Quadric>) {
-    let mut id = vec![u32::MAX; b.clusters];
-    let mut order = Vec::new();
-    for (_, t) in &b.faces {
-        for &k in t {
-            if id[k as usize] == u32::MAX {
-                id[k as usize] = order.len() as u32;
-                order.push(k);
-            }
-        }
-    }
+    let (order, id) = crate::mesh::first_use(&b.faces, b.clusters, |(_, t)| *t);
     let src = |k: u32| b.placed[k as usize].attr as usize;
     let mut out = mesh.clone_without_geometry();
     out.positions = order

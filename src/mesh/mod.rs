@@ -4,6 +4,7 @@
 //! Attributes are optional and per vertex; materials and groups are per face. A vertex is one
 //! combination of position and attributes: two vertices may share a position (an attribute seam).
 
+mod first_use;
 mod generate;
 pub(crate) mod morton;
 pub mod prepare;
@@ -11,6 +12,7 @@ pub mod sort;
 pub(crate) mod topology;
 pub(crate) mod weld;
 
+pub(crate) use first_use::first_use;
 pub use generate::*;
 pub use topology::{Topology, topology};
 pub use weld::{WeldResult, weld, weld_positions};
@@ -366,20 +368,18 @@ impl Mesh {
     /// Drops vertices no face uses, renumbering the rest in order of first use by the faces
     /// (a cache-friendly order for the output). Attributes follow their vertices.
     pub fn remove_unused_vertices(&mut self) {
-        let mut map = vec![u32::MAX; self.positions.len()];
-        let mut order = Vec::new();
-        for t in &mut self.triangles {
-            for v in t.iter_mut() {
-                let m = &mut map[*v as usize];
-                if *m == u32::MAX {
-                    *m = order.len() as u32;
-                    order.push(*v);
-                }
-                *v = *m;
-            }
-        }
-        fn pick<T: Copy>(order: &[u32], src: &[T]) -> Vec<T> {
-            order.iter().map(|&v| src[v as usize]).collect()
+        use rayon::prelude::*;
+        let (order, place) = first_use(&self.triangles, self.positions.len(), |t| *t);
+        self.triangles
+            .par_iter_mut()
+            .with_min_len(1 << 14)
+            .for_each(|t| *t = t.map(|v| place[v as usize]));
+        fn pick<T: Copy + Send + Sync>(order: &[u32], src: &[T]) -> Vec<T> {
+            order
+                .par_iter()
+                .with_min_len(1 << 14)
+                .map(|&v| src[v as usize])
+                .collect()
         }
         self.positions = pick(&order, &self.positions);
         self.normals = self.normals.as_deref().map(|s| pick(&order, s));
