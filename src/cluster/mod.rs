@@ -242,30 +242,8 @@ impl Work<'_, '_> {
             .into_par_iter()
             .with_min_len(256)
             .map_init(Vec::new, |members, k| {
-                let cell_members = |k: usize| {
-                    clusters.cell.get(k).map_or(&[][..], |&c| {
-                        let (a, b) = (cells.start[c as usize], cells.start[c as usize + 1]);
-                        &cells.members[a as usize..b as usize]
-                    })
-                };
-                // The gather's members' face lists lie anywhere in the lists too: each list's
-                // bounds asked for twice as far ahead, so that its start can be asked for with
-                // the positions. The 1M scan at 10% (`hybrid`): the placements 0.063-0.068 ->
-                // 0.057-0.061 s (three rounds of 12 calls each way, turn about); asking for
-                // the lists' faces a third step ahead, or other distances, was slower.
                 let csr = surface.as_ref().map(|s| s.csr);
-                if let Some(csr) = csr {
-                    for &m in cell_members(k + 2 * PLACE_AHEAD) {
-                        crate::cache::prefetch(&csr.offsets, m as usize);
-                    }
-                }
-                for &m in cell_members(k + PLACE_AHEAD) {
-                    crate::cache::prefetch(&self.pts.positions, m as usize);
-                    if let Some(csr) = csr {
-                        let list = csr.offsets[m as usize] as usize;
-                        crate::cache::prefetch(&csr.vertex_faces, list);
-                    }
-                }
+                stages::ask_ahead(&clusters, &cells, &self.pts.positions, csr, k);
                 members.clear();
                 members.extend(clusters.members(&cells, label.as_deref(), k));
                 let ((lo, hi), o) = (boxes[k], centre(k));
@@ -294,11 +272,6 @@ impl Work<'_, '_> {
         })
     }
 }
-
-/// How many clusters ahead the placements ask for a cluster's members' positions, which lie
-/// anywhere in the points. `cluster` on the 1M scan at 10%: 0.0083 -> 0.0075 s for the
-/// placements (three rounds of 15 calls each way, turn about).
-const PLACE_AHEAD: usize = 2;
 
 impl Work<'_, '_> {
     /// What [`stages::cluster_quadric`] reads; `None` without vertex→face lists (`cluster`).
