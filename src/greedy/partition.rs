@@ -310,11 +310,11 @@ pub(super) fn partitioned_level(
     let parts: Vec<&[(u32, [u32; 3])]> = std::iter::once(cut_part.as_slice())
         .chain(live.iter().map(Vec::as_slice))
         .collect();
-    let n_live = parts.iter().map(|part| part.len()).sum();
+    let part_lens: Vec<usize> = parts.iter().map(|part| part.len()).collect();
+    let n_live = part_lens.iter().sum();
     let mut faces = vec![[0u32; 3]; n_live];
     let mut origin = vec![0u32; n_live];
     let mut ref_normal = vec![[0f32; 3]; n_live];
-    let part_lens: Vec<usize> = parts.iter().map(|part| part.len()).collect();
     split_lengths(&mut faces, &part_lens)
         .into_par_iter()
         .zip(split_lengths(&mut origin, &part_lens))
