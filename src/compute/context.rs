@@ -13,6 +13,8 @@ pub struct GpuContext {
     /// lavapipe at 1%: 9.5 s against 3.2 s for cpu-parallel and 1.1 s for cpu), so `auto` passes
     /// it over.
     pub software: bool,
+    /// What wgpu says of the adapter (its pipeline cache is keyed by it).
+    pub adapter_info: wgpu::AdapterInfo,
     /// The device's pipeline cache, which every family simplifying on it shares.
     pub pipelines: std::sync::Arc<crate::compute::gpu::Pipelines>,
 }
@@ -41,11 +43,12 @@ impl GpuContext {
             pollster::block_on(adapter.request_device(&device_descriptor(&adapter)))
                 .map_err(|e| Error::Gpu(format!("adapter {} refused a device: {e}", info.name)))?;
         Ok(GpuContext {
-            pipelines: crate::compute::gpu::Pipelines::new(&device),
+            pipelines: crate::compute::gpu::Pipelines::with_disk_cache(&device, &info),
             device,
             queue,
-            adapter_name: info.name,
+            adapter_name: info.name.clone(),
             software: info.device_type == wgpu::DeviceType::Cpu,
+            adapter_info: info,
         })
     }
 }
@@ -124,7 +127,9 @@ pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'sta
     wgpu::DeviceDescriptor {
         label: Some("meshslim"),
         required_features: adapter.features()
-            & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::POLYGON_MODE_LINE),
+            & (wgpu::Features::TIMESTAMP_QUERY
+                | wgpu::Features::POLYGON_MODE_LINE
+                | wgpu::Features::PIPELINE_CACHE),
         required_limits: adapter.limits(),
         ..Default::default()
     }

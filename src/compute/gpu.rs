@@ -18,15 +18,54 @@ use std::time::Instant;
 pub struct Pipelines {
     device: wgpu::Device,
     made: Mutex<HashMap<&'static str, wgpu::ComputePipeline>>,
+    /// The driver's compiled pipelines kept on disk between processes, where the adapter can.
+    disk: Option<super::disk_cache::DiskCache>,
 }
 
 impl Pipelines {
-    /// An empty cache for `device`.
+    /// An empty cache for `device`, kept in memory only.
     pub fn new(device: &wgpu::Device) -> Arc<Pipelines> {
         Arc::new(Pipelines {
             device: device.clone(),
             made: Mutex::new(HashMap::new()),
+            disk: None,
         })
+    }
+
+    /// An empty cache for `device` (made on the adapter `info`), its pipelines compiled
+    /// through the on-disk cache of that adapter in the user's cache folder when the device
+    /// keeps one ([`super::disk_cache`]).
+    pub fn with_disk_cache(device: &wgpu::Device, info: &wgpu::AdapterInfo) -> Arc<Pipelines> {
+        match super::disk_cache::cache_dir() {
+            Some(dir) => Pipelines::with_disk_cache_in(device, info, &dir),
+            None => Pipelines::new(device),
+        }
+    }
+
+    /// As [`Pipelines::with_disk_cache`], the cache file in the folder `dir`.
+    pub fn with_disk_cache_in(
+        device: &wgpu::Device,
+        info: &wgpu::AdapterInfo,
+        dir: &std::path::Path,
+    ) -> Arc<Pipelines> {
+        Arc::new(Pipelines {
+            device: device.clone(),
+            made: Mutex::new(HashMap::new()),
+            disk: super::disk_cache::DiskCache::open(device, info, dir),
+        })
+    }
+
+    /// The file the device's pipelines are kept in between processes, if any.
+    pub fn cache_file(&self) -> Option<&std::path::Path> {
+        self.disk.as_ref().map(|d| d.path())
+    }
+
+    /// How this device's pipelines are found: from the file on disk, compiled into it, or
+    /// without one.
+    pub fn cache_status(&self) -> super::disk_cache::CacheStatus {
+        self.disk
+            .as_ref()
+            .map_or(super::disk_cache::CacheStatus::Unsupported, |d| d.status)
     }
 
     /// The device the pipelines are made on.
@@ -42,51 +81,81 @@ impl Pipelines {
         entries
     }
 
-    /// The pipelines of `stages`, compiling those this device has not made yet (each shader
-    /// module once): entry point → pipeline, and the seconds spent compiling.
+    /// The pipelines of `stages`, compiling those this device has not made yet: entry point →
+    /// pipeline, and the seconds spent compiling. Each shader's module and pipelines are made
+    /// on a core of their own (a driver compiles them one by one otherwise), each under its
+    /// own error scope, since wgpu's scopes are per thread.
     pub fn get<B, G>(
         &self,
         stages: &[&'static Stage<B, G>],
     ) -> Result<(HashMap<&'static str, wgpu::ComputePipeline>, f64)> {
+        use rayon::prelude::*;
         let t = Instant::now();
         let mut made = self.made.lock().unwrap_or_else(|p| p.into_inner());
-        let scope = ErrorScope::push(&self.device);
-        let cached: Vec<&str> = made.keys().copied().collect();
-        let mut modules: HashMap<&str, wgpu::ShaderModule> = HashMap::new();
-        let missing: Vec<&Stage<B, G>> = stages
-            .iter()
-            .copied()
-            .filter(|s| !made.contains_key(s.entry))
-            .collect();
-        for stage in missing {
-            let module = modules.entry(stage.shader).or_insert_with(|| {
-                // Every described stage's shader is in SOURCES (the schedules' tests check it).
-                let src = super::shaders::stage_source(stage.shader).unwrap_or_default();
-                self.device
-                    .create_shader_module(wgpu::ShaderModuleDescriptor {
-                        label: Some(stage.shader),
-                        source: wgpu::ShaderSource::Wgsl(src.into()),
-                    })
-            });
-            let label = format!("meshslim.{}", stage.entry);
-            let p = self
-                .device
-                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(&label),
-                    layout: None,
-                    module,
-                    entry_point: Some(stage.entry),
-                    compilation_options: Default::default(),
-                    cache: None,
-                });
-            made.insert(stage.entry, p);
-        }
-        if let Err(e) = scope.check("creating the compute pipelines") {
-            // The pipelines made here are not kept: the next caller sees the error again.
-            for s in stages.iter().filter(|s| !cached.contains(&s.entry)) {
-                made.remove(s.entry);
+        let mut shaders: Vec<(&'static str, Vec<&'static str>)> = Vec::new();
+        for s in stages.iter().filter(|s| !made.contains_key(s.entry)) {
+            match shaders.iter_mut().find(|(sh, _)| *sh == s.shader) {
+                Some((_, entries)) if !entries.contains(&s.entry) => entries.push(s.entry),
+                Some(_) => {}
+                None => shaders.push((s.shader, vec![s.entry])),
             }
+        }
+        let cache = self.disk.as_ref().map(|d| &d.cache);
+        let compiled: Vec<Result<Vec<(&'static str, wgpu::ComputePipeline)>>> = shaders
+            .par_iter()
+            .map(|(shader, entries)| {
+                let scope = ErrorScope::push(&self.device);
+                // Every described stage's shader is in SOURCES (the schedules' tests check it).
+                let src = super::shaders::stage_source(shader).unwrap_or_default();
+                let module = self
+                    .device
+                    .create_shader_module(wgpu::ShaderModuleDescriptor {
+                        label: Some(shader),
+                        source: wgpu::ShaderSource::Wgsl(src.into()),
+                    });
+                let pipelines = entries
+                    .iter()
+                    .map(|&entry| {
+                        let label = format!("meshslim.{entry}");
+                        let p =
+                            self.device
+                                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                                    label: Some(&label),
+                                    layout: None,
+                                    module: &module,
+                                    entry_point: Some(entry),
+                                    compilation_options: Default::default(),
+                                    cache,
+                                });
+                        (entry, p)
+                    })
+                    .collect();
+                scope.check(&format!(
+                    "creating the compute pipelines of shaders/{shader}.wgsl"
+                ))?;
+                Ok(pipelines)
+            })
+            .collect();
+        // The pipelines of a shader that failed are not kept: the next caller sees the error
+        // again.
+        let mut first_error = None;
+        let mut new = 0;
+        for r in compiled {
+            match r {
+                Ok(pipelines) => {
+                    new += pipelines.len();
+                    made.extend(pipelines)
+                }
+                Err(e) => first_error = first_error.or(Some(e)),
+            }
+        }
+        if let Some(e) = first_error {
             return Err(e);
+        }
+        if new > 0
+            && let Some(disk) = &self.disk
+        {
+            disk.save();
         }
         let out = stages
             .iter()
@@ -137,6 +206,45 @@ impl Kernels {
             max_workgroups: limits.max_compute_workgroups_per_dimension,
             seconds,
         })
+    }
+
+    /// The device's workgroups per dimension: a grid past it is split over y.
+    pub fn max_workgroups(&self) -> u32 {
+        self.max_workgroups
+    }
+
+    /// The bind group of `stage` on the buffers `bind` gives, to record passes with
+    /// ([`Kernels::pass_bound`]) as long as those buffers live: a family that keeps its
+    /// buffers makes each once, not once a pass.
+    pub fn bind_group<'b, B: Copy, G>(
+        &self,
+        device: &wgpu::Device,
+        stage: &Stage<B, G>,
+        bind: impl Fn(B) -> &'b wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        bind_group(device, &self.pipelines, stage, bind)
+    }
+
+    /// One compute pass of `stage` with a bind group made by [`Kernels::bind_group`].
+    pub fn pass_bound<B, G>(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        stage: &Stage<B, G>,
+        bg: &wgpu::BindGroup,
+        groups: Groups,
+        indirect: Option<&wgpu::Buffer>,
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        dispatch(
+            enc,
+            &self.pipelines,
+            stage,
+            bg,
+            groups,
+            self.max_workgroups,
+            indirect,
+            timestamps,
+        )
     }
 
     /// One compute pass of `stage` into `enc`: see [`pass`].
@@ -260,6 +368,31 @@ pub fn record<B: Copy + 'static, G: 'static, C: Copy, X: Copy>(
     }
 }
 
+/// The bind group of `stage`: each binding's buffer from `bind`, in binding order, on the layout
+/// of its pipeline in `pipelines`.
+fn bind_group<'b, B: Copy, G>(
+    device: &wgpu::Device,
+    pipelines: &HashMap<&'static str, wgpu::ComputePipeline>,
+    stage: &Stage<B, G>,
+    bind: impl Fn(B) -> &'b wgpu::Buffer,
+) -> wgpu::BindGroup {
+    let layout = pipelines[stage.entry].get_bind_group_layout(0);
+    let entries: Vec<wgpu::BindGroupEntry> = stage
+        .bindings
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: bind(b.buf).as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(stage.entry),
+        layout: &layout,
+        entries: &entries,
+    })
+}
+
 /// One compute pass of `stage`: its pipeline from `pipelines`, each binding's buffer from
 /// `bind` in binding order, over `groups` (a direct count beyond `max_x` is split over y; the
 /// shader folds y back into its index), with `timestamps` when given; `indirect` holds the
@@ -276,28 +409,31 @@ fn pass<'b, B: Copy, G>(
     indirect: Option<&wgpu::Buffer>,
     timestamps: Option<wgpu::ComputePassTimestampWrites>,
 ) {
+    let bg = bind_group(device, pipelines, stage, bind);
+    dispatch(
+        enc, pipelines, stage, &bg, groups, max_x, indirect, timestamps,
+    )
+}
+
+/// One compute pass of `stage` with its bind group `bg` (see [`pass`]).
+#[allow(clippy::too_many_arguments)]
+fn dispatch<B, G>(
+    enc: &mut wgpu::CommandEncoder,
+    pipelines: &HashMap<&'static str, wgpu::ComputePipeline>,
+    stage: &Stage<B, G>,
+    bg: &wgpu::BindGroup,
+    groups: Groups,
+    max_x: u32,
+    indirect: Option<&wgpu::Buffer>,
+    timestamps: Option<wgpu::ComputePassTimestampWrites>,
+) {
     let (label, pipeline) = (stage.entry, &pipelines[stage.entry]);
-    let layout = pipeline.get_bind_group_layout(0);
-    let entries: Vec<wgpu::BindGroupEntry> = stage
-        .bindings
-        .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry {
-            binding: i as u32,
-            resource: bind(b.buf).as_entire_binding(),
-        })
-        .collect();
-    let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some(label),
-        layout: &layout,
-        entries: &entries,
-    });
     let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
         label: Some(label),
         timestamp_writes: timestamps,
     });
     pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, &bg, &[]);
+    pass.set_bind_group(0, bg, &[]);
     match (groups, indirect) {
         (Groups::Indirect(offset), Some(args)) => pass.dispatch_workgroups_indirect(args, offset),
         (Groups::Indirect(_), None) => {

@@ -12,6 +12,8 @@
 pub mod common;
 // The process's device and the checks on buffers any family makes.
 pub mod context;
+// The compiled pipelines kept on disk between processes.
+pub mod disk_cache;
 pub mod gpu;
 pub mod schedule;
 pub(crate) mod shaders;
