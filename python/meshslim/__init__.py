@@ -17,12 +17,37 @@ weighed in the cost, so a painted scan keeps its painting.
 from __future__ import annotations
 
 import json
+import os
 from typing import Any, Callable, Optional
 
 import numpy as np
 
-from . import _meshslim
-from ._meshslim import Mesh, __version__
+
+def _quiet_wayland_probe() -> None:
+    """Mesa's device-select layer asks libwayland for a compositor whenever wgpu opens a
+    Vulkan device, and libwayland prints ``error: XDG_RUNTIME_DIR is invalid or not set in the
+    environment.`` on a headless machine though nothing failed. As the command line does
+    (``compute::context::quiet_wayland_probe``): with no Wayland display named and no valid
+    runtime folder, point the probe at an empty private folder of our own, removed at exit;
+    with any of them set nothing is touched."""
+    env = os.environ
+    runtime = env.get("XDG_RUNTIME_DIR", "")
+    if env.get("WAYLAND_DISPLAY") or env.get("WAYLAND_SOCKET") or os.path.isabs(runtime):
+        return
+    import atexit
+    import shutil
+    import tempfile
+
+    folder = tempfile.mkdtemp(prefix="meshslim-runtime-")  # 0700, as XDG asks
+    env["XDG_RUNTIME_DIR"] = folder
+    atexit.register(shutil.rmtree, folder, True)
+
+
+# Before the extension loads: no device exists before it.
+_quiet_wayland_probe()
+
+from . import _meshslim  # noqa: E402
+from ._meshslim import Mesh, __version__  # noqa: E402
 
 __all__ = ["Mesh", "Result", "mesh", "read", "write", "simplify", "lods", "remesh", "compare",
            "__version__"]
