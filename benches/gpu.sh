@@ -169,6 +169,31 @@ for r in reports:
                     "transfer_s": rr["transfer_seconds"], "rest_s": rest,
                     "gpu_timestamps": rr["gpu_timestamps"], "rounds": rr["rounds"],
                     "stage_seconds": stages})
+print()
+print("what each rounds run cost on the device's side: waits (round trips), submits, dispatches,")
+print("bind groups made, bytes each way; host: the call less its time blocked on the device;")
+print("cache: the pipelines from the on-disk cache (hit), compiled into it (miss), or neither")
+print(f"{'mesh':<30} {'ratio':>5} {'method':<8} {'backend':<12} {'simplify':>8} {'waits':>5} "
+      f"{'submits':>7} {'dispatch':>8} {'binds':>5} {'MB up':>7} {'MB back':>7} {'host s':>7} "
+      f"{'cache':>11}")
+for r in reports:
+    rr = r.get("rounds")
+    if not rr:
+        continue
+    ratio = r["target_faces"] / max(r["input_faces"], 1)
+    method = "qem" if r.get("clustering") is None else "hybrid"
+    print(f"{r['input']:<30} {ratio:>5.2f} {method:<8} {r['backend']:<12} "
+          f"{r['seconds']['simplify']:>8.3f} {rr.get('device_waits', 0):>5} "
+          f"{rr.get('submits', 0):>7} {rr.get('dispatches', 0):>8} "
+          f"{rr.get('bind_groups_created', 0):>5} {rr.get('bytes_uploaded', 0) / 1e6:>7.1f} "
+          f"{rr.get('bytes_read_back', 0) / 1e6:>7.2f} {rr.get('host_seconds', 0.0):>7.3f} "
+          f"{rr.get('pipeline_cache') or '-':>11}")
+gpu_qem = [r for r in reports if r["backend"] == "gpu" and r.get("rounds")
+           and r.get("clustering") is None and r["target_faces"] * 50 < r["input_faces"]]
+for r in gpu_qem:
+    s = r["seconds"]["simplify"]
+    print(f"goal: {r['input']} at 1% in {s * 1000:.1f} ms on the gpu path "
+          f"({'within' if s <= 0.030 else 'over'} the 30 ms goal)")
 json.dump({"adapter": adapter, "bench": bench, "gpu_runs": summary, "reports": reports},
           open(os.path.join(out, "gpu.json"), "w"), indent=1)
 print(f"\nJSON: {os.path.join(out, 'gpu.json')}" if os.environ.get("KEEP") == "1"

@@ -1,5 +1,5 @@
 // Shared structs, constants and quadric math of every stage; prepended to each stage's source at
-// load time. Twin of src/gpu/types.rs (structs) and src/cpu/common.rs (math): keep in sync.
+// load time. Twin of src/compute/types.rs (structs) and src/compute/common.rs (math): keep in sync.
 
 const WG: u32 = 256u;
 const SCAN_BLOCK: u32 = 1024u;
@@ -74,6 +74,32 @@ struct Counters {
     tentative: u32,
     live: u32,
     _pad: array<u32, 4>,
+}
+
+// Keep in sync with PlanState and Planned in src/compute/types.rs.
+struct PlanState {
+    vertices: u32,
+    faces: u32,
+    target_faces: u32,
+    stopped: u32,
+    executed: u32,
+    max_groups: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+const GRID_VERTICES: u32 = 0u;
+const GRID_FACES: u32 = 1u;
+const GRID_EDGE_SLOTS: u32 = 2u;
+const GRID_VERTICES_OR_FACES: u32 = 3u;
+const GRID_SCAN_VERTICES: u32 = 4u;
+const GRID_ONE: u32 = 7u;
+const GRID_SLOTS: u32 = 8u;
+
+struct Planned {
+    params: Params,
+    scans: array<ScanParams, 3>,
+    grids: array<vec4<u32>, 8>,
 }
 
 // Relative to its vertex: [a00 a01 a02 a11] [a12 a22 b0 b1] [b2 c weight 0].

@@ -538,4 +538,21 @@ pub struct RoundsReport {
     /// The rounds' waits, from each round's submission to its counters read back: the GPU's
     /// work and the driver's (gpu backend).
     pub wait_seconds: f64,
+    /// What the call cost on the device's side (gpu backend; zero on the CPU backends):
+    /// the host's waits for the device (each a round trip)...
+    pub device_waits: u64,
+    /// ...command buffers submitted, compute passes dispatched, bind groups made...
+    pub submits: u64,
+    pub dispatches: u64,
+    pub bind_groups_created: u64,
+    /// ...bytes written to the device's buffers and read back from them...
+    pub bytes_uploaded: u64,
+    pub bytes_read_back: u64,
+    /// ...and the call's seconds less those blocked on the device (`wait_seconds` and the
+    /// read-backs' waits): what the host itself spent.
+    pub host_seconds: f64,
+    /// How the device's pipelines were found: `hit` (compiled from the on-disk cache),
+    /// `miss` (compiled, the cache written), `unsupported` (the adapter keeps none), or
+    /// `shared` (made earlier in this process).
+    pub pipeline_cache: Option<String>,
 }

@@ -53,6 +53,7 @@ fn families_on_one_device_share_its_pipelines() {
         "the shared stages compiled once"
     );
     let again = GpuSimplifier::on(&cache, &ctx.queue).unwrap();
+    assert_eq!(again.pipeline_cache, "shared", "made by the first");
     assert!(
         again.pipeline_seconds < rounds.pipeline_seconds,
         "nothing left to compile: {} s against {} s",
@@ -604,6 +605,156 @@ fn gpu_report_names_adapter_and_stages() {
                 .iter()
                 .any(|(s, _)| s == "edge_costs")
         );
+    }
+}
+
+/// The compiled pipelines are kept on disk where the adapter can (Vulkan, lavapipe included):
+/// a first device compiles and writes the file, a second one made from it hits, and a file
+/// damaged in any way is a miss that compiles again and rewrites it, never an error.
+#[test]
+fn pipelines_are_kept_on_disk_and_a_damaged_cache_is_compiled_again() {
+    use meshslim::compute::disk_cache::CacheStatus;
+    use meshslim::compute::gpu::Pipelines;
+    let Some(ctx) = gpu_context() else { return };
+    if !ctx
+        .device
+        .features()
+        .contains(wgpu::Features::PIPELINE_CACHE)
+    {
+        let cache = Pipelines::with_disk_cache(&ctx.device, &ctx.adapter_info);
+        assert_eq!(cache.cache_status(), CacheStatus::Unsupported);
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let make = || {
+        let cache = Pipelines::with_disk_cache_in(&ctx.device, &ctx.adapter_info, dir.path());
+        let sim = GpuSimplifier::on(&cache, &ctx.queue).unwrap();
+        (cache, sim.pipeline_cache)
+    };
+    let (first, status) = make();
+    assert_eq!((first.cache_status(), status), (CacheStatus::Miss, "miss"));
+    let file = first.cache_file().unwrap().to_path_buf();
+    let written = std::fs::read(&file).unwrap();
+    assert!(written.len() > 28, "{} bytes", written.len());
+    let (_, status) = make();
+    assert_eq!(status, "hit");
+    for damaged in [
+        written[..written.len() / 2].to_vec(),
+        b"not a cache".to_vec(),
+        {
+            let mut w = written.clone();
+            let at = w.len() - 7;
+            w[at] ^= 0x5a;
+            w
+        },
+    ] {
+        std::fs::write(&file, &damaged).unwrap();
+        let (_, status) = make();
+        assert_eq!(status, "miss");
+        assert!(std::fs::read(&file).unwrap().len() > 28, "rewritten");
+    }
+    // And the simplifier made from a hit simplifies as the first did.
+    let m = meshslim::mesh::icosphere(3);
+    let (cache, _) = make();
+    let sim = GpuSimplifier::on(&cache, &ctx.queue).unwrap();
+    let up = Upload::new(&m);
+    let opts = SimplifyOptions::with_ratio(m.triangles.len(), 0.25).unwrap();
+    let (out, _) =
+        meshslim::rounds::gpu::simplify_upload(ctx, &sim, &up, &m, &opts, &mut |_| {}).unwrap();
+    let (want, _) = run(&m, Backend::Gpu, 0.25);
+    assert_eq!(out, want);
+}
+
+/// What a call costs on the device's side is counted, and stays small however many rounds run:
+/// one wait per batch of rounds and one for the result, each stage's bind groups made once per
+/// half, the read-back about the result's size.
+#[test]
+fn gpu_report_counts_waits_bind_groups_and_bytes() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let m = meshslim::mesh::noisy_sphere(5, 0.002, 7);
+    let (out, r) = run(&m, Backend::Gpu, 0.01);
+    let rr = r.rounds.unwrap();
+    let batches = rr.rounds.div_ceil(meshslim::rounds::BATCH_ROUNDS) as u64;
+    assert!(
+        rr.rounds > meshslim::rounds::BATCH_ROUNDS,
+        "{} rounds",
+        rr.rounds
+    );
+    // Each batch waits once, the result once; an exhaustive retry adds its own.
+    assert!(
+        (batches + 1..=batches + 3).contains(&rr.device_waits),
+        "{} waits for {} rounds",
+        rr.device_waits,
+        rr.rounds
+    );
+    assert!(rr.submits >= rr.device_waits);
+    let stages = meshslim::rounds::schedule::STAGES
+        .iter()
+        .map(|l| l.len())
+        .sum::<usize>() as u64;
+    // Two halves, and the prefix sum's three stages over each scan it runs.
+    assert!(
+        rr.bind_groups_created <= 2 * (stages + 3 * 6),
+        "{} bind groups",
+        rr.bind_groups_created
+    );
+    assert!(
+        rr.dispatches > 10 * rr.bind_groups_created,
+        "{} dispatches",
+        rr.dispatches
+    );
+    let result = out.positions.len() * 16 + out.triangles.len() * 28;
+    assert!(
+        (rr.bytes_read_back as usize) < 2 * result + 64 * 1024,
+        "{} B back for a {result} B result",
+        rr.bytes_read_back
+    );
+    let input = m.positions.len() * 16 + m.triangles.len() * 12;
+    assert!(rr.bytes_uploaded as usize >= input);
+    assert!(rr.host_seconds > 0.0 && rr.pipeline_cache.is_some());
+}
+
+/// Rounds planned on the device are the rounds the host plans: batches of rounds (and their
+/// rounds past a stop, which dispatch nothing) give the bytes of one round per wait, with
+/// fewer waits, and the rounds cpu-parallel runs.
+#[test]
+fn batches_of_rounds_planned_on_the_device_change_no_byte() {
+    let Some((ctx, sim)) = meshslim::rounds::gpu::shared().ok() else {
+        gpu_context();
+        return;
+    };
+    let m = meshslim::mesh::noisy_sphere(4, 0.01, 3);
+    for ratio in [0.9, 0.5, 0.02] {
+        let opts = SimplifyOptions::with_ratio(m.triangles.len(), ratio).unwrap();
+        let up = Upload::pinned(&m, &opts.pin).attributes(&opts.attributes);
+        let go = |one_per_wait| {
+            let adapter = Some(ctx.adapter_name.clone());
+            let (out, r, _) = meshslim::rounds::gpu::run_rounds(
+                sim,
+                adapter,
+                &up,
+                &m,
+                &opts,
+                one_per_wait,
+                &mut |_| {},
+            )
+            .unwrap();
+            (out, r.rounds.unwrap())
+        };
+        let (batched, br) = go(false);
+        let (single, sr) = go(true);
+        assert_eq!(batched, single, "at {ratio}");
+        assert_eq!(br.faces_removed_per_round, sr.faces_removed_per_round);
+        assert!(br.device_waits < sr.device_waits, "at {ratio}");
+        let (_, cr) = run(&m, Backend::CpuParallel, ratio);
+        if rounds_like_the_cpu() {
+            assert_eq!(
+                br.faces_removed_per_round,
+                cr.rounds.unwrap().faces_removed_per_round
+            );
+        }
     }
 }
 

@@ -10,6 +10,10 @@
 
 @compute @workgroup_size(256)
 fn trim_mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    // A round planned on the device records the trim in every round; it acts only when asked.
+    if (params.trim == 0u) {
+        return;
+    }
     let e = gid.x + gid.y * nwg.x * WG;
     if (e >= params.edge_capacity) {
         return;

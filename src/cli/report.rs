@@ -235,6 +235,19 @@ fn write_rounds(out: &mut impl Write, rr: &crate::rounds::RoundsReport) -> std::
              submissions to their counters",
             rr.prepare_seconds, rr.wait_seconds
         )?;
+        writeln!(
+            out,
+            "device              {} waits, {} submits, {} dispatches, {} bind groups; {} B up, \
+             {} B back; host {:.3} s; pipeline cache {}",
+            rr.device_waits,
+            rr.submits,
+            rr.dispatches,
+            rr.bind_groups_created,
+            rr.bytes_uploaded,
+            rr.bytes_read_back,
+            rr.host_seconds,
+            rr.pipeline_cache.as_deref().unwrap_or("-")
+        )?;
     }
     let removed = &rr.faces_removed_per_round;
     writeln!(out, "rounds              {}", rr.rounds)?;

@@ -99,6 +99,7 @@ pub const SOURCES: &[Shader] = &[
     stage!("rounds/compact_faces", [COMMON]),
     stage!("rounds/dispatch_args", [COMMON]),
     stage!("rounds/draw_args", [COMMON]),
+    stage!("rounds/plan_round", [COMMON]),
     stage!("cluster/cell_keys", [COMMON, CLUSTER]),
     stage!("cluster/radix_count", [COMMON, CLUSTER]),
     stage!("cluster/radix_scatter", [COMMON, CLUSTER]),
@@ -287,6 +288,16 @@ mod tests {
             ("C_TENTATIVE", C::Tentative as u32),
             ("C_LIVE", C::Live as u32),
             ("COUNTERS", (std::mem::size_of::<Counters>() / 4) as u32),
+            ("GRID_VERTICES", grid_slot::VERTICES as u32),
+            ("GRID_FACES", grid_slot::FACES as u32),
+            ("GRID_EDGE_SLOTS", grid_slot::EDGE_SLOTS as u32),
+            (
+                "GRID_VERTICES_OR_FACES",
+                grid_slot::VERTICES_OR_FACES as u32,
+            ),
+            ("GRID_SCAN_VERTICES", grid_slot::SCAN_VERTICES as u32),
+            ("GRID_ONE", grid_slot::ONE as u32),
+            ("GRID_SLOTS", grid_slot::COUNT as u32),
         ];
         for (name, rust) in pairs {
             assert_eq!(value(name), rust, "const {name}: WGSL against Rust");
@@ -305,6 +316,8 @@ mod tests {
         assert_eq!(size("EdgeCandidate"), size_of::<EdgeCandidate>());
         assert_eq!(size("FaceExtra"), size_of::<FaceExtra>());
         assert_eq!(size("DrawArgs"), size_of::<DrawArgs>());
+        assert_eq!(size("PlanState"), size_of::<PlanState>());
+        assert_eq!(size("Planned"), size_of::<Planned>());
         let module = parse(
             "cluster_quadrics",
             &stage_source("cluster/cluster_quadrics").unwrap(),

@@ -143,6 +143,50 @@ pub struct Counters {
     pub _pad: [u32; 4],
 }
 
+/// What the rounds' planner (`plan_round`) keeps between the rounds of a batch: the mesh's
+/// counts after the last round it accepted, the target, whether the batch has stopped, and how
+/// many of its rounds ran. Keep in sync with `PlanState` in shaders/common.inc.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct PlanState {
+    pub vertices: u32,
+    pub faces: u32,
+    pub target_faces: u32,
+    /// 1 once a round removed nothing, grew the mesh or reached the target: every later pass
+    /// of the batch dispatches no workgroup.
+    pub stopped: u32,
+    /// Rounds of the batch that ran (the first always does).
+    pub executed: u32,
+    /// The device's workgroups per dimension: a grid past it is split over y.
+    pub max_groups: u32,
+    pub _pad: [u32; 2],
+}
+
+/// Slots of [`Planned::grids`]: the indirect grids of the stages a planned round runs over
+/// a count. Keep in sync with the `GRID_*` constants in shaders/common.inc.wgsl.
+pub mod grid_slot {
+    pub const VERTICES: usize = 0;
+    pub const FACES: usize = 1;
+    pub const EDGE_SLOTS: usize = 2;
+    pub const VERTICES_OR_FACES: usize = 3;
+    /// `SCAN_VERTICES + i`: a prefix sum's blocks over the count `i` (vertices, faces, slots).
+    pub const SCAN_VERTICES: usize = 4;
+    pub const ONE: usize = 7;
+    pub const COUNT: usize = 8;
+}
+
+/// The next round as `plan_round` writes it: its parameters and prefix-sum counts (copied into
+/// the uniforms the stages bind) and its indirect grids ([`grid_slot`]; all zero once the batch
+/// has stopped). Keep in sync with `Planned` in shaders/common.inc.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct Planned {
+    pub params: Params,
+    /// Prefix sums over the vertices, the faces and the edge slots.
+    pub scans: [ScanParams; 3],
+    pub grids: [[u32; 4]; grid_slot::COUNT],
+}
+
 /// A vertex's quadric in f32, relative to the vertex's own position: `E(y) = yᵀAy + 2bᵀy + c`
 /// with `y = x - position`. Keeping the origin at the vertex keeps `c` and `b` small, so f32
 /// does not lose the tiny errors of a million-triangle scan to cancellation.

@@ -22,6 +22,7 @@ use crate::mesh::Mesh;
 use crate::mesh::prepare::Surface;
 pub use crate::options::{RoundsReport, StageTimes};
 use crate::options::{SimplifyOptions, SimplifyReport, StopReason};
+use cpu::plan_round;
 
 /// Selection passes per round. One pass removes ~5% of the faces per round, three ~15%
 /// (ARCHITECTURE.md's prototype); more passes add little once most candidates are blocked.
@@ -38,6 +39,11 @@ pub const CEILING_MIN_SHARE: f64 = 0.25;
 pub const TRIM_SHARE: f64 = 0.4;
 /// Safety net: a run that has not converged after this many rounds stops.
 pub const MAX_ROUNDS: usize = 400;
+/// Rounds a batch runs between two waits for the host, each planned on the device from the last
+/// one's counters (`plan_round`): the 1M scan to 1% takes about 30 rounds, so four or five
+/// waits; rounds past a batch's stop dispatch nothing, so a longer batch costs only their
+/// empty passes.
+pub const BATCH_ROUNDS: usize = 8;
 
 /// How many selection passes a round runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -58,6 +64,25 @@ pub trait RoundRunner {
     /// Runs one round with `params` (the first also computes face planes, flags and quadrics)
     /// and returns its counters.
     fn round(&mut self, params: &Params, first: bool, selection: Selection) -> Result<Counters>;
+    /// Ordinary rounds from `params` on, at most `most`, each after the first planned by the
+    /// runner from the last one's counters (`cpu::plan_round`) until one removes nothing, grows
+    /// the mesh or reaches the target: each round's parameters and counters, in order.
+    fn rounds(
+        &mut self,
+        params: &Params,
+        first: bool,
+        most: usize,
+    ) -> Result<Vec<(Params, Counters)>> {
+        let _ = most;
+        Ok(vec![(
+            *params,
+            self.round(params, first, Selection::Ordinary)?,
+        )])
+    }
+    /// How many rounds [`RoundRunner::rounds`] runs at most between two looks of the driver.
+    fn batch(&self) -> usize {
+        1
+    }
     /// The current mesh, read back; the rounds can go on afterwards.
     fn download(&mut self) -> Result<Download>;
     fn stage_times(&self) -> &StageTimes;
@@ -124,6 +149,7 @@ pub struct Download {
     pub flags: Vec<u32>,
     pub vertex_attr: Vec<u32>,
     pub indices: Vec<u32>,
+    /// Per face; empty when the output needs none ([`Upload::output_needs_face_extra`]).
     pub face_extra: Vec<FaceExtra>,
     /// Per attribute vertex: the weighted appearance values (empty without).
     pub attr_values: Vec<f32>,
@@ -305,6 +331,13 @@ impl Upload {
         self.face_extra.len()
     }
 
+    /// Whether the output needs the faces' extras read back: a seam corner's attribute vertex,
+    /// or the input face a face came from for its material or group. Without either, a
+    /// download may leave [`Download::face_extra`] empty.
+    pub fn output_needs_face_extra(&self) -> bool {
+        self.seams > 0 || self.welded.face_materials.is_some() || self.welded.face_groups.is_some()
+    }
+
     /// The round parameters common to every round.
     pub fn base_params(&self, opts: &SimplifyOptions) -> Params {
         let (attributes, color_weight) = self.attrs.as_ref().map_or((0, 0.0), |a| a.params());
@@ -339,7 +372,7 @@ impl Upload {
                 out.positions[d.vertex_attr[v] as usize] = q;
             }
         }
-        let nf = d.face_extra.len();
+        let nf = d.indices.len() / 3;
         let attrs = corner_attributes(&d.flags, &d.vertex_attr, &d.indices, &d.face_extra);
         out.triangles = attrs.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
         let origin = |f: usize| d.face_extra[f].origin as usize;
@@ -432,6 +465,8 @@ impl Driver {
         let (mut nv, mut nf) = (self.vertices as u32, self.faces as u32);
         let from = nf;
         let start = nf.saturating_sub(target).max(1) as f32;
+        // Rounds a runner ran ahead in its last batch, not yet looked at.
+        let mut ahead = std::collections::VecDeque::new();
         let reason = loop {
             // Trimming lands a round on the target or one below it (an interior collapse
             // removes two faces), never above: the target is reached only when it is met.
@@ -441,31 +476,37 @@ impl Driver {
             if self.removed.len() >= MAX_ROUNDS {
                 break StopReason::NoValidCollapse;
             }
-            self.cancel.check()?;
-            let needed = nf - target;
-            let mut params = Params {
-                vertex_count: nv,
-                face_count: nf,
-                target_faces: target,
-                edge_capacity: 3 * nf,
-                needed_faces: needed,
-                ceiling_wanted: needed
-                    .div_ceil(2)
-                    .saturating_mul(CEILING_FACTOR)
-                    .max((nf as f64 * CEILING_MIN_SHARE) as u32)
-                    .max(1),
-                trim: ((needed as f64) < TRIM_SHARE * nf as f64) as u32,
-                ..self.base
+            let mut params = plan_round::next_params(&self.base, nv, nf, target);
+            let mut c = match ahead.pop_front() {
+                Some((planned, c)) => {
+                    // The runner planned this round itself: it must be the round planned here.
+                    if planned != params {
+                        return Err(crate::error::Error::Internal(format!(
+                            "round {}: the runner planned {planned:?}, the driver {params:?}",
+                            self.removed.len() + 1
+                        )));
+                    }
+                    c
+                }
+                None => {
+                    self.cancel.check()?;
+                    let most = runner.batch().clamp(1, MAX_ROUNDS - self.removed.len());
+                    let mut batch = runner.rounds(&params, self.first, most)?.into_iter();
+                    self.first = false;
+                    let (_, c) = batch.next().ok_or_else(|| {
+                        crate::error::Error::Internal("a batch of rounds ran none".into())
+                    })?;
+                    ahead.extend(batch);
+                    c
+                }
             };
-            let mut c = runner.round(&params, self.first, Selection::Ordinary)?;
-            self.first = false;
             if c.faces_out == nf {
                 // The ceiling is picked from the edges' errors, lower bounds of their priorities
                 // that know nothing of flips, and the passes may all have gone to candidates
                 // that failed validation: valid edges may wait above the ceiling or behind
                 // them. Let every edge compete, through as many passes as it takes, before
                 // concluding that none can go (the round changed nothing, so it runs again on
-                // the same mesh).
+                // the same mesh). A batch stops at such a round, so none ran after it.
                 params.ceiling_wanted = u32::MAX;
                 c = runner.round(&params, false, Selection::Exhaustive)?;
             }
@@ -494,6 +535,12 @@ impl Driver {
             self.faces = nf as usize;
             progress((from - nf) as f32 / start);
         };
+        if !ahead.is_empty() {
+            return Err(crate::error::Error::Internal(format!(
+                "the rounds stopped ({reason:?}) with {} rounds of a batch after the stop",
+                ahead.len()
+            )));
+        }
         Ok(reason)
     }
 

@@ -61,10 +61,15 @@ pub enum Buf {
     AttrValues,
     /// Per attribute vertex: its attribute sums `G`, `D`, `W` relative to its vertex.
     AttrSums,
+    /// The planner's state between the rounds of a batch ([`crate::compute::types::PlanState`]).
+    Plan,
+    /// The next round as the planner wrote it ([`crate::compute::types::Planned`]): copied
+    /// into `Params` and the scans' counts, and the indirect grids of a planned round.
+    Planned,
 }
 
 /// A count a prefix sum runs over.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Count {
     Vertices,
     Faces,
@@ -93,6 +98,8 @@ pub enum Grid {
     ScanBlocks,
     /// A single workgroup.
     One,
+    /// A single workgroup in every round, also past a batch's stop: the planner's.
+    Planner,
     /// From the `dispatch` buffer `dispatch_args` writes: one per edge...
     PerEdge,
     /// ...one per tentative winner of the selection pass...
@@ -217,6 +224,9 @@ pub static COMPACT_FACES: Stage = crate::stage!(Buf; compact_faces in "rounds/co
     face_extra: Read FaceExtra, remap: Read Remap, vertex_keep: Read VertexKeep,
     face_keep: Read FaceKeep, indices_out: ReadWrite IndicesOut,
     face_normals_out: ReadWrite FaceNormalsOut, face_extra_out: ReadWrite FaceExtraOut);
+pub static PLAN_ROUND: Stage = crate::stage!(Buf; plan_round in "rounds/plan_round" over Grid::Planner;
+    params: Uniform Params, counters: Read Counters, plan: ReadWrite Plan,
+    planned: ReadWrite Planned, dispatch: ReadWrite Dispatch);
 pub static DRAW_ARGS: Stage = crate::stage!(Buf; draw_args in "rounds/draw_args" over One;
     params: Uniform Params, vertex_keep: Read VertexKeep, face_keep: Read FaceKeep,
     counters: ReadWrite Counters, draw: ReadWrite DrawArgs);
@@ -249,6 +259,7 @@ const OWN_STAGES: &[&Stage] = &[
     &COMPACT_VERTICES,
     &COMPACT_FACES,
     &DRAW_ARGS,
+    &PLAN_ROUND,
 ];
 
 /// The rounds' own steps, beside the core's ([`crate::compute::schedule::Step`]).
@@ -259,6 +270,9 @@ pub enum RoundStep {
     /// The CPU twin's check that no two winners reach one face, before `collapse` writes through
     /// unsynchronised slices on that promise (`cpu::select::shared_face`); nothing on the GPU.
     CheckWinners,
+    /// The planner's round into the uniforms the stages bind: `Planned::params` into `Params`,
+    /// its scan counts into the prefix sums'.
+    ApplyPlan,
 }
 
 /// One step of a round.
@@ -279,12 +293,19 @@ pub enum When {
     FirstRoundAttributes,
     /// Repeated as the round's [`crate::rounds::Selection`] says.
     EachSelectionPass,
-    /// When the round trims its winners to land on the target (`Params::trim`).
+    /// When the round trims its winners to land on the target (`Params::trim`); in a round
+    /// planned on the device, always (the trim stages do nothing unless it trims).
     Trimming,
+    /// Before a round the device planned from the last one's counters: not the first of its
+    /// batch. The CPU twin plans between rounds on the host ([`crate::rounds::cpu::CpuRounds`]
+    /// runs `plan_round` there).
+    Planned,
 }
 
 use crate::compute::schedule::Step::{Clear, Own, PrefixSum, Run};
 
+/// The round planned from the last one's counters (before they are cleared).
+pub const PLAN: &[Step] = &[Run(&PLAN_ROUND), Own(RoundStep::ApplyPlan)];
 /// The first round's set-up.
 pub const SETUP: &[Step] = &[Run(&VERTEX_FLAGS)];
 /// The input's face planes and vertex quadrics.
@@ -352,7 +373,8 @@ pub const APPLY: &[Step] = &[
 
 impl When {
     /// Whether a part runs once in the round of `p`: the `first` round, quadrics `carried` in.
-    /// [`When::EachSelectionPass`] is the runner's to repeat, and says no here.
+    /// [`When::EachSelectionPass`] is the runner's to repeat and [`When::Planned`] the
+    /// runner's to record in a batch; both say no here.
     pub fn runs_once(self, first: bool, carried: bool, p: &Params) -> bool {
         match self {
             When::Always => true,
@@ -360,13 +382,14 @@ impl When {
             When::FirstRoundQuadrics => first && !carried,
             When::FirstRoundAttributes => first && p.attributes != 0,
             When::Trimming => p.trim != 0,
-            When::EachSelectionPass => false,
+            When::EachSelectionPass | When::Planned => false,
         }
     }
 }
 
 /// A round, in order (after the counters are zeroed); the halves swap after it.
 pub const ROUND: &[(When, &[Step])] = &[
+    (When::Planned, PLAN),
     (When::Always, ADJACENCY),
     (When::FirstRound, SETUP),
     (When::FirstRoundQuadrics, SETUP_QUADRICS),

@@ -18,6 +18,7 @@ pub mod edge_errors;
 pub mod edges;
 pub mod face_planes;
 pub mod live_list;
+pub mod plan_round;
 pub mod prefix_sum;
 pub mod select;
 pub mod trim;
@@ -199,6 +200,9 @@ pub struct CpuRounds {
     pub attr_sums: Vec<f32>,
     /// The indirect grids `dispatch_args` computes (three `(x, y, z, _)`), as the GPU's.
     pub dispatch: [u32; 12],
+    /// The planner's state and its next round, between the rounds of a batch.
+    pub plan: PlanState,
+    pub planned: Planned,
     out_positions: Vec<[f32; 4]>,
     out_quadrics: Vec<Quadric>,
     out_flags: Vec<u32>,
@@ -276,6 +280,9 @@ impl CpuRounds {
                     self.times.add("prefix_sum", t.elapsed().as_secs_f64());
                 }
                 S::Own(RoundStep::CheckWinners) => self.check_winners(p)?,
+                // The next round's parameters go by value (`rounds` takes them from
+                // `planned`); there are no uniforms to copy into.
+                S::Own(RoundStep::ApplyPlan) => {}
                 S::CopyBuffer(from, _) => return Err(no_twin("copying", from)),
             }
         }
@@ -442,6 +449,38 @@ impl RoundRunner for CpuRounds {
         Ok(*bytemuck::from_bytes::<Counters>(bytemuck::cast_slice(
             &self.counters,
         )))
+    }
+
+    /// Up to `most` rounds as the GPU runs a batch: after each, `plan_round` plans the next
+    /// from its counters; the rounds the GPU would run past the batch's stop change nothing
+    /// there, and are not run here.
+    fn rounds(&mut self, p: &Params, first: bool, most: usize) -> Result<Vec<(Params, Counters)>> {
+        self.plan = PlanState {
+            vertices: p.vertex_count,
+            faces: p.face_count,
+            target_faces: p.target_faces,
+            executed: 1,
+            max_groups: u16::MAX as u32,
+            ..Default::default()
+        };
+        let (mut p, mut first, mut out) = (*p, first, Vec::new());
+        loop {
+            let c = self.round(&p, first, Selection::Ordinary)?;
+            first = false;
+            out.push((p, c));
+            if out.len() >= most {
+                return Ok(out);
+            }
+            self.run_steps(&p, schedule::PLAN)?;
+            if self.plan.stopped != 0 {
+                return Ok(out);
+            }
+            p = self.planned.params;
+        }
+    }
+
+    fn batch(&self) -> usize {
+        crate::rounds::BATCH_ROUNDS
     }
 
     fn download(&mut self) -> Result<Download> {

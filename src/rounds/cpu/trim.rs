@@ -4,6 +4,8 @@
 //! winner kept may take two where one was left), never above, as the greedy reference does. Bins
 //! of the winners' costs find the bin where the budget runs out; within that bin, winners are
 //! taken in edge-id order (a prefix sum of the faces they remove) while the budget is not met.
+//! Each stage does nothing in a round that does not trim (`Params::trim` 0): a round planned on
+//! the device records them in every round.
 
 use super::edge_costs::{CounterField, counter};
 use super::{par_for, par_for_mut};
@@ -18,6 +20,9 @@ pub fn trim_histogram(
     edge_offsets: &[u32], // per vertex + 1: the edge count at [vertex_count]
     histogram: &[AtomicU32],
 ) {
+    if params.trim == 0 {
+        return;
+    }
     let edge_count = edge_offsets[params.vertex_count as usize];
     par_for(edge_count, |e| {
         if edge_state[e as usize] == state::WON {
@@ -30,6 +35,9 @@ pub fn trim_histogram(
 /// One invocation: the bin where the winners' removals reach `needed_faces`, and what is left of
 /// the budget in it (at least 1); `HIST_BINS` (nothing trimmed) when all winners fit.
 pub fn trim_ceiling(params: &Params, histogram: &[u32], counters: &[AtomicU32]) {
+    if params.trim == 0 {
+        return;
+    }
     let budget = params.needed_faces;
     let (mut bin_out, mut left) = (HIST_BINS, 0);
     if counter(counters, CounterField::Removed).load(Relaxed) > budget {
@@ -58,6 +66,9 @@ pub fn trim_mark(
     counters: &[AtomicU32],
     marks: &mut [u32],
 ) {
+    if params.trim == 0 {
+        return;
+    }
     let edge_count = edge_offsets[params.vertex_count as usize];
     let trim_bin = counter(counters, CounterField::TrimBin).load(Relaxed);
     par_for_mut(&mut marks[..params.edge_capacity as usize], |e, m| {
@@ -83,6 +94,9 @@ pub fn trim_apply(
     edge_offsets: &[u32], // per vertex + 1: the edge count at [vertex_count]
     edge_state: &mut [u32],
 ) {
+    if params.trim == 0 {
+        return;
+    }
     let edge_count = edge_offsets[params.vertex_count as usize];
     let trim_bin = counter(counters, CounterField::TrimBin).load(Relaxed);
     let budget = counter(counters, CounterField::TrimBudget).load(Relaxed);

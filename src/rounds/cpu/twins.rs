@@ -318,6 +318,10 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         );
         s.draw = draw;
     }),
+    (&schedule::PLAN_ROUND, |s, p| {
+        let c: Counters = *bytemuck::from_bytes(bytemuck::cast_slice(&s.counters));
+        plan_round::plan_round(p, &c, &mut s.plan, &mut s.planned, &mut s.dispatch)
+    }),
 ];
 
 #[cfg(test)]

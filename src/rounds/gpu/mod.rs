@@ -60,6 +60,8 @@ pub fn simplify_with(
     let (out, mut rep) = simplify_upload(ctx, sim, &up, mesh, opts, progress)?;
     if let Some(r) = rep.rounds.as_mut() {
         r.prepare_seconds = prepare;
+        // Preparing is the host's own work, before the rounds' call.
+        r.host_seconds += prepare;
     }
     Ok((out, rep))
 }
@@ -90,18 +92,21 @@ pub fn run_rounds<'a>(
     share_queue: bool,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport, GpuRounds<'a>)> {
+    let t = std::time::Instant::now();
     let mut rounds = GpuRounds::new(sim, up, SELECTION_PASSES)?;
     rounds.share_queue = share_queue;
     let report = RoundsReport {
         adapter,
         gpu_timestamps: sim.has_timestamps(),
         pipeline_seconds: sim.pipeline_seconds,
+        pipeline_cache: Some(sim.pipeline_cache.to_string()),
         ..Default::default()
     };
     let (out, mut rep) = simplify_rounds(&mut rounds, up, mesh, opts, progress, report)?;
     if let Some(r) = rep.rounds.as_mut() {
         r.transfer_seconds = rounds.transfer_seconds;
         r.wait_seconds = rounds.wait_seconds;
+        rounds.costs.report(r, t.elapsed().as_secs_f64());
     }
     Ok((out, rep, rounds))
 }

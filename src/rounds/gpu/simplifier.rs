@@ -8,14 +8,19 @@ use crate::compute::types::*;
 use crate::error::{Error, Result};
 use crate::rounds::schedule::{self, Buf, Count, RoundStep, Stage, Step, When};
 use crate::rounds::{Download, RoundRunner, Selection, StageTimes, Upload};
+use std::collections::HashMap;
 use std::time::Instant;
+
+mod batch;
+pub use batch::Costs;
 
 const SU: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
     .union(wgpu::BufferUsages::COPY_DST)
     .union(wgpu::BufferUsages::COPY_SRC);
 
-/// Timestamp slots per round: two per compute pass.
-const QUERY_CAP: u32 = 512;
+/// Timestamp slots per submission (a round, or a batch of them): two per compute pass, up to
+/// the 4096 queries a WebGPU query set may hold.
+const QUERY_CAP: u32 = 4096;
 
 /// Selection passes recorded between two read-backs in an exhaustive round: a pass with nothing
 /// left to select costs a few empty dispatches, a read-back a round trip.
@@ -26,6 +31,9 @@ const COUNTERS_BYTES: u64 = std::mem::size_of::<Counters>() as u64;
 /// `Counters::tentative`, cleared before each selection pass.
 const TENTATIVE_OFFSET: u64 = std::mem::offset_of!(Counters, tentative) as u64;
 
+/// A bind group's key: the stage, the half that is current, and the prefix sum's (count, data).
+type BindKey = (&'static str, usize, Option<(Count, Buf)>);
+
 /// Compute pipelines of every stage, made once for a device and reused for every mesh.
 pub struct GpuSimplifier {
     device: wgpu::Device,
@@ -33,6 +41,9 @@ pub struct GpuSimplifier {
     kernels: Kernels,
     /// Seconds spent compiling shaders and creating pipelines.
     pub pipeline_seconds: f64,
+    /// How they were found: `hit`, `miss` or `unsupported` ([`crate::compute::disk_cache`]),
+    /// or `shared` when another family on the device had made them all.
+    pub pipeline_cache: &'static str,
     timestamps: bool,
 }
 
@@ -47,8 +58,16 @@ impl GpuSimplifier {
     /// made yet.
     pub fn on(cache: &Pipelines, queue: &wgpu::Queue) -> Result<GpuSimplifier> {
         let device = cache.device();
+        let before = cache.compiled().len();
         let kernels = Kernels::new(cache, schedule::STAGES, "the simplifier")?;
+        let pipeline_cache = match cache.cache_status() {
+            _ if cache.compiled().len() == before => "shared",
+            crate::compute::disk_cache::CacheStatus::Hit => "hit",
+            crate::compute::disk_cache::CacheStatus::Miss => "miss",
+            crate::compute::disk_cache::CacheStatus::Unsupported => "unsupported",
+        };
         Ok(GpuSimplifier {
+            pipeline_cache,
             device: device.clone(),
             queue: queue.clone(),
             pipeline_seconds: kernels.seconds,
@@ -175,6 +194,19 @@ pub struct GpuRounds<'a> {
     neighbours: wgpu::Buffer,
     block_sums: wgpu::Buffer,
     counters: wgpu::Buffer,
+    /// The planner's state and its next round (`plan_round`), between the rounds of a batch.
+    plan: wgpu::Buffer,
+    planned: wgpu::Buffer,
+    /// Recording a round the device planned: grids from `planned`.
+    planned_round: bool,
+    /// Every bind group made so far: the buffers never change, so each stage binds each
+    /// half's once.
+    bind_groups: HashMap<BindKey, wgpu::BindGroup>,
+    /// What the simplification cost on the device's side.
+    pub costs: Costs,
+    /// The output needs the faces' extras ([`Upload::output_needs_face_extra`]): the download
+    /// reads them back.
+    face_extra_out: bool,
     /// Per attribute vertex: weighted appearance values and attribute sums (a word each when
     /// the rounds carry none: bound, never read).
     attr_values: wgpu::Buffer,
@@ -218,7 +250,9 @@ impl<'a> GpuRounds<'a> {
         let mk = |label: &str, size: u64, usage: wgpu::BufferUsages| {
             checked_buffer(dev, &format!("meshslim.{label}"), size, usage)
         };
+        let uploaded = std::cell::Cell::new(0u64);
         let init = |label: &str, data: &[u8], usage: wgpu::BufferUsages| {
+            uploaded.set(uploaded.get() + data.len() as u64);
             checked_buffer_init(dev, &format!("meshslim.{label}"), data, data.len(), usage)
         };
         let mesh_usage = MESH_USAGE;
@@ -278,7 +312,11 @@ impl<'a> GpuRounds<'a> {
                 std::mem::size_of::<DrawArgs>() as u64,
                 DRAW_ARGS_USAGE,
             )?,
-            params: mk("params", std::mem::size_of::<Params>() as u64, uniform)?,
+            params: mk(
+                "params",
+                std::mem::size_of::<Params>() as u64,
+                uniform | wgpu::BufferUsages::COPY_SRC,
+            )?,
             scan_v: mk("scan_v", 16, uniform)?,
             scan_f: mk("scan_f", 16, uniform)?,
             scan_e: mk("scan_e", 16, uniform)?,
@@ -308,6 +346,20 @@ impl<'a> GpuRounds<'a> {
             neighbours: mk("neighbours", nf * 24, SU)?,
             block_sums: mk("block_sums", blocks * 4, SU)?,
             counters: mk("counters", COUNTERS_BYTES, SU)?,
+            plan: mk(
+                "plan",
+                std::mem::size_of::<crate::compute::types::PlanState>() as u64,
+                SU,
+            )?,
+            planned: mk(
+                "planned",
+                std::mem::size_of::<crate::compute::types::Planned>() as u64,
+                SU | wgpu::BufferUsages::INDIRECT,
+            )?,
+            planned_round: false,
+            bind_groups: HashMap::new(),
+            costs: Costs::default(),
+            face_extra_out: up.output_needs_face_extra(),
             attr_values: match &up.attrs {
                 Some(a) => init("attr_values", bytemuck::cast_slice(&a.values), SU)?,
                 None => mk("attr_values", 4, SU)?,
@@ -316,7 +368,7 @@ impl<'a> GpuRounds<'a> {
             attr_len: up.attrs.as_ref().map_or(0, |a| a.values.len() as u64),
             readback: mk(
                 "readback",
-                COUNTERS_BYTES + QUERY_CAP as u64 * 8,
+                batch::READBACK_BYTES,
                 wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             )?,
             queries,
@@ -335,8 +387,8 @@ impl<'a> GpuRounds<'a> {
             instance_count: 1,
             ..Default::default()
         };
-        sim.queue
-            .write_buffer(&r.draw_args, 0, bytemuck::bytes_of(&args));
+        Costs::add(&r.costs.uploaded, uploaded.get());
+        r.write(&r.draw_args, 0, bytemuck::bytes_of(&args));
         scope.check("uploading the mesh")?;
         let mut r = r;
         r.transfer_seconds += t.elapsed().as_secs_f64();
@@ -373,7 +425,7 @@ impl<'a> GpuRounds<'a> {
                 0,
                 h.indices.size().min(h0.indices.size()),
             );
-            self.sim.queue.submit([enc.finish()]);
+            self.submit(enc);
             (h0.positions.clone(), h0.indices.clone())
         };
         scope.check("keeping the result on the device")?;
@@ -416,7 +468,7 @@ impl<'a> GpuRounds<'a> {
             0,
             std::mem::size_of::<DrawArgs>() as u64,
         );
-        self.sim.queue.submit([enc.finish()]);
+        self.submit(enc);
         scope.check("copying a level of detail")?;
         Ok(mesh)
     }
@@ -443,8 +495,8 @@ impl<'a> GpuRounds<'a> {
         });
         let mut enc = dev.create_command_encoder(&Default::default());
         enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
-        self.sim.queue.submit([enc.finish()]);
-        if let Err(e) = map_wait(dev, &staging) {
+        self.submit(enc);
+        if let Err(e) = self.map_wait(&staging) {
             return scope.check_with("reading back", Err(e));
         }
         let data = staging
@@ -453,136 +505,8 @@ impl<'a> GpuRounds<'a> {
             .to_vec();
         staging.unmap();
         scope.check("reading back")?;
+        Costs::add(&self.costs.read_back, bytes);
         Ok(data)
-    }
-}
-
-/// Maps `buf` for reading and waits for it.
-fn map_wait(dev: &wgpu::Device, buf: &wgpu::Buffer) -> Result<()> {
-    let (tx, rx) = std::sync::mpsc::channel();
-    buf.map_async(wgpu::MapMode::Read, .., move |r| {
-        let _ = tx.send(r);
-    });
-    dev.poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| Error::Gpu(format!("waiting for the device: {e}")))?;
-    rx.recv()
-        .map_err(|_| Error::Gpu("the device dropped a read-back".into()))?
-        .map_err(|e| Error::Gpu(format!("mapping a read-back buffer: {e}")))
-}
-
-impl RoundRunner for GpuRounds<'_> {
-    fn round(&mut self, p: &Params, first: bool, selection: Selection) -> Result<Counters> {
-        let sim = self.sim;
-        let (q, dev) = (&sim.queue, &sim.device);
-        let scope = ErrorScope::push(dev);
-        q.write_buffer(&self.params, 0, bytemuck::bytes_of(p));
-        let sp = |n: u32| ScanParams { n, _pad: [0; 3] };
-        q.write_buffer(&self.scan_v, 0, bytemuck::bytes_of(&sp(p.vertex_count)));
-        q.write_buffer(&self.scan_f, 0, bytemuck::bytes_of(&sp(p.face_count)));
-        q.write_buffer(&self.scan_e, 0, bytemuck::bytes_of(&sp(p.edge_capacity)));
-        self.query_stages.clear();
-        let mut enc = dev.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("meshslim.round"),
-        });
-        enc.clear_buffer(&self.counters, 0, None);
-        for &(when, steps) in schedule::ROUND {
-            match when {
-                When::EachSelectionPass => {
-                    for pass in 0u32.. {
-                        match selection {
-                            Selection::Ordinary if pass == self.selection_passes => break,
-                            // Exhaustive: every EXHAUSTIVE_CHUNK passes, submit what is
-                            // recorded and read the last pass's tentative count; none means
-                            // no candidate is left to settle.
-                            Selection::Exhaustive if pass > 0 && pass % EXHAUSTIVE_CHUNK == 0 => {
-                                let done = std::mem::replace(
-                                    &mut enc,
-                                    dev.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                                        label: Some("meshslim.round"),
-                                    }),
-                                );
-                                q.submit([done.finish()]);
-                                let now: Counters = *bytemuck::from_bytes(
-                                    &self.read(&self.counters, COUNTERS_BYTES)?,
-                                );
-                                if now.tentative == 0 {
-                                    break;
-                                }
-                            }
-                            _ => {}
-                        }
-                        self.record(&mut enc, p, steps);
-                    }
-                }
-                w if w.runs_once(first, self.carried_quadrics, p) => {
-                    self.record(&mut enc, p, steps)
-                }
-                _ => {}
-            }
-        }
-        let (o, counters) = (1 - self.cur, self.counters.clone());
-        enc.copy_buffer_to_buffer(&counters, 0, &self.readback, 0, COUNTERS_BYTES);
-        let used = self.query_stages.len() as u32 * 2;
-        if let Some((set, resolve)) = &self.queries
-            && used > 0
-        {
-            enc.resolve_query_set(set, 0..used, resolve, 0);
-            enc.copy_buffer_to_buffer(resolve, 0, &self.readback, COUNTERS_BYTES, used as u64 * 8);
-        }
-        let t = Instant::now();
-        q.submit([enc.finish()]);
-        if let Err(e) = map_wait(dev, &self.readback) {
-            return scope.check_with("running a round", Err(e));
-        }
-        let wall = t.elapsed().as_secs_f64();
-        self.wait_seconds += wall;
-        let (counters_out, stamps) = {
-            let view = self
-                .readback
-                .get_mapped_range(..)
-                .map_err(|e| Error::Gpu(format!("reading the round counters: {e}")))?;
-            let n = COUNTERS_BYTES as usize;
-            let c: Counters = *bytemuck::from_bytes(&view[..n]);
-            let stamps: Vec<u64> =
-                bytemuck::cast_slice::<u8, u64>(&view[n..n + used as usize * 8]).to_vec();
-            (c, stamps)
-        };
-        self.readback.unmap();
-        scope.check("running a round")?;
-        if self.queries.is_some() && !stamps.is_empty() {
-            let period = q.get_timestamp_period() as f64 * 1e-9;
-            for (i, stage) in self.query_stages.iter().enumerate() {
-                let d = stamps[2 * i + 1].saturating_sub(stamps[2 * i]);
-                self.times.add(stage, d as f64 * period);
-            }
-        } else {
-            self.times.add("round (wall, no timestamps)", wall);
-        }
-        self.cur = o;
-        self.live_counts = (counters_out.vertices_out, counters_out.faces_out);
-        Ok(counters_out)
-    }
-
-    fn download(&mut self) -> Result<Download> {
-        let t = Instant::now();
-        let (nv, nf) = (self.live_counts.0 as u64, self.live_counts.1 as u64);
-        let h = &self.half[self.cur];
-        let d = Download {
-            positions: bytemuck::pod_collect_to_vec(&self.read(&h.positions, nv * 16)?),
-            flags: bytemuck::pod_collect_to_vec(&self.read(&h.flags, nv * 4)?),
-            vertex_attr: bytemuck::pod_collect_to_vec(&self.read(&h.vertex_attr, nv * 4)?),
-            indices: bytemuck::pod_collect_to_vec(&self.read(&h.indices, nf * 12)?),
-            face_extra: bytemuck::pod_collect_to_vec(&self.read(&h.face_extra, nf * 16)?),
-            attr_values: bytemuck::pod_collect_to_vec(
-                &self.read(&self.attr_values, self.attr_len * 4)?,
-            ),
-        };
-        self.transfer_seconds += t.elapsed().as_secs_f64();
-        Ok(d)
-    }
-
-    fn stage_times(&self) -> &StageTimes {
-        &self.times
     }
 }
 
@@ -641,6 +565,8 @@ impl Runner<Buf, schedule::Grid, Count, RoundStep> for GpuRounds<'_> {
             Buf::DrawArgs => &self.draw_args,
             Buf::AttrValues => &self.attr_values,
             Buf::AttrSums => &self.attr_sums,
+            Buf::Plan => &self.plan,
+            Buf::Planned => &self.planned,
         }
     }
 
@@ -653,15 +579,27 @@ impl Runner<Buf, schedule::Grid, Count, RoundStep> for GpuRounds<'_> {
     ) {
         let p = &self.round_params;
         let wg = |n: u32| Groups::Direct(n.div_ceil(WG));
-        let groups = match stage.grid {
-            schedule::Grid::Each(count) => wg(count.of(p)),
-            schedule::Grid::VerticesOrFaces => wg(p.vertex_count.max(p.face_count)),
-            schedule::Grid::ScanBlocks => {
-                let n = scan.map_or(p.vertex_count, |(count, _)| count.of(p));
-                Groups::Direct(n.div_ceil(SCAN_BLOCK))
+        let planned = match stage.grid {
+            _ if !self.planned_round => None,
+            grid => Self::planned_grid(grid, scan.map(|s| s.0)),
+        };
+        let (groups, args) = match (planned, stage.grid) {
+            (Some(at), _) => (Groups::Indirect(at), &self.planned),
+            (None, schedule::Grid::Each(count)) => (wg(count.of(p)), &self.dispatch),
+            (None, schedule::Grid::VerticesOrFaces) => {
+                (wg(p.vertex_count.max(p.face_count)), &self.dispatch)
             }
-            schedule::Grid::One => Groups::Direct(1),
-            indirect => Groups::Indirect(indirect.indirect_offset().unwrap_or(0)),
+            (None, schedule::Grid::ScanBlocks) => {
+                let n = scan.map_or(p.vertex_count, |(count, _)| count.of(p));
+                (Groups::Direct(n.div_ceil(SCAN_BLOCK)), &self.dispatch)
+            }
+            (None, schedule::Grid::One | schedule::Grid::Planner) => {
+                (Groups::Direct(1), &self.dispatch)
+            }
+            (None, indirect) => (
+                Groups::Indirect(indirect.indirect_offset().unwrap_or(0)),
+                &self.dispatch,
+            ),
         };
         let qi = self.query_stages.len() as u32 * 2;
         let timestamps = match &self.queries {
@@ -675,15 +613,20 @@ impl Runner<Buf, schedule::Grid, Count, RoundStep> for GpuRounds<'_> {
             }
             _ => None,
         };
-        self.sim.kernels.pass(
-            &self.sim.device,
-            enc,
-            stage,
-            |b| self.buffer(b, scan),
-            groups,
-            Some(&self.dispatch),
-            timestamps,
-        );
+        let key: BindKey = (stage.entry, self.cur, scan);
+        if !self.bind_groups.contains_key(&key) {
+            let bg = self
+                .sim
+                .kernels
+                .bind_group(&self.sim.device, stage, |b| self.buffer(b, scan));
+            Costs::add(&self.costs.bind_groups, 1);
+            self.bind_groups.insert(key, bg);
+        }
+        let bg = &self.bind_groups[&key];
+        self.sim
+            .kernels
+            .pass_bound(enc, stage, bg, groups, Some(args), timestamps);
+        Costs::add(&self.costs.dispatches, 1);
         if self.share_queue {
             // Submit this pass alone and wait for it, so that work others put on the queue
             // meanwhile (the viewer's frames) runs between passes instead of after the round.
@@ -695,12 +638,15 @@ impl Runner<Buf, schedule::Grid, Count, RoundStep> for GpuRounds<'_> {
                         label: Some("meshslim.round"),
                     }),
             );
-            let index = self.sim.queue.submit([done.finish()]);
+            let index = self.submit(done);
             // A failed wait shows up at the round's own wait, which reports it.
+            let t = Instant::now();
             let _ = self.sim.device.poll(wgpu::PollType::Wait {
                 submission_index: Some(index),
                 timeout: None,
             });
+            Costs::add(&self.costs.waits, 1);
+            Costs::add(&self.costs.blocked_ns, t.elapsed().as_nanos() as u64);
         }
     }
 
@@ -712,6 +658,7 @@ impl Runner<Buf, schedule::Grid, Count, RoundStep> for GpuRounds<'_> {
             // The GPU's winners are checked by the tests against the CPU twin; nothing on the
             // device writes through unchecked host memory.
             RoundStep::CheckWinners => {}
+            RoundStep::ApplyPlan => self.apply_plan(enc),
         }
     }
 
