@@ -94,12 +94,15 @@ const GRID_EDGE_SLOTS: u32 = 2u;
 const GRID_VERTICES_OR_FACES: u32 = 3u;
 const GRID_SCAN_VERTICES: u32 = 4u;
 const GRID_ONE: u32 = 7u;
-const GRID_SLOTS: u32 = 8u;
+const GRID_TRIM_EDGE_SLOTS: u32 = 8u;
+const GRID_TRIM_SCAN: u32 = 9u;
+const GRID_TRIM_ONE: u32 = 10u;
+const GRID_SLOTS: u32 = 11u;
 
 struct Planned {
     params: Params,
     scans: array<ScanParams, 3>,
-    grids: array<vec4<u32>, 8>,
+    grids: array<vec4<u32>, 11>,
 }
 
 // Relative to its vertex: [a00 a01 a02 a11] [a12 a22 b0 b1] [b2 c weight 0].

@@ -535,8 +535,8 @@ pub struct RoundsReport {
     /// Preparing the upload on the host before the rounds: weld, position classes, Morton
     /// order, normalization (gpu backend, `qem`; `hybrid`'s hand-over is in its clustering).
     pub prepare_seconds: f64,
-    /// The rounds' waits, from each round's submission to its counters read back: the GPU's
-    /// work and the driver's (gpu backend).
+    /// The rounds' waits, from each submission of a round or a batch of them to their counters
+    /// read back: the GPU's work and the driver's (gpu backend).
     pub wait_seconds: f64,
     /// What the call cost on the device's side (gpu backend; zero on the CPU backends):
     /// the host's waits for the device (each a round trip)...

@@ -361,7 +361,7 @@ fn each_stage_matches_its_cpu_twin() {
             "{name}: the GPU's selection picked no winner"
         );
         // dispatch_args, as it last ran: after the last pass's select_win.
-        let mut args = [0u32; 12];
+        let mut args = [0u32; 16];
         meshslim::rounds::cpu::dispatch_args::dispatch_args(
             &p,
             &cpu.edge_offsets,
@@ -369,7 +369,7 @@ fn each_stage_matches_its_cpu_twin() {
             &mut args,
         );
         assert_eq!(
-            pod::<u32>(rd(Buf::Dispatch, 48)),
+            pod::<u32>(rd(Buf::Dispatch, 64)),
             args,
             "{name}: dispatch_args"
         );

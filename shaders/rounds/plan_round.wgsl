@@ -7,7 +7,7 @@
 @group(0) @binding(1) var<storage, read> counters: array<u32, 16>;
 @group(0) @binding(2) var<storage, read_write> plan: PlanState;
 @group(0) @binding(3) var<storage, read_write> planned: Planned;
-@group(0) @binding(4) var<storage, read_write> dispatch: array<u32, 12>; // three (x, y, z, _) grids
+@group(0) @binding(4) var<storage, read_write> dispatch: array<u32, 16>; // four (x, y, z, _) grids
 
 // Workgroups for n invocations of `per` each, split over y past the device's limit.
 fn grid(n: u32, per: u32) -> vec4<u32> {
@@ -34,7 +34,7 @@ fn plan_round() {
         for (var i = 0u; i < GRID_SLOTS; i = i + 1u) {
             planned.grids[i] = vec4<u32>(0u);
         }
-        for (var i = 0u; i < 12u; i = i + 1u) {
+        for (var i = 0u; i < 16u; i = i + 1u) {
             dispatch[i] = 0u;
         }
         return;
@@ -69,4 +69,15 @@ fn plan_round() {
     }
     planned.grids[GRID_VERTICES_OR_FACES] = grid(max(nv, nf), WG);
     planned.grids[GRID_ONE] = vec4<u32>(1u, 1u, 1u, 0u);
+    var trim = vec3<u32>(0u);
+    if (p.trim != 0u) {
+        trim = vec3<u32>(GRID_EDGE_SLOTS, GRID_SCAN_VERTICES + 2u, GRID_ONE);
+        planned.grids[GRID_TRIM_EDGE_SLOTS] = planned.grids[trim.x];
+        planned.grids[GRID_TRIM_SCAN] = planned.grids[trim.y];
+        planned.grids[GRID_TRIM_ONE] = planned.grids[trim.z];
+    } else {
+        planned.grids[GRID_TRIM_EDGE_SLOTS] = vec4<u32>(0u);
+        planned.grids[GRID_TRIM_SCAN] = vec4<u32>(0u);
+        planned.grids[GRID_TRIM_ONE] = vec4<u32>(0u);
+    }
 }

@@ -258,7 +258,7 @@ fn write_rounds(out: &mut impl Write, rr: &crate::rounds::RoundsReport) -> std::
     } else if rr.gpu_timestamps {
         "GPU time (timestamp queries)"
     } else {
-        "wall time per round (the device has no timestamp queries)"
+        "wall time of each submission (the device has no timestamp queries)"
     };
     let total = rr.stage_seconds.total();
     writeln!(out, "stage times         {kind}, {total:.3} s in all")?;

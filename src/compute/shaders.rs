@@ -297,6 +297,9 @@ mod tests {
             ),
             ("GRID_SCAN_VERTICES", grid_slot::SCAN_VERTICES as u32),
             ("GRID_ONE", grid_slot::ONE as u32),
+            ("GRID_TRIM_EDGE_SLOTS", grid_slot::TRIM_EDGE_SLOTS as u32),
+            ("GRID_TRIM_SCAN", grid_slot::TRIM_SCAN as u32),
+            ("GRID_TRIM_ONE", grid_slot::TRIM_ONE as u32),
             ("GRID_SLOTS", grid_slot::COUNT as u32),
         ];
         for (name, rust) in pairs {

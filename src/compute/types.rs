@@ -172,7 +172,12 @@ pub mod grid_slot {
     /// `SCAN_VERTICES + i`: a prefix sum's blocks over the count `i` (vertices, faces, slots).
     pub const SCAN_VERTICES: usize = 4;
     pub const ONE: usize = 7;
-    pub const COUNT: usize = 8;
+    /// The trim's grids: over the edge slots, the blocks of their prefix sum, one workgroup;
+    /// all zero in a round that does not trim.
+    pub const TRIM_EDGE_SLOTS: usize = 8;
+    pub const TRIM_SCAN: usize = 9;
+    pub const TRIM_ONE: usize = 10;
+    pub const COUNT: usize = 11;
 }
 
 /// The next round as `plan_round` writes it: its parameters and prefix-sum counts (copied into

@@ -104,17 +104,20 @@ pub enum Grid {
     PerEdge,
     /// ...one per tentative winner of the selection pass...
     PerTentative,
-    /// ...one per candidate on the live list.
+    /// ...one per candidate on the live list...
     PerLive,
+    /// ...and one per edge when the round trims, none otherwise.
+    PerEdgeTrim,
 }
 
 impl Grid {
-    /// Byte offset of an indirect grid in the `dispatch` buffer (three `(x, y, z, _)` grids).
+    /// Byte offset of an indirect grid in the `dispatch` buffer (four `(x, y, z, _)` grids).
     pub fn indirect_offset(self) -> Option<u64> {
         match self {
             Grid::PerEdge => Some(0),
             Grid::PerTentative => Some(16),
             Grid::PerLive => Some(32),
+            Grid::PerEdgeTrim => Some(48),
             _ => None,
         }
     }
@@ -126,7 +129,7 @@ pub type Stage = crate::compute::schedule::Stage<Buf, Grid>;
 pub use crate::compute::schedule::{Access, Binding};
 
 use Count::{EdgeSlots, Faces, Vertices};
-use Grid::{Each, One, PerEdge, PerLive, PerTentative, VerticesOrFaces};
+use Grid::{Each, One, PerEdge, PerEdgeTrim, PerLive, PerTentative, VerticesOrFaces};
 
 // The prefix sum, the vertex→face lists and the face planes: written once for every family.
 crate::compute::schedule::shared_stages!(Stage, Step, Buf, Grid, Count);
@@ -192,7 +195,7 @@ pub static VALIDATE: Stage = crate::stage!(Buf; validate in "rounds/validate" ov
     candidates: ReadWrite Candidates, edge_state: ReadWrite EdgeState,
     vertex_lock: ReadWrite VertexLock, counters: ReadWrite Counters);
 
-pub static TRIM_HISTOGRAM: Stage = crate::stage!(Buf; trim_histogram in "rounds/trim_histogram" over PerEdge;
+pub static TRIM_HISTOGRAM: Stage = crate::stage!(Buf; trim_histogram in "rounds/trim_histogram" over PerEdgeTrim;
     params: Uniform Params, candidates: Read Candidates, edge_state: Read EdgeState,
     edge_offsets: Read EdgeOffsets, histogram: ReadWrite TrimHistogram);
 pub static TRIM_CEILING: Stage = crate::stage!(Buf; trim_ceiling in "rounds/trim_ceiling" over One;
@@ -200,7 +203,7 @@ pub static TRIM_CEILING: Stage = crate::stage!(Buf; trim_ceiling in "rounds/trim
 pub static TRIM_MARK: Stage = crate::stage!(Buf; trim_mark in "rounds/trim_mark" over Each(EdgeSlots);
     params: Uniform Params, candidates: Read Candidates, edge_state: Read EdgeState,
     edge_offsets: Read EdgeOffsets, counters: Read Counters, marks: ReadWrite Marks);
-pub static TRIM_APPLY: Stage = crate::stage!(Buf; trim_apply in "rounds/trim_apply" over PerEdge;
+pub static TRIM_APPLY: Stage = crate::stage!(Buf; trim_apply in "rounds/trim_apply" over PerEdgeTrim;
     params: Uniform Params, candidates: Read Candidates, marks: Read Marks,
     counters: Read Counters, edge_offsets: Read EdgeOffsets, edge_state: ReadWrite EdgeState);
 
@@ -294,7 +297,7 @@ pub enum When {
     /// Repeated as the round's [`crate::rounds::Selection`] says.
     EachSelectionPass,
     /// When the round trims its winners to land on the target (`Params::trim`); in a round
-    /// planned on the device, always (the trim stages do nothing unless it trims).
+    /// planned on the device, always, over the planner's trim grids (all zero unless it trims).
     Trimming,
     /// Before a round the device planned from the last one's counters: not the first of its
     /// batch. The CPU twin plans between rounds on the host ([`crate::rounds::cpu::CpuRounds`]

@@ -198,8 +198,8 @@ pub struct CpuRounds {
     /// Per attribute vertex: weighted appearance values and attribute sums (empty without).
     pub attr_values: Vec<f32>,
     pub attr_sums: Vec<f32>,
-    /// The indirect grids `dispatch_args` computes (three `(x, y, z, _)`), as the GPU's.
-    pub dispatch: [u32; 12],
+    /// The indirect grids `dispatch_args` computes (four `(x, y, z, _)`), as the GPU's.
+    pub dispatch: [u32; 16],
     /// The planner's state and its next round, between the rounds of a batch.
     pub plan: PlanState,
     pub planned: Planned,

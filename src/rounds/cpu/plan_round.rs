@@ -83,6 +83,12 @@ pub fn plan_round(
     }
     planned.grids[grid_slot::VERTICES_OR_FACES] = grid(nv.max(nf), WG, m);
     planned.grids[grid_slot::ONE] = [1, 1, 1, 0];
+    // The trim runs over the edge slots' grids only in a round that trims.
+    let g = planned.grids;
+    let trims = |slot: usize| if p.trim != 0 { g[slot] } else { [0; 4] };
+    planned.grids[grid_slot::TRIM_EDGE_SLOTS] = trims(grid_slot::EDGE_SLOTS);
+    planned.grids[grid_slot::TRIM_SCAN] = trims(grid_slot::SCAN_VERTICES + 2);
+    planned.grids[grid_slot::TRIM_ONE] = trims(grid_slot::ONE);
 }
 
 #[cfg(test)]
@@ -120,7 +126,7 @@ mod tests {
         };
         let mut plan = state(520, 1000, 100);
         let mut planned = Planned::default();
-        let mut dispatch = [7u32; 12];
+        let mut dispatch = [7u32; 16];
         plan_round(
             &base,
             &after(420, 800),
@@ -141,7 +147,29 @@ mod tests {
         assert_eq!(planned.grids[grid_slot::EDGE_SLOTS], [10, 1, 1, 0]);
         assert_eq!(planned.grids[grid_slot::SCAN_VERTICES], [1, 1, 1, 0]);
         assert_eq!(planned.grids[grid_slot::ONE], [1, 1, 1, 0]);
-        assert_eq!(dispatch, [7; 12], "dispatch_args writes the per-edge grids");
+        assert_eq!(dispatch, [7; 16], "dispatch_args writes the per-edge grids");
+        assert_eq!(planned.grids[grid_slot::TRIM_EDGE_SLOTS], [0; 4], "no trim");
+        assert_eq!(planned.grids[grid_slot::TRIM_ONE], [0; 4], "no trim");
+    }
+
+    /// A round that trims gets the trim's grids: those of the edge slots, their scan, one group.
+    #[test]
+    fn a_planned_round_that_trims_runs_the_trim() {
+        let mut plan = state(100, 200, 120);
+        let mut planned = Planned::default();
+        let mut dispatch = [0u32; 16];
+        plan_round(
+            &Params::default(),
+            &after(80, 130),
+            &mut plan,
+            &mut planned,
+            &mut dispatch,
+        );
+        assert_eq!(planned.params.trim, 1);
+        let g = planned.grids;
+        assert_eq!(g[grid_slot::TRIM_EDGE_SLOTS], g[grid_slot::EDGE_SLOTS]);
+        assert_eq!(g[grid_slot::TRIM_SCAN], g[grid_slot::SCAN_VERTICES + 2]);
+        assert_eq!(g[grid_slot::TRIM_ONE], [1, 1, 1, 0]);
     }
 
     /// Near the target a round trims: 5 × 30 < 2 × 130.
@@ -167,7 +195,7 @@ mod tests {
                 grids: [[1; 4]; grid_slot::COUNT],
                 ..Default::default()
             };
-            let mut dispatch = [7u32; 12];
+            let mut dispatch = [7u32; 16];
             plan_round(
                 &Params::default(),
                 &c,
@@ -178,7 +206,7 @@ mod tests {
             assert_eq!(plan.stopped, 1, "{why}");
             assert_eq!((plan.vertices, plan.faces, plan.executed), (520, 1000, 1));
             assert_eq!(planned.grids, [[0; 4]; grid_slot::COUNT], "{why}");
-            assert_eq!(dispatch, [0; 12], "{why}");
+            assert_eq!(dispatch, [0; 16], "{why}");
             // Stopped stays stopped, whatever the counters of a round that did not run say.
             plan_round(
                 &Params::default(),

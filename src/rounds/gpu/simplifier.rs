@@ -1,6 +1,8 @@
-//! The rounds on the GPU: pipelines made once per device ([`GpuSimplifier`]), buffers made once
-//! per mesh ([`GpuMesh`] plus the working buffers), and one command buffer per round whose only
-//! read-back is the 64-byte counters block (and the stage timestamps when the device has them).
+//! The rounds on the GPU: pipelines made once per device ([`GpuSimplifier`]), buffers and their
+//! bind groups made once per mesh ([`GpuMesh`] plus the working buffers), and one command
+//! buffer per batch of rounds the device plans itself, whose only read-back is the planner's
+//! state and each round's counters (and the stage timestamps when the device has them); the
+//! submissions and read-backs are in [`batch`].
 
 use crate::compute::context::{checked_buffer, checked_buffer_init};
 use crate::compute::gpu::{ErrorScope, Groups, Kernels, Pipelines, Runner};
@@ -26,7 +28,7 @@ const QUERY_CAP: u32 = 4096;
 /// left to select costs a few empty dispatches, a read-back a round trip.
 const EXHAUSTIVE_CHUNK: u32 = 8;
 
-/// Bytes of the counters block, the round's one read-back.
+/// Bytes of the counters block, a round's read-back.
 const COUNTERS_BYTES: u64 = std::mem::size_of::<Counters>() as u64;
 /// `Counters::tentative`, cleared before each selection pass.
 const TENTATIVE_OFFSET: u64 = std::mem::offset_of!(Counters, tentative) as u64;
@@ -197,8 +199,10 @@ pub struct GpuRounds<'a> {
     /// The planner's state and its next round (`plan_round`), between the rounds of a batch.
     plan: wgpu::Buffer,
     planned: wgpu::Buffer,
-    /// Recording a round the device planned: grids from `planned`.
+    /// Recording a round the device planned: grids from `planned`...
     planned_round: bool,
+    /// ...and its trim: the planner's trim grids.
+    trimming: bool,
     /// Every bind group made so far: the buffers never change, so each stage binds each
     /// half's once.
     bind_groups: HashMap<BindKey, wgpu::BindGroup>,
@@ -224,7 +228,7 @@ pub struct GpuRounds<'a> {
     carried_quadrics: bool,
     /// Upload and download seconds.
     pub transfer_seconds: f64,
-    /// Seconds from each round's submission to its counters read back.
+    /// Seconds from each submission of rounds to their counters read back.
     pub wait_seconds: f64,
     /// The round being recorded's parameters (the grids are counted from them).
     round_params: Params,
@@ -341,7 +345,7 @@ impl<'a> GpuRounds<'a> {
             face_keep: mk("face_keep", (nf + 1) * 4, SU)?,
             marks: mk("marks", (cap + 1) * 4, SU)?,
             tentative: mk("tentative", cap * 4, SU)?,
-            dispatch: mk("dispatch", 48, SU | wgpu::BufferUsages::INDIRECT)?,
+            dispatch: mk("dispatch", 64, SU | wgpu::BufferUsages::INDIRECT)?,
             live: mk("live", cap * 4, SU)?,
             neighbours: mk("neighbours", nf * 24, SU)?,
             block_sums: mk("block_sums", blocks * 4, SU)?,
@@ -357,6 +361,7 @@ impl<'a> GpuRounds<'a> {
                 SU | wgpu::BufferUsages::INDIRECT,
             )?,
             planned_round: false,
+            trimming: false,
             bind_groups: HashMap::new(),
             costs: Costs::default(),
             face_extra_out: up.output_needs_face_extra(),
@@ -581,7 +586,7 @@ impl Runner<Buf, schedule::Grid, Count, RoundStep> for GpuRounds<'_> {
         let wg = |n: u32| Groups::Direct(n.div_ceil(WG));
         let planned = match stage.grid {
             _ if !self.planned_round => None,
-            grid => Self::planned_grid(grid, scan.map(|s| s.0)),
+            grid => Self::planned_grid(grid, scan.map(|s| s.0), self.trimming),
         };
         let (groups, args) = match (planned, stage.grid) {
             (Some(at), _) => (Groups::Indirect(at), &self.planned),

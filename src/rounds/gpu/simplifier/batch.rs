@@ -107,14 +107,22 @@ impl GpuRounds<'_> {
         }
     }
 
-    /// The grid of a stage over `grid` in a planned round: the planner's slot for it.
-    pub(super) fn planned_grid(grid: schedule::Grid, scan: Option<Count>) -> Option<u64> {
+    /// The grid of a stage over `grid` in a planned round: the planner's slot for it (its trim
+    /// slots while `trimming`).
+    pub(super) fn planned_grid(
+        grid: schedule::Grid,
+        scan: Option<Count>,
+        trimming: bool,
+    ) -> Option<u64> {
         let count = |c: Count| match c {
             Count::Vertices => 0,
             Count::Faces => 1,
             Count::EdgeSlots => 2,
         };
         let slot = match grid {
+            schedule::Grid::Each(Count::EdgeSlots) if trimming => grid_slot::TRIM_EDGE_SLOTS,
+            schedule::Grid::ScanBlocks if trimming => grid_slot::TRIM_SCAN,
+            schedule::Grid::One if trimming => grid_slot::TRIM_ONE,
             schedule::Grid::Each(c) => grid_slot::VERTICES + count(c),
             schedule::Grid::VerticesOrFaces => grid_slot::VERTICES_OR_FACES,
             schedule::Grid::ScanBlocks => {
@@ -164,7 +172,11 @@ impl GpuRounds<'_> {
                         self.record(enc, p, steps);
                     }
                 }
-                When::Trimming if planned => self.record(enc, p, steps),
+                When::Trimming if planned => {
+                    self.trimming = true;
+                    self.record(enc, p, steps);
+                    self.trimming = false;
+                }
                 w if w.runs_once(first, self.carried_quadrics, p) => self.record(enc, p, steps),
                 _ => {}
             }
