@@ -40,6 +40,8 @@ pub mod cluster;
 // The GPU layer every family shares: schedules' vocabulary, pipeline cache, error capture.
 #[doc(hidden)]
 pub mod compute;
+// Cluster levels of detail (Nanite-style meshlet DAGs).
+pub mod dag;
 pub mod decimate;
 pub mod error;
 mod greedy;

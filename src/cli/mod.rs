@@ -14,6 +14,7 @@ mod args;
 mod bench;
 mod builtins;
 mod compare;
+mod dag;
 mod error;
 mod files;
 mod info;
@@ -36,6 +37,8 @@ use bench::{BENCH_AFTER_HELP, run_bench};
 pub use builtins::{BUILTINS, BuiltinMesh, MAX_BUILTIN_FACES, builtin};
 pub use compare::CompareArgs;
 use compare::{COMPARE_AFTER_HELP, run_compare};
+pub use dag::DagArgs;
+use dag::{DAG_AFTER_HELP, run_dag};
 pub use error::UsageError;
 pub use info::InfoArgs;
 use info::{INFO_AFTER_HELP, run_info};
@@ -109,6 +112,10 @@ pub enum Command {
     /// project), keeping sharp features and borders
     #[command(after_help = REMESH_AFTER_HELP)]
     Remesh(RemeshArgs),
+    /// Cluster levels of detail (a Nanite-style DAG of meshlets): build one from a mesh, cut it
+    /// at an error or for a camera, describe it
+    #[command(after_help = DAG_AFTER_HELP)]
+    Dag(DagArgs),
 }
 
 /// The exit code for an error [`run`] returned: 2 for bad usage, 1 for everything else.
@@ -137,6 +144,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Some(Command::Lods(args)) => run_lods(args),
         Some(Command::Pareto(args)) => run_pareto(args),
         Some(Command::Remesh(args)) => run_remesh(args),
+        Some(Command::Dag(args)) => run_dag(args),
     }
 }
 

@@ -35,7 +35,7 @@ impl std::fmt::Display for CacheStatus {
 
 /// FNV-1a over `bytes`: a check that the payload is what was written (wgpu reserves a hash in
 /// its own header but does not check it).
-fn fnv1a(bytes: &[u8]) -> u64 {
+pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
         (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
     })

@@ -17,7 +17,7 @@ pub struct WeldResult {
 
 /// Key of a vertex: bit patterns, so that -0.0 and 0.0 differ only where they really differ
 /// (we canonicalise -0.0 to 0.0 so coincident points written either way still weld).
-fn bits(x: f32) -> u32 {
+pub(crate) fn bits(x: f32) -> u32 {
     if x == 0.0 { 0 } else { x.to_bits() }
 }
 
