@@ -9,7 +9,7 @@ cd "$(dirname "$0")"
 seconds=${1:-600}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(read_obj read_ply read_stl read_gltf simplify)
+[ ${#targets[@]} -gt 0 ] || targets=(read_obj read_ply read_stl read_gltf read_mslod simplify)
 models=${MESHSLIM_MODELS:-../../shared/models}
 binary=../target/release/meshslim
 [ -x "$binary" ] || (cd .. && cargo build --release)

@@ -123,6 +123,15 @@ def main():
                     if ext == "stl":
                         seeds.append(("stl", ascii_stl(data)))
     counts = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        # Cluster DAGs of small built-in meshes, one with colours.
+        for k, mesh in enumerate(["builtin:sphere:300", "builtin:torus:800", "builtin:grid:500"]):
+            out = pathlib.Path(tmp) / f"dag{k}.mslod"
+            subprocess.run([binary, "dag", "build", mesh, str(out)], check=True, capture_output=True)
+            d = corpus / "read_mslod"
+            d.mkdir(parents=True, exist_ok=True)
+            (d / f"seed-{k:03}.mslod").write_bytes(out.read_bytes())
+            counts["read_mslod"] = counts.get("read_mslod", 0) + 1
     for k, (ext, data) in enumerate(seeds):
         target = "read_gltf" if ext in ("gltf", "glb") else f"read_{ext}"
         for name, body in [(target, data),

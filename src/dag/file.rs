@@ -192,6 +192,9 @@ pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Dag> {
     if flags & !(NORMALS | UVS | COLORS | UV_TOP_LEFT) != 0 {
         return r.fail(12, format!("unknown flags {flags:#x}"));
     }
+    if flags & UV_TOP_LEFT != 0 && flags & UVS == 0 {
+        return r.fail(12, "a UV origin is flagged but no UVs");
+    }
     let n = [r.u32(), r.u32(), r.u32(), r.u32()].map(|x| x as usize);
     let diagonal = f64::from_le_bytes(bytes[32..40].try_into().expect("8 bytes"));
     r.at = HEADER;
