@@ -365,3 +365,21 @@ fn the_command_line_builds_describes_and_cuts() {
     expect_code(&o, 1);
     assert!(String::from_utf8_lossy(&o.stderr).contains("bad.mslod: byte offset 5: truncated"));
 }
+
+/// Normals made again on every level must not become seams that stall the next one, and a UV
+/// seam must not open a crack: a torus with normals and a UV seam reaches one small root.
+#[test]
+fn normals_and_uv_seams_neither_stall_nor_crack() {
+    let mut m = mesh::subdivide_midpoint(&mesh::subdivide_midpoint(&seamed_torus()));
+    m.recompute_normals();
+    let (d, r) = built(&m, &DagOptions::default());
+    assert_eq!((r.root_groups, r.stuck_groups), (1, 0), "{r:?}");
+    assert!(*r.triangles_per_level.last().unwrap() <= 256, "{r:?}");
+    assert!(d.mesh.normals.is_some() && d.mesh.uvs.is_some());
+    for e in [0.0, 1e-3, 1e-2, 1.0] {
+        assert_closed_manifold(
+            &format!("at {e}"),
+            &d.mesh_of(&d.cut_at_error(e * d.diagonal)),
+        );
+    }
+}

@@ -288,7 +288,13 @@ impl Builder {
                 }));
             }
         }
-        let sub = self.store.submesh(&ids, tris);
+        let mut sub = self.store.submesh(&ids, tris);
+        if opts.attributes.normal == 0.0 {
+            // Normals out of the cost are made again from each result's faces, and differ
+            // where two groups meet: carried in, they would be seams the next level's
+            // simplification keeps whole (the horse's root stalled at 1,756 triangles).
+            sub.normals = None;
+        }
         let pin: Vec<u32> = (0..ids.len() as u32)
             .filter(|&l| shared[self.store.class[ids[l as usize] as usize] as usize])
             .collect();
@@ -302,12 +308,15 @@ impl Builder {
         };
         let diagonal = sub.bounds().map_or(0.0, |b| b.diagonal());
         let (mut mesh, r) = crate::simplify(&sub, &so)?;
+        if self.store.mesh.normals.is_some() && mesh.normals.is_none() {
+            mesh.recompute_normals();
+        }
         let class = local_classes(&mesh.positions);
         let c = |v: u32| class[v as usize];
         mesh.triangles
             .retain(|t| c(t[0]) != c(t[1]) && c(t[1]) != c(t[2]) && c(t[0]) != c(t[2]));
         let parts = split(&mesh.triangles, &mesh.positions, &class, self.limits);
-        let mut by_bits: FxHashMap<[u32; 12], u32> = FxHashMap::default();
+        let mut by_bits: FxHashMap<[u32; 9], u32> = FxHashMap::default();
         for (l, &g) in ids.iter().enumerate() {
             by_bits.insert(vertex_bits(&sub, l), g);
         }
@@ -409,7 +418,10 @@ struct Store {
     mesh: Mesh,
     /// Per vertex: its position class.
     class: Vec<u32>,
-    classes: u32,
+    /// Per position (bits): its class. A vertex that comes back with other attributes (the
+    /// normals a simplification made again on a pinned border) is a new vertex of the old
+    /// class, or the groups it borders would no longer meet there.
+    by_position: FxHashMap<[u32; 3], u32>,
 }
 
 impl Store {
@@ -421,21 +433,27 @@ impl Store {
         mesh.face_materials = None;
         mesh.face_groups = None;
         let tris = std::mem::take(&mut mesh.triangles);
-        let (class, firsts) = crate::mesh::weld::position_classes(&mesh.positions);
+        let (class, _) = crate::mesh::weld::position_classes(&mesh.positions);
+        let by_position = mesh
+            .positions
+            .iter()
+            .zip(&class)
+            .map(|(p, &c)| (p.map(bits), c))
+            .collect();
         let store = Store {
-            classes: firsts.len() as u32,
             mesh,
             class,
+            by_position,
         };
         (store, tris)
     }
 
     fn class_count(&self) -> usize {
-        self.classes as usize
+        self.by_position.len()
     }
 
-    /// The ids of `m`'s vertices: `known[v]` where it is one, else a new vertex (with a class of
-    /// its own: a moved vertex meets no other) for each vertex the faces use.
+    /// The ids of `m`'s vertices: `known[v]` where it is one, else a new vertex for each vertex
+    /// the faces use.
     fn add_new(&mut self, m: &Mesh, known: &[u32]) -> Vec<u32> {
         let mut used = vec![false; m.positions.len()];
         for &v in m.triangles.as_flattened() {
@@ -451,8 +469,12 @@ impl Store {
 
     fn push(&mut self, m: &Mesh, v: usize) -> u32 {
         let id = self.mesh.positions.len() as u32;
-        self.class.push(self.classes);
-        self.classes += 1;
+        let next = self.by_position.len() as u32;
+        let class = *self
+            .by_position
+            .entry(m.positions[v].map(bits))
+            .or_insert(next);
+        self.class.push(class);
         self.mesh.positions.push(m.positions[v]);
         if let Some(n) = &mut self.mesh.normals {
             n.push(m.normals.as_ref().map_or([0.0; 3], |s| s[v]));
@@ -496,23 +518,21 @@ impl Store {
     }
 }
 
-/// Vertex `v` of `m` as bits: position, normal, UV, colour (zero where absent).
-fn vertex_bits(m: &Mesh, v: usize) -> [u32; 12] {
-    let mut key = [0u32; 12];
+/// Vertex `v` of `m` as bits: position, UV, colour (zero where absent). Not the normal: a
+/// pinned vertex keeps its place and appearance but gets a normal made again.
+fn vertex_bits(m: &Mesh, v: usize) -> [u32; 9] {
+    let mut key = [0u32; 9];
     let mut put = |at: usize, xs: &[f32]| {
         for (i, &x) in xs.iter().enumerate() {
             key[at + i] = bits(x);
         }
     };
     put(0, &m.positions[v]);
-    if let Some(n) = &m.normals {
-        put(3, &n[v]);
-    }
     if let Some(t) = &m.uvs {
-        put(6, &t[v]);
+        put(3, &t[v]);
     }
     if let Some(c) = &m.colors {
-        put(8, &c[v]);
+        put(5, &c[v]);
     }
     key
 }
