@@ -28,6 +28,8 @@
 //! - A. Papageorgiou, N. Platis. Triangular mesh simplification on the GPU. The Visual Computer,
 //!   2015 (independent-set collapses on the GPU; our rounds remove 13–18% per round where its
 //!   single local-minimum pass removed 8–9%).
+//! - B. Karis, R. Stubbe, G. Wihlidal. A Deep Dive into Nanite Virtualized Geometry. SIGGRAPH
+//!   2021 (the cluster DAG of [`dag`]).
 
 #[cfg(feature = "bench")]
 pub mod bench;
