@@ -383,3 +383,36 @@ fn normals_and_uv_seams_neither_stall_nor_crack() {
         );
     }
 }
+
+/// A scan in many pieces: separate small spheres share no edge, so only the spatial fallback
+/// groups them; they still reach one root, every level halves, and every cut is closed.
+#[test]
+fn separate_pieces_still_reach_one_root() {
+    let piece = mesh::icosphere(2);
+    let mut m = Mesh::new(Vec::new(), Vec::new());
+    for k in 0..64u32 {
+        let at = [k % 4, k / 4 % 4, k / 16].map(|x| x as f32 * 3.0);
+        let base = m.positions.len() as u32;
+        m.positions.extend(
+            piece
+                .positions
+                .iter()
+                .map(|p| [0, 1, 2].map(|i| p[i] + at[i])),
+        );
+        m.triangles
+            .extend(piece.triangles.iter().map(|t| t.map(|v| v + base)));
+    }
+    let (d, r) = built(&m, &DagOptions::default());
+    assert_eq!(r.root_groups, 1, "{:?}", r.triangles_per_level);
+    // 64 tetrahedra (256 triangles) are as far as 64 closed pieces go: the last level may halve
+    // no further, and its group may stick.
+    assert!(r.stuck_groups <= 1, "{r:?}");
+    assert!(*r.triangles_per_level.last().unwrap() <= 256, "{r:?}");
+    for w in r.triangles_per_level.windows(2) {
+        let halved = (w[1] as f64) <= 0.6 * w[0] as f64;
+        assert!(halved || w[1] <= 256, "{:?}", r.triangles_per_level);
+    }
+    for e in [0.001, 0.01, 0.05, 1.0] {
+        assert_closed_manifold(&format!("at {e}"), &d.mesh_of(&d.cut_at_error(e)));
+    }
+}

@@ -365,8 +365,19 @@ int main(int argc, char** argv) {
     for (size_t d = 0; d < per_level.size(); ++d)
         printf("%s%zu", d ? ", " : "", per_level[d]);
     const char* commit = getenv("MESHOPT_COMMIT");
-    printf("], \"dag_triangles\": %zu, \"diagonal\": %.9g, \"meshoptimizer_commit\": %s, \"cuts\": [",
+    printf("], \"dag_triangles\": %zu, \"diagonal\": %.9g, \"meshoptimizer_commit\": %s, \"group_errors\": [",
         dag_triangles, diagonal, json(commit && *commit ? commit : "unknown").c_str());
+    // Per depth, the median and the largest simplified error of its groups (of the diagonal; the
+    // terminal groups' FLT_MAX left out): how evenly the error grows up the DAG.
+    for (int d = 0; d < levels; ++d) {
+        std::vector<float> e;
+        for (const clodGroup& g : dag.groups)
+            if (g.depth == d && g.simplified.error < FLT_MAX) e.push_back(g.simplified.error);
+        std::sort(e.begin(), e.end());
+        double median = e.empty() ? 0 : e[e.size() / 2] / diagonal, most = e.empty() ? 0 : e.back() / diagonal;
+        printf("%s[%.4g, %.4g]", d ? ", " : "", median, most);
+    }
+    printf("], \"cuts\": [");
 
     for (size_t ci = 0; ci < cuts.size(); ++ci) {
         double t = cuts[ci] * diagonal;

@@ -1,12 +1,12 @@
 //! Groups: neighbouring clusters that are simplified together, their outer border locked.
 //!
-//! Greedy growth over the cluster graph, seeds in Morton order: a group takes the unassigned
-//! neighbour it shares most edges with, counting twice the edges the last level locked (those
-//! between clusters of different parent groups), so that this level frees them (Karis 2021:
-//! "the boundary of one level must fall inside a group of the next"). A group whose neighbours
-//! are all taken while it is under half its size goes on with the nearest unassigned cluster in
-//! Morton order, so the small pieces of a scan still reach one root.
+//! Agglomerative grouping over the cluster graph (see [`group`]), counting twice the edges the
+//! last level locked (those between clusters of different parent groups), so that this level
+//! frees them (Karis 2021: "the boundary of one level must fall inside a group of the next").
+//! A group left under half its size joins a neighbour, or, with none (a separate piece of a
+//! scan), the nearest group along the Morton curve, so the pieces still reach one root.
 
+use super::dist2;
 use super::meshlets::{edge_key, morton_order, sort};
 use rustc_hash::FxHashMap;
 
@@ -20,50 +20,90 @@ pub struct Member<'a> {
 
 /// The clusters `members` in groups of at most `size`: indices into `members`, each group's in
 /// the order taken. `class[v]` is vertex `v`'s position class.
+///
+/// Agglomerative (T. Kurita, "An efficient agglomerative clustering algorithm using a heap",
+/// 1991, as meshoptimizer's `meshopt_partitionClusters` uses it): every cluster starts as a
+/// group; the group with the fewest vertices joins the neighbour whose shared edges weigh most
+/// against both their expected borders (the square roots of their vertex counts), while the
+/// two fit in `size`, until none is under `size` or none can grow. Growing one group at a time
+/// from Morton-order seeds instead left groups whose border held 22% of their vertices at the
+/// 1M scan's first level and 43% at its fifth, and the fifth level's largest error was 3.4
+/// times its median, an error every coarser group inherits.
 pub fn group(members: &[Member<'_>], class: &[u32], size: usize) -> Vec<Vec<u32>> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
     assert!(size >= 1);
     let n = members.len();
     let links = links(members, class);
-    let centers: Vec<[f32; 3]> = members.iter().map(|m| m.center).collect();
-    let order = morton_order(&centers);
-    let mut group_of = vec![u32::MAX; n];
-    let mut groups: Vec<Vec<u32>> = Vec::new();
-    let mut seed = 0usize;
-    loop {
-        while seed < n && group_of[order[seed] as usize] != u32::MAX {
-            seed += 1;
+    let mut group_of: Vec<u32> = (0..n as u32).collect();
+    let mut parts: Vec<Vec<u32>> = (0..n as u32).map(|c| vec![c]).collect();
+    let mut verts: Vec<u32> = members
+        .iter()
+        .map(|m| {
+            let mut v: Vec<u32> = m
+                .triangles
+                .iter()
+                .flatten()
+                .map(|&v| class[v as usize])
+                .collect();
+            v.sort_unstable();
+            v.dedup();
+            v.len() as u32
+        })
+        .collect();
+    let mut heap: BinaryHeap<Reverse<(u32, u32)>> = (0..n as u32)
+        .map(|g| Reverse((verts[g as usize], g)))
+        .collect();
+    let mut shared: FxHashMap<u32, u32> = FxHashMap::default();
+    while let Some(Reverse((v, g))) = heap.pop() {
+        let gi = g as usize;
+        if parts[gi].is_empty() || v != verts[gi] || parts[gi].len() >= size {
+            continue;
         }
-        if seed == n {
-            break;
-        }
-        let id = groups.len() as u32;
-        let mut g: Vec<u32> = Vec::new();
-        let mut weight: FxHashMap<u32, u32> = FxHashMap::default();
-        let mut next = Some(order[seed]);
-        let mut fallback = seed;
-        while let Some(c) = next {
-            group_of[c as usize] = id;
-            g.push(c);
-            weight.remove(&c);
+        shared.clear();
+        for &c in &parts[gi] {
             for &(o, w) in links.of(c) {
-                if group_of[o as usize] == u32::MAX {
-                    *weight.entry(o).or_insert(0) += w;
+                let h = group_of[o as usize];
+                if h != g {
+                    *shared.entry(h).or_insert(0) += w;
                 }
-            }
-            if g.len() == size {
-                break;
-            }
-            next = strongest(&weight, &centers, &g);
-            if next.is_none() && g.len() < size.div_ceil(2) {
-                while fallback < n && group_of[order[fallback] as usize] != u32::MAX {
-                    fallback += 1;
-                }
-                next = order.get(fallback).copied();
             }
         }
-        groups.push(g);
+        let own = 1.0 / (verts[gi] as f64).sqrt();
+        let best = shared
+            .iter()
+            .filter(|&(&h, _)| parts[gi].len() + parts[h as usize].len() <= size)
+            .map(|(&h, &w)| {
+                (
+                    w as f64 * (own + 1.0 / (verts[h as usize] as f64).sqrt()),
+                    h,
+                    w,
+                )
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)));
+        let Some((_, h, w)) = best else { continue };
+        let moved = std::mem::take(&mut parts[h as usize]);
+        for &c in &moved {
+            group_of[c as usize] = g;
+        }
+        parts[gi].extend(moved);
+        verts[gi] = (verts[gi] + verts[h as usize]).saturating_sub(w).max(1);
+        verts[h as usize] = 0;
+        heap.push(Reverse((verts[gi], g)));
     }
-    merge_small(groups, &group_of, &links, size)
+    // The groups renumbered densely, in order of their first cluster.
+    let mut dense = vec![u32::MAX; n];
+    let mut groups: Vec<Vec<u32>> = Vec::new();
+    for c in 0..n {
+        let g = group_of[c] as usize;
+        if dense[g] == u32::MAX {
+            dense[g] = groups.len() as u32;
+            groups.push(std::mem::take(&mut parts[g]));
+        }
+    }
+    let group_of: Vec<u32> = group_of.iter().map(|&g| dense[g as usize]).collect();
+    let centers: Vec<[f32; 3]> = members.iter().map(|m| m.center).collect();
+    merge_small(groups, &group_of, &links, &centers, size)
 }
 
 /// Groups under half `size` (the leftovers a greedy sweep strands between full groups) joined
@@ -74,6 +114,7 @@ fn merge_small(
     mut groups: Vec<Vec<u32>>,
     group_of: &[u32],
     links: &Links,
+    centers: &[[f32; 3]],
     size: usize,
 ) -> Vec<Vec<u32>> {
     let mut into: Vec<u32> = (0..groups.len() as u32).collect();
@@ -106,27 +147,51 @@ fn merge_small(
             into[gi] = h;
         }
     }
-    groups.retain(|g| !g.is_empty());
-    groups
-}
-
-/// The candidate with the largest weight, then nearest the group's centre, then lowest id.
-fn strongest(weight: &FxHashMap<u32, u32>, centers: &[[f32; 3]], g: &[u32]) -> Option<u32> {
-    let mut c = [0.0f64; 3];
-    for &m in g {
-        for i in 0..3 {
-            c[i] += centers[m as usize][i] as f64 / g.len() as f64;
+    // Pieces with no neighbour at all: the nearest of the groups a few places either side along
+    // the Morton curve of group centres that has room.
+    const WINDOW: usize = 8;
+    let centre = |g: &[u32]| {
+        let mut c = [0.0f64; 3];
+        for &m in g {
+            for i in 0..3 {
+                c[i] += centers[m as usize][i] as f64 / g.len() as f64;
+            }
+        }
+        c.map(|x| x as f32)
+    };
+    let live: Vec<u32> = (0..groups.len() as u32)
+        .filter(|&g| !groups[g as usize].is_empty())
+        .collect();
+    let mids: Vec<[f32; 3]> = live.iter().map(|&g| centre(&groups[g as usize])).collect();
+    let order: Vec<u32> = morton_order(&mids)
+        .into_iter()
+        .map(|i| live[i as usize])
+        .collect();
+    let mid_of: FxHashMap<u32, [f32; 3]> = live.iter().copied().zip(mids).collect();
+    for k in 0..order.len() {
+        let gi = order[k] as usize;
+        if groups[gi].len() * 2 >= size || groups[gi].is_empty() {
+            continue;
+        }
+        let here = mid_of[&(gi as u32)];
+        let best = order[k.saturating_sub(WINDOW)..(k + WINDOW + 1).min(order.len())]
+            .iter()
+            .map(|&h| root(&into, h))
+            .filter(|&h| {
+                h as usize != gi
+                    && !groups[h as usize].is_empty()
+                    && groups[h as usize].len() + groups[gi].len() <= size + size / 2
+            })
+            .map(|h| (dist2(here, mid_of[&h]), h))
+            .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        if let Some((_, h)) = best {
+            let moved = std::mem::take(&mut groups[gi]);
+            groups[h as usize].extend(moved);
+            into[gi] = h;
         }
     }
-    let d = |o: u32| -> f64 {
-        let p = centers[o as usize];
-        (0..3).map(|i| (p[i] as f64 - c[i]).powi(2)).sum()
-    };
-    weight
-        .iter()
-        .map(|(&o, &w)| (w, d(o), o))
-        .max_by(|a, b| a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)).then(b.2.cmp(&a.2)))
-        .map(|k| k.2)
+    groups.retain(|g| !g.is_empty());
+    groups
 }
 
 /// The cluster graph: per cluster, its neighbours and the weight of the edges they share.

@@ -6,7 +6,7 @@
 //! the frontier's that adds the fewest new vertices, then the one nearest the cluster's centre;
 //! a cluster whose frontier runs dry goes on from the next unassigned triangle in Morton order.
 
-use crate::mesh::morton::morton3;
+use crate::mesh::morton::grid_codes;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
@@ -256,25 +256,8 @@ pub(crate) fn edge_key(a: u32, b: u32) -> u64 {
 
 /// Indices of `points` along a Morton curve over their box, ties by index.
 pub(crate) fn morton_order(points: &[[f32; 3]]) -> Vec<u32> {
-    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for p in points {
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i]);
-            hi[i] = hi[i].max(p[i]);
-        }
-    }
-    let spread = (0..3)
-        .map(|i| hi[i] - lo[i])
-        .fold(0.0f32, f32::max)
-        .max(f32::MIN_POSITIVE);
-    let mut keyed: Vec<(u32, u32)> = points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let q = |k: usize| ((((p[k] - lo[k]) / spread) * 1023.0) as u32).min(1023);
-            (morton3(q(0), q(1), q(2)), i as u32)
-        })
-        .collect();
+    let codes = grid_codes(points.len(), |i| points[i]);
+    let mut keyed: Vec<(u32, u32)> = codes.into_iter().zip(0..).collect();
     keyed.sort_unstable();
     keyed.into_iter().map(|k| k.1).collect()
 }

@@ -105,20 +105,8 @@ impl Dag {
 
 /// The sphere around points: the centre of their box, the farthest point's distance (in f64,
 /// rounded up to f32 so the f32 sphere still holds every point).
-pub(crate) fn sphere_of_points(points: impl Iterator<Item = [f32; 3]> + Clone) -> [f32; 4] {
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in points.clone() {
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i] as f64);
-            hi[i] = hi[i].max(p[i] as f64);
-        }
-    }
-    if lo[0] > hi[0] {
-        return [0.0; 4];
-    }
-    let c = [0, 1, 2].map(|i| ((lo[i] + hi[i]) * 0.5) as f32);
-    let r = points.map(|p| dist(c, p)).fold(0.0f64, f64::max);
-    [c[0], c[1], c[2], round_up(r)]
+pub(crate) fn sphere_of_points(points: impl Iterator<Item = [f32; 3]>) -> [f32; 4] {
+    sphere_around(&[], &points.collect::<Vec<_>>())
 }
 
 /// A sphere holding `spheres` and `points`.
@@ -149,10 +137,12 @@ pub(crate) fn sphere_around(spheres: &[[f32; 4]], points: &[[f32; 3]]) -> [f32; 
 }
 
 fn dist(a: [f32; 3], b: [f32; 3]) -> f64 {
-    (0..3)
-        .map(|i| (a[i] as f64 - b[i] as f64).powi(2))
-        .sum::<f64>()
-        .sqrt()
+    dist2(a, b).sqrt()
+}
+
+/// The squared distance between two points, in f64.
+pub(crate) fn dist2(a: [f32; 3], b: [f32; 3]) -> f64 {
+    (0..3).map(|i| (a[i] as f64 - b[i] as f64).powi(2)).sum()
 }
 
 /// `x` as the smallest f32 at least `x`.

@@ -25,9 +25,14 @@ pub(crate) fn spatial_order(
 
 /// Each class's Morton code: its first vertex's position on a 1024³ grid over their box.
 fn codes(positions: &[[f32; 3]], firsts: &[u32]) -> Vec<u32> {
+    grid_codes(firsts.len(), |i| positions[firsts[i] as usize])
+}
+
+/// The Morton codes of `n` points (`point(i)`) on a 1024³ grid over their box, its cells cubes
+/// of the box's longest side.
+pub(crate) fn grid_codes(n: usize, point: impl Fn(usize) -> [f32; 3] + Sync) -> Vec<u32> {
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for &v in firsts {
-        let p = positions[v as usize];
+    for p in (0..n).map(&point) {
         lo = [0, 1, 2].map(|i| lo[i].min(p[i]));
         hi = [0, 1, 2].map(|i| hi[i].max(p[i]));
     }
@@ -35,12 +40,11 @@ fn codes(positions: &[[f32; 3]], firsts: &[u32]) -> Vec<u32> {
         .map(|i| hi[i] - lo[i])
         .fold(0.0f32, f32::max)
         .max(f32::MIN_POSITIVE);
-    let code = |v: u32| {
-        let p = positions[v as usize];
+    let code = |p: [f32; 3]| {
         let q = |i: usize| (((p[i] - lo[i]) / spread) * 1023.0) as u32;
         morton3(q(0), q(1), q(2))
     };
-    firsts.par_iter().map(|&v| code(v)).collect()
+    (0..n).into_par_iter().map(|i| code(point(i))).collect()
 }
 
 /// The Morton code of a cell with coordinates below 1024: the low 10 bits of x, y and z
