@@ -12,6 +12,8 @@ weighed in the cost, so a painted scan keeps its painting.
 >>> meshslim.write("scan-1.ply", res.mesh)
 >>> res = meshslim.simplify(V, F, ratio=0.1, colors=C)      # numpy arrays in and out
 >>> res.vertices, res.faces, res.colors, res.report["output_faces"]
+>>> lod = meshslim.dag(mesh)                                # a Nanite-style cluster DAG
+>>> lod.clusters["error"], lod.cut(error=0.001)             # arrays, and a cut as a Mesh
 """
 
 from __future__ import annotations
@@ -49,8 +51,8 @@ _quiet_wayland_probe()
 from . import _meshslim  # noqa: E402
 from ._meshslim import Mesh, __version__  # noqa: E402
 
-__all__ = ["Mesh", "Result", "mesh", "read", "write", "simplify", "lods", "remesh", "compare",
-           "__version__"]
+__all__ = ["Mesh", "Result", "Dag", "mesh", "read", "write", "simplify", "lods", "remesh",
+           "compare", "dag", "read_dag", "__version__"]
 
 METHODS = ("qem", "cluster", "floating-cell", "hybrid", "decimate")
 BACKENDS = ("cpu", "cpu-parallel", "gpu", "auto")
@@ -207,3 +209,118 @@ def compare(a: Mesh, b: Mesh, *, samples: Optional[int] = None,
     relative to the diagonal), colour and normal deviation, area, volume, triangle quality and
     topology of each, as ``meshslim compare --json`` prints them."""
     return json.loads(_meshslim.compare(a, b, samples=samples, seed=seed))
+
+
+class Dag:
+    """A cluster DAG (B. Karis et al., "A Deep Dive into Nanite Virtualized Geometry", 2021), as
+    :func:`dag` builds it and ``meshslim dag build`` writes it: clusters of at most 128
+    triangles, grouped and simplified level after level down to one root, every level's
+    triangles over one set of vertices.
+
+    ``mesh``: the vertices and, cluster after cluster, the triangles of every level.
+    ``clusters``: a dict of arrays, one entry per cluster: ``first_triangle``,
+    ``triangle_count``, ``depth`` (0 for the input's), ``group`` (the group that simplifies it;
+    ``NONE`` for a root), ``parent_group`` (the group that made it; ``NONE`` at depth 0), all
+    uint32; ``bounds`` and ``lod_sphere`` (k, 4) float32 spheres (centre, radius); ``error``
+    float32, in mesh units. ``groups``: ``depth``, ``sphere`` (g, 4), ``error``. ``diagonal``:
+    the input's bounding-box diagonal. ``report``: the build's report (levels,
+    triangles_per_level, clusters, groups, root_groups, dag_triangles, stuck_groups, seconds),
+    or None for a DAG read from a file."""
+
+    NONE = 2**32 - 1
+
+    def __init__(self, native: Any, report: Optional[dict] = None):
+        self._native = native
+        self.report = report
+        self.clusters = native.clusters()
+        self.groups = native.groups()
+
+    mesh = property(lambda self: self._native.mesh)
+    diagonal = property(lambda self: self._native.diagonal)
+
+    def cut_clusters(self, *, error: Optional[float] = None, triangles: Optional[int] = None,
+                     camera: Any = None, pixels: Optional[float] = None, fov: float = 60.0,
+                     height: float = 1080.0) -> np.ndarray:
+        """The ids (uint32) of the clusters one cut draws; the arguments are :meth:`cut`'s."""
+        return self._cut(error, triangles, camera, pixels, fov, height)[0]
+
+    def cut(self, *, error: Optional[float] = None, triangles: Optional[int] = None,
+            camera: Any = None, pixels: Optional[float] = None, fov: float = 60.0,
+            height: float = 1080.0) -> Mesh:
+        """One cut of the DAG as a :class:`Mesh`; give one of:
+
+        - ``error``: object space, a fraction of the bounding-box diagonal: the clusters whose
+          own error is at most it and whose group's is over it;
+        - ``triangles``: the finest object-space cut with at most that many triangles;
+        - ``camera`` (x, y, z) with ``pixels``: the view-dependent cut whose projected error is
+          at most ``pixels`` for a camera there (``fov`` degrees vertically, ``height`` pixels).
+
+        Every cut of a closed mesh is closed: no cracks between clusters of different levels."""
+        return self._native.mesh_of(self._cut(error, triangles, camera, pixels, fov, height)[0])
+
+    def _cut(self, error, triangles, camera, pixels, fov, height):
+        if triangles is not None and (not isinstance(triangles, (int, np.integer))
+                                      or triangles < 0):
+            raise ValueError(f"triangles: expected a count, 0 or more, got {triangles!r}")
+        if camera is not None:
+            eye = np.asarray(camera, dtype=np.float64).reshape(-1)
+            if eye.shape != (3,):
+                raise ValueError(f"camera: expected (x, y, z), got {camera!r}")
+            camera = [float(x) for x in eye]
+        if (camera is None) != (pixels is None):
+            raise ValueError("camera and pixels go together")
+        return self._native.cut_clusters(
+            error=None if error is None else float(error),
+            triangles=None if triangles is None else int(triangles), camera=camera,
+            pixels=None if pixels is None else float(pixels), fov=float(fov),
+            height=float(height))
+
+    def write(self, path: str) -> None:
+        """Writes the DAG as a .mslod file (docs/MSLOD.md), which ``meshslim dag cut`` reads;
+        the file appears whole or not at all."""
+        self._native.write(str(path))
+
+    def __repr__(self) -> str:
+        return repr(self._native)
+
+
+def dag(mesh_or_vertices: Any, faces: Any = None, *, backend: str = "cpu",
+        cluster_triangles: int = 128, cluster_vertices: int = 255, group_size: int = 16,
+        colors: Any = None, uvs: Any = None, normals: Any = None,
+        color_weight: Optional[float] = None, uv_weight: Optional[float] = None,
+        normal_weight: Optional[float] = None,
+        progress: Optional[Callable[[float], Any]] = None) -> Dag:
+    """Builds a Nanite-style cluster DAG of a mesh (``meshslim dag build``): clusters of at most
+    ``cluster_triangles`` triangles and ``cluster_vertices`` vertices, groups of up to
+    ``group_size`` neighbouring clusters, each group simplified to half with its border to the
+    other groups pinned, level after level down to one root. Returns a :class:`Dag`.
+
+    ``backend``: ``"cpu"`` (the greedy on many groups at once across the cores), or
+    ``"cpu-parallel"`` / ``"gpu"`` (the rounds; the same bytes as each other), or ``"auto"``.
+    The arguments otherwise are :func:`simplify`'s."""
+    if isinstance(mesh_or_vertices, Mesh):
+        if faces is not None or colors is not None or uvs is not None or normals is not None:
+            raise ValueError("faces, colors, uvs and normals go with a vertex array, not a Mesh")
+        m = mesh_or_vertices
+    else:
+        if faces is None:
+            raise ValueError("faces: needed with a vertex array")
+        m = mesh(mesh_or_vertices, faces, normals=normals, uvs=uvs, colors=colors)
+    if progress is not None and not callable(progress):
+        raise ValueError("progress: expected a callable taking the fraction done")
+    for name, n in (("cluster_triangles", cluster_triangles),
+                    ("cluster_vertices", cluster_vertices), ("group_size", group_size)):
+        if not isinstance(n, (int, np.integer)) or n < 0:
+            raise ValueError(f"{name}: expected a count, got {n!r}")
+    native, report = _meshslim.dag_build(
+        m, backend=backend, cluster_triangles=int(cluster_triangles),
+        cluster_vertices=int(cluster_vertices), group_size=int(group_size),
+        color_weight=color_weight, uv_weight=uv_weight, normal_weight=normal_weight,
+        progress=progress)
+    return Dag(native, json.loads(report))
+
+
+def read_dag(path: str) -> Dag:
+    """Reads a .mslod file (as ``meshslim dag build`` writes it). Raises ``OSError`` when it
+    cannot be read and ``ValueError`` naming the byte offset when it is damaged."""
+    return Dag(_meshslim.read_dag(str(path)))

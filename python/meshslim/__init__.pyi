@@ -117,3 +117,60 @@ def remesh(
 
 def compare(a: Mesh, b: Mesh, *, samples: Optional[int] = ..., seed: Optional[int] = ...) -> dict:
     """Two-sided Metro distance, appearance, area, volume, quality and topology."""
+
+class Dag:
+    """A cluster DAG: clusters and groups as numpy arrays, cuts as meshes."""
+
+    NONE: int
+    report: Optional[dict]
+    clusters: dict[str, np.ndarray]
+    groups: dict[str, np.ndarray]
+    @property
+    def mesh(self) -> Mesh: ...
+    @property
+    def diagonal(self) -> float: ...
+    def cut(
+        self,
+        *,
+        error: Optional[float] = ...,
+        triangles: Optional[int] = ...,
+        camera: Any = ...,
+        pixels: Optional[float] = ...,
+        fov: float = ...,
+        height: float = ...,
+    ) -> Mesh:
+        """One cut: at an object-space error, a triangle budget, or from a camera."""
+    def cut_clusters(
+        self,
+        *,
+        error: Optional[float] = ...,
+        triangles: Optional[int] = ...,
+        camera: Any = ...,
+        pixels: Optional[float] = ...,
+        fov: float = ...,
+        height: float = ...,
+    ) -> npt.NDArray[np.uint32]:
+        """The ids of the clusters one cut draws."""
+    def write(self, path: str) -> None:
+        """Writes a .mslod file."""
+
+def dag(
+    mesh_or_vertices: Any,
+    faces: Any = ...,
+    *,
+    backend: str = ...,
+    cluster_triangles: int = ...,
+    cluster_vertices: int = ...,
+    group_size: int = ...,
+    colors: Any = ...,
+    uvs: Any = ...,
+    normals: Any = ...,
+    color_weight: Optional[float] = ...,
+    uv_weight: Optional[float] = ...,
+    normal_weight: Optional[float] = ...,
+    progress: Optional[Callable[[float], Any]] = ...,
+) -> Dag:
+    """Builds a Nanite-style cluster DAG."""
+
+def read_dag(path: str) -> Dag:
+    """Reads a .mslod file."""

@@ -9,9 +9,10 @@
 use meshslim::options::AttributeWeights;
 use meshslim::{Backend, Error, Method, SimplifyOptions};
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// A library error as the Python exception a user expects.
@@ -481,9 +482,213 @@ fn compare(
     })
 }
 
+/// A cluster DAG (Karis 2021; `meshslim dag build`): every level's triangles over one set of
+/// vertices, the clusters (meshlets) that index them, and the groups that join them.
+#[pyclass(name = "Dag", module = "meshslim", frozen)]
+struct PyDag {
+    inner: meshslim::dag::Dag,
+}
+
+/// Per item of `items`, `f` of it, as a 1-D numpy array.
+fn column<'py, I, T: numpy::Element>(
+    py: Python<'py>,
+    items: &[I],
+    f: impl Fn(&I) -> T,
+) -> Bound<'py, PyArray1<T>> {
+    items.iter().map(f).collect::<Vec<T>>().into_pyarray(py)
+}
+
+#[pymethods]
+impl PyDag {
+    /// The vertices and, cluster after cluster, the triangles of every level.
+    #[getter]
+    fn mesh(&self) -> PyMesh {
+        PyMesh {
+            inner: self.inner.mesh.clone(),
+        }
+    }
+
+    /// The input's bounding-box diagonal (object-space errors are fractions of it).
+    #[getter]
+    fn diagonal(&self) -> f64 {
+        self.inner.diagonal
+    }
+
+    /// The clusters as arrays, one entry per cluster: `first_triangle`, `triangle_count`,
+    /// `depth`, `group` (the group that simplifies it, 2**32-1 for a root), `parent_group` (the
+    /// group that made it, 2**32-1 at depth 0) as uint32; `bounds` and `lod_sphere` (k, 4)
+    /// float32 (centre, radius); `error` float32, in mesh units.
+    fn clusters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let c = &self.inner.clusters;
+        let d = PyDict::new(py);
+        d.set_item("first_triangle", column(py, c, |c| c.first_triangle))?;
+        d.set_item("triangle_count", column(py, c, |c| c.triangle_count))?;
+        d.set_item("depth", column(py, c, |c| c.depth))?;
+        d.set_item("group", column(py, c, |c| c.group))?;
+        d.set_item("parent_group", column(py, c, |c| c.parent_group))?;
+        let bounds: Vec<[f32; 4]> = c.iter().map(|c| c.bounds).collect();
+        d.set_item("bounds", array(py, &bounds))?;
+        let lod: Vec<[f32; 4]> = c.iter().map(|c| c.lod_sphere).collect();
+        d.set_item("lod_sphere", array(py, &lod))?;
+        d.set_item("error", column(py, c, |c| c.error))?;
+        Ok(d)
+    }
+
+    /// The groups as arrays, one entry per group: `depth` uint32 (of the clusters it
+    /// simplifies), `sphere` (g, 4) float32, `error` float32 in mesh units.
+    fn groups<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let g = &self.inner.groups;
+        let d = PyDict::new(py);
+        d.set_item("depth", column(py, g, |g| g.depth))?;
+        let spheres: Vec<[f32; 4]> = g.iter().map(|g| g.sphere).collect();
+        d.set_item("sphere", array(py, &spheres))?;
+        d.set_item("error", column(py, g, |g| g.error))?;
+        Ok(d)
+    }
+
+    /// The clusters of one cut and, for an object-space one, its threshold (of the diagonal):
+    /// see the wrapper's `Dag.cut`.
+    #[pyo3(signature = (*, error=None, triangles=None, camera=None, pixels=None, fov=60.0,
+        height=1080.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn cut_clusters<'py>(
+        &self,
+        py: Python<'py>,
+        error: Option<f64>,
+        triangles: Option<usize>,
+        camera: Option<[f64; 3]>,
+        pixels: Option<f64>,
+        fov: f64,
+        height: f64,
+    ) -> PyResult<(Bound<'py, PyArray1<u32>>, Option<f64>)> {
+        guarded(|| {
+            let dag = &self.inner;
+            let diagonal = dag.diagonal.max(f64::MIN_POSITIVE);
+            let (ids, threshold) = match (error, triangles, camera, pixels) {
+                (Some(e), None, None, None) => {
+                    if !(e >= 0.0 && e.is_finite()) {
+                        return Err(PyValueError::new_err(format!(
+                            "error: must be a finite number, 0 or more, got {e}"
+                        )));
+                    }
+                    (dag.cut_at_error(e * dag.diagonal), Some(e))
+                }
+                (None, Some(n), None, None) => {
+                    let (ids, t) = py.detach(|| dag.cut_to_triangles(n));
+                    (ids, Some(t / diagonal))
+                }
+                (None, None, Some(eye), Some(pixels)) => {
+                    let cam = meshslim::dag::CameraCut {
+                        eye,
+                        pixels,
+                        fov_deg: fov,
+                        height,
+                    };
+                    cam.check().map_err(raise)?;
+                    (dag.cut_from_camera(&cam), None)
+                }
+                _ => {
+                    return Err(PyValueError::new_err(
+                        "give one of error=E, triangles=N, or camera=(x, y, z) with pixels=P",
+                    ));
+                }
+            };
+            Ok((ids.into_pyarray(py), threshold))
+        })
+    }
+
+    /// The mesh of the clusters `ids` (from `cut_clusters`): their triangles, the vertices
+    /// they use.
+    fn mesh_of(&self, ids: Vec<u32>) -> PyResult<PyMesh> {
+        let n = self.inner.clusters.len();
+        if let Some(i) = ids.iter().position(|&c| c as usize >= n) {
+            return Err(PyValueError::new_err(format!(
+                "ids: entry {i} is {} but there are {n} clusters",
+                ids[i]
+            )));
+        }
+        Ok(PyMesh {
+            inner: self.inner.mesh_of(&ids),
+        })
+    }
+
+    /// Writes the DAG as a .mslod file (docs/MSLOD.md).
+    fn write(&self, py: Python<'_>, path: std::path::PathBuf) -> PyResult<()> {
+        guarded(|| {
+            py.detach(|| meshslim::dag::file::write(&path, &self.inner))
+                .map_err(raise)
+        })
+    }
+
+    fn __repr__(&self) -> String {
+        let d = &self.inner;
+        format!(
+            "meshslim.Dag({} levels, {} clusters, {} groups, {} triangles)",
+            d.levels(),
+            d.clusters.len(),
+            d.groups.len(),
+            d.mesh.triangles.len()
+        )
+    }
+}
+
+/// Builds the cluster DAG of `mesh`; returns it and the report as JSON.
+#[pyfunction]
+#[pyo3(signature = (mesh, *, backend="cpu", cluster_triangles=128, cluster_vertices=255,
+    group_size=16, color_weight=None, uv_weight=None, normal_weight=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn dag_build(
+    py: Python<'_>,
+    mesh: &PyMesh,
+    backend: &str,
+    cluster_triangles: usize,
+    cluster_vertices: usize,
+    group_size: usize,
+    color_weight: Option<f64>,
+    uv_weight: Option<f64>,
+    normal_weight: Option<f64>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(PyDag, String)> {
+    guarded(|| {
+        let mut opts = SimplifyOptions::with_faces(0);
+        let weights = (color_weight, uv_weight, normal_weight);
+        configure(&mut opts, "qem", backend, false, weights)?;
+        let dag_opts = meshslim::dag::DagOptions {
+            max_triangles: cluster_triangles,
+            max_vertices: cluster_vertices,
+            group_size,
+            backend: opts.backend,
+            attributes: opts.attributes,
+            cancel: opts.cancel.clone(),
+            ..Default::default()
+        };
+        let m = &mesh.inner;
+        let (dag, report) = detached(py, &opts, progress, |_, p| {
+            meshslim::dag::build_with_progress(m, &dag_opts, p)
+        })?;
+        let json = serde_json::to_string(&report)
+            .map_err(|e| PyRuntimeError::new_err(format!("the report: {e}")))?;
+        Ok((PyDag { inner: dag }, json))
+    })
+}
+
+/// Reads a .mslod file.
+#[pyfunction]
+fn read_dag(py: Python<'_>, path: std::path::PathBuf) -> PyResult<PyDag> {
+    guarded(|| {
+        let inner = py
+            .detach(|| meshslim::dag::file::read(&path))
+            .map_err(raise)?;
+        Ok(PyDag { inner })
+    })
+}
+
 #[pymodule]
 fn _meshslim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyMesh>()?;
+    m.add_class::<PyDag>()?;
+    m.add_function(wrap_pyfunction!(dag_build, m)?)?;
+    m.add_function(wrap_pyfunction!(read_dag, m)?)?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(write, m)?)?;
     m.add_function(wrap_pyfunction!(simplify, m)?)?;

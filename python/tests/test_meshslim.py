@@ -303,3 +303,79 @@ def test_trimesh_round_trip_of_spot_keeps_its_uvs():
     assert small.visual.kind == "texture"
     assert small.visual.uv.shape == (len(small.vertices), 2)
     assert abs(len(small.faces) - 0.1 * len(spot.faces)) <= 1
+
+
+def edges_used(F):
+    """How many faces use each undirected edge of F (a closed manifold: every edge twice)."""
+    e = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    return np.unique(e, axis=0, return_counts=True)[1]
+
+
+def test_dag_arrays_cuts_and_file_match_the_command_line(tmp_path):
+    V, F = torus()
+    seen = []
+    lod = meshslim.dag(V, F, progress=seen.append)
+    assert seen and seen[-1] == 1.0
+    c, g = lod.clusters, lod.groups
+    k = len(c["error"])
+    assert k == lod.report["clusters"] and len(g["error"]) == lod.report["groups"]
+    for name in ("first_triangle", "triangle_count", "depth", "group", "parent_group"):
+        assert c[name].dtype == np.uint32 and c[name].shape == (k,), name
+    assert c["bounds"].shape == (k, 4) and c["lod_sphere"].dtype == np.float32
+    assert (c["triangle_count"] <= 128).all()
+    assert c["triangle_count"][c["depth"] == 0].sum() == len(F)
+    assert lod.report["root_groups"] == 1 and lod.report["stuck_groups"] == 0
+    # Errors only grow: a cluster's group errs at least as much as the cluster.
+    inner = c["group"] != meshslim.Dag.NONE
+    assert (g["error"][c["group"][inner]] >= c["error"][inner]).all()
+    coarse = None
+    for e in (0.0, 0.002, 0.01, 0.05):
+        cut = lod.cut(error=e)
+        assert (edges_used(cut.faces) == 2).all(), f"a crack at {e}"
+        assert coarse is None or len(cut.faces) <= coarse
+        coarse = len(cut.faces)
+    assert len(lod.cut(error=0.0).faces) == len(F)
+    near = lod.cut(camera=(2.0, 0.0, 0.5), pixels=1.0, height=720)
+    assert (edges_used(near.faces) == 2).all()
+    assert len(lod.cut(triangles=1000).faces) <= 1000
+    ids = lod.cut_clusters(error=0.01)
+    assert ids.dtype == np.uint32 and c["triangle_count"][ids].sum() == len(lod.cut(error=0.01).faces)
+    # The file reads back, and the command line cuts it to the bytes Python writes.
+    path = tmp_path / "torus.mslod"
+    lod.write(path)
+    back = meshslim.read_dag(path)
+    for name in c:
+        assert np.array_equal(back.clusters[name], c[name]), name
+    subprocess.run([str(CLI), "dag", "cut", str(path), str(tmp_path / "cli.ply"), "--error",
+                    "0.01"], check=True, capture_output=True)
+    meshslim.write(tmp_path / "py.ply", back.cut(error=0.01))
+    assert (tmp_path / "py.ply").read_bytes() == (tmp_path / "cli.ply").read_bytes()
+
+
+def test_dag_errors_name_what_is_wrong(tmp_path):
+    V, F = torus(24, 12)
+    lod = meshslim.dag(V, F)
+    for kwargs, message in [
+        ({}, "give one of"),
+        ({"error": 0.01, "triangles": 10}, "give one of"),
+        ({"error": -1.0}, "0 or more"),
+        ({"camera": (0, 0, 5)}, "camera and pixels"),
+        ({"camera": (0, 0), "pixels": 1.0}, r"camera: expected \(x, y, z\)"),
+        ({"camera": (0, 0, 5), "pixels": 1.0, "fov": 200}, "field of view"),
+        ({"triangles": -3}, "triangles"),
+    ]:
+        with pytest.raises(ValueError, match=message):
+            lod.cut(**kwargs)
+    with pytest.raises(ValueError, match="group size"):
+        meshslim.dag(V, F, group_size=1)
+    with pytest.raises(ValueError, match="backend"):
+        meshslim.dag(V, F, backend="tpu")
+    with pytest.raises(OSError, match="nope.mslod"):
+        meshslim.read_dag(tmp_path / "nope.mslod")
+    path = tmp_path / "d.mslod"
+    lod.write(path)
+    data = bytearray(path.read_bytes())
+    data[-20] ^= 0xFF
+    path.write_bytes(bytes(data))
+    with pytest.raises(ValueError, match="d.mslod"):
+        meshslim.read_dag(path)
