@@ -94,8 +94,8 @@ pub fn group(members: &[Member<'_>], class: &[u32], size: usize) -> Vec<Vec<u32>
     // The groups renumbered densely, in order of their first cluster.
     let mut dense = vec![u32::MAX; n];
     let mut groups: Vec<Vec<u32>> = Vec::new();
-    for c in 0..n {
-        let g = group_of[c] as usize;
+    for &g in &group_of {
+        let g = g as usize;
         if dense[g] == u32::MAX {
             dense[g] = groups.len() as u32;
             groups.push(std::mem::take(&mut parts[g]));
