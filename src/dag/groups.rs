@@ -8,6 +8,7 @@
 
 use super::dist2;
 use super::meshlets::{edge_key, morton_order, sort};
+use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
 /// What the grouping needs of one cluster.
@@ -38,7 +39,7 @@ pub fn group(members: &[Member<'_>], class: &[u32], size: usize) -> Vec<Vec<u32>
     let mut group_of: Vec<u32> = (0..n as u32).collect();
     let mut parts: Vec<Vec<u32>> = (0..n as u32).map(|c| vec![c]).collect();
     let mut verts: Vec<u32> = members
-        .iter()
+        .par_iter()
         .map(|m| {
             let mut v: Vec<u32> = m
                 .triangles
@@ -207,19 +208,31 @@ impl Links {
 }
 
 fn links(members: &[Member<'_>], class: &[u32]) -> Links {
-    let mut edges: Vec<(u64, u32)> = Vec::new();
-    for (c, m) in members.iter().enumerate() {
-        for t in m.triangles {
-            for k in 0..3 {
-                let (a, b) = (class[t[k] as usize], class[t[(k + 1) % 3] as usize]);
-                if a != b {
-                    edges.push((edge_key(a, b), c as u32));
+    // Each cluster's border first, on every core: the edges only one of its triangles has (an
+    // edge two of them share cannot be another cluster's on a manifold surface). Sorting every
+    // edge of the level at once instead took most of the grouping's 0.27 s on the 1M scan's
+    // first level; its borders are a tenth of its edges.
+    let mut edges: Vec<(u64, u32)> = members
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(c, m)| {
+            let mut own: Vec<u64> = Vec::with_capacity(3 * m.triangles.len());
+            for t in m.triangles {
+                for k in 0..3 {
+                    let (a, b) = (class[t[k] as usize], class[t[(k + 1) % 3] as usize]);
+                    if a != b {
+                        own.push(edge_key(a, b));
+                    }
                 }
             }
-        }
-    }
+            own.sort_unstable();
+            own.chunk_by(|a, b| a == b)
+                .filter(|run| run.len() == 1)
+                .map(|run| (run[0], c as u32))
+                .collect::<Vec<_>>()
+        })
+        .collect();
     sort(&mut edges);
-    edges.dedup();
     let mut pairs: Vec<(u32, u32, u32)> = Vec::new();
     for run in edges.chunk_by(|a, b| a.0 == b.0) {
         for (i, a) in run.iter().enumerate() {
