@@ -9,6 +9,8 @@
 #
 #   INPUT            binary little-endian PLY or OBJ (triangles only)
 #   --cut E1,E2,...  DAG cuts at these errors, as fractions of the input's bounding-box diagonal
+#   --cut-triangles N1,N2,...
+#                    the finest DAG cut with at most each many triangles (P-t<N>.ply)
 #   --out-prefix P   write each cut as P-<E>.ply (only with a single INPUT: the names would clash)
 #
 #   MESHOPT_SRC      meshoptimizer source folder [/tmp/meshoptimizer-src]; a folder that already

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Our cluster DAG (`meshslim dag build`) beside meshoptimizer's clusterlod.h on the same inputs:
 # build time, triangles per level, the DAG's size, and at five object-space errors the mean
-# two-sided distance (`meshslim compare`) of clusterlod's cut against ours cut to the same
-# triangle count (`dag cut --triangles N`). Prints a Markdown table per input.
+# two-sided distance (`meshslim compare`) of clusterlod's cut against ours cut to at most as many
+# triangles (`dag cut --triangles N`), and of that cut of ours against clusterlod's finest cut with
+# at most as many as ours has (the driver's --cut-triangles): the two ways of pairing cuts of the
+# same size when a DAG has no cut of exactly that size. Prints a Markdown table per input.
 #
 #   bash benches/dag_vs_clusterlod.sh INPUT...
 #   bash benches/dag_vs_clusterlod.sh .dev/scan-1m.ply .dev/torus-1m.ply
@@ -45,15 +47,26 @@ for input in "$@"; do
   echo "| clusters, groups | $(echo "$clod" | field 'str(d["clusters"])+", "+str(d["groups"])') | $(echo "$ours" | field 'str(d["clusters"])+", "+str(d["groups"])') |"
   echo "| stuck groups | | $(echo "$ours" | field 'd["stuck_groups"]') |"
   echo
-  echo "| error (of the diagonal) | triangles | clusterlod mean distance | ours at as many triangles | ours / clusterlod |"
-  echo "|---|---|---|---|---|"
+  ours_counts=()
   for e in ${errors//,/ }; do
     n=$(echo "$clod" | field "[c['triangles'] for c in d['cuts'] if abs(c['error']-$e)<1e-12][0]")
     "$bin" dag cut "$work/ours.mslod" "$work/ours-$e.ply" --triangles "$n" --json > "$work/cut.json"
-    ours_n=$(field 'd["triangles"]' < "$work/cut.json")
+    ours_counts+=("$(field 'd["triangles"]' < "$work/cut.json")")
+  done
+  counts=$(IFS=,; echo "${ours_counts[*]}")
+  again=$(bash "$here/clusterlod.sh" "$input" -- --cut-triangles "$counts" --out-prefix "$work/clod")
+  echo "| error (of the diagonal) | clusterlod triangles | its distance | ours at most as many | our distance | ours / clusterlod | clusterlod at most as many as ours | its distance | ours / it |"
+  echo "|---|---|---|---|---|---|---|---|---|"
+  i=0
+  for e in ${errors//,/ }; do
+    n=$(echo "$clod" | field "[c['triangles'] for c in d['cuts'] if abs(c['error']-$e)<1e-12][0]")
+    ours_n=${ours_counts[$i]}
+    back_n=$(echo "$again" | field "[c['triangles'] for c in d['triangle_cuts'] if c['triangles_max']==$ours_n][0]")
     a=$(mean_rel "$input" "$work/clod-$e.ply")
     b=$(mean_rel "$input" "$work/ours-$e.ply")
-    echo "| $e | $n (ours $ours_n) | $(printf %.3e "$a") | $(printf %.3e "$b") | $(python3 -c "print(round($b/$a,3))") |"
+    c=$(mean_rel "$input" "$work/clod-t$ours_n.ply")
+    echo "| $e | $n | $(printf %.3e "$a") | $ours_n | $(printf %.3e "$b") | $(python3 -c "print(round($b/$a,3))") | $back_n | $(printf %.3e "$c") | $(python3 -c "print(round($b/$c,3))") |"
+    i=$((i+1))
   done
   echo
 done

@@ -3,12 +3,14 @@
 // benches/clusterlod.sh, which extracts meshoptimizer's source into a scratch folder outside the
 // repository (it is never committed here) and compiles this file against it.
 //
-//   clusterlod-driver INPUT.{ply,obj} [--cut E1,E2,...] [--out-prefix P]
+//   clusterlod-driver INPUT.{ply,obj} [--cut E1,E2,...] [--cut-triangles N1,N2,...] [--out-prefix P]
 //
 // Reads the mesh (binary little-endian PLY, or OBJ), builds the DAG with clodDefaultConfig(128)
 // on one thread from positions only, and prints one JSON object on stdout. --cut takes error
 // thresholds as fractions of the input's bounding-box diagonal; for each it selects the DAG cut
 // at that error and, with --out-prefix, writes the cut as P-<E>.ply (binary little endian).
+// --cut-triangles takes triangle counts; for each it selects the finest cut at a threshold with
+// at most that many triangles (bisection over the groups' errors) and writes it as P-t<N>.ply.
 #include <errno.h>
 #include <float.h>
 #include <stdarg.h>
@@ -297,12 +299,13 @@ static std::string json(const std::string& s) {
 int main(int argc, char** argv) {
     const uint32_t one = 1;
     if (*(const unsigned char*)&one != 1) die("this driver assumes a little-endian host");
-    const char* usage = "usage: clusterlod-driver INPUT.{ply,obj} [--cut E1,E2,...] [--out-prefix P]";
+    const char* usage = "usage: clusterlod-driver INPUT.{ply,obj} [--cut E1,E2,...] [--cut-triangles N1,N2,...] [--out-prefix P]";
     const char* input = NULL;
-    std::string cut_list, prefix;
+    std::string cut_list, prefix, count_list;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         if ((a == "--cut" || a == "--out-prefix") && i + 1 < argc) (a == "--cut" ? cut_list : prefix) = argv[++i];
+        else if (a == "--cut-triangles" && i + 1 < argc) count_list = argv[++i];
         else if (a[0] != '-' && !input) input = argv[i];
         else die("%s (bad argument '%s')", usage, a.c_str());
     }
@@ -316,6 +319,17 @@ int main(int argc, char** argv) {
         if (token.empty() || *end || !(e >= 0)) die("--cut: '%s' is not a non-negative number", token.c_str());
         cut_names.push_back(token);
         cuts.push_back(e);
+    }
+
+    std::vector<std::string> count_names;
+    std::vector<size_t> counts;
+    std::istringstream count_stream(count_list);
+    for (std::string token; std::getline(count_stream, token, ',');) {
+        char* end;
+        unsigned long long n = strtoull(token.c_str(), &end, 10);
+        if (token.empty() || *end || token[0] == '-') die("--cut-triangles: '%s' is not a count", token.c_str());
+        count_names.push_back(token);
+        counts.push_back(size_t(n));
     }
 
     std::string data = readFile(input);
@@ -379,23 +393,49 @@ int main(int argc, char** argv) {
     }
     printf("], \"cuts\": [");
 
-    for (size_t ci = 0; ci < cuts.size(); ++ci) {
-        double t = cuts[ci] * diagonal;
-        // The rule from clusterlod.h. groups[refined].simplified.error is the error of the cluster
-        // itself (it is part of that group's simplified output; 0 for original geometry), and the
-        // simplified error of the group it is in is that of its next coarser version (FLT_MAX when
-        // there is none): render the clusters that are fine enough while their coarser version is not.
+    // The rule from clusterlod.h. groups[refined].simplified.error is the error of the cluster
+    // itself (it is part of that group's simplified output; 0 for original geometry), and the
+    // simplified error of the group it is in is that of its next coarser version (FLT_MAX when
+    // there is none): render the clusters that are fine enough while their coarser version is not.
+    auto cut = [&](double t, size_t* clusters) {
         std::vector<unsigned int> tris;
-        size_t clusters = 0;
+        *clusters = 0;
         for (const Cluster& c : dag.clusters)
             if (dag.groups[c.group].simplified.error > t && (c.refined == -1 || dag.groups[c.refined].simplified.error <= t)) {
                 tris.insert(tris.end(), &dag.indices[c.first], &dag.indices[c.first] + c.count);
-                clusters++;
+                ++*clusters;
             }
+        return tris;
+    };
+    for (size_t ci = 0; ci < cuts.size(); ++ci) {
+        double t = cuts[ci] * diagonal;
+        size_t clusters;
+        std::vector<unsigned int> tris = cut(t, &clusters);
         std::string file = prefix.empty() ? "" : prefix + "-" + cut_names[ci] + ".ply";
         if (!file.empty()) writePly(file, mesh, tris);
         printf("%s{\"error\": %.9g, \"threshold\": %.9g, \"triangles\": %zu, \"clusters\": %zu, \"file\": %s}", ci ? ", " : "",
             cuts[ci], t, tris.size() / 3, clusters, file.empty() ? "null" : json(file).c_str());
+    }
+    printf("], \"triangle_cuts\": [");
+    // The cut only changes at a group's error: the smallest of those (or 0) whose cut fits, by
+    // bisection (a larger threshold never draws more triangles).
+    std::vector<double> at(1, 0.0);
+    for (const clodGroup& g : dag.groups)
+        if (g.simplified.error < FLT_MAX) at.push_back(g.simplified.error);
+    std::sort(at.begin(), at.end());
+    at.erase(std::unique(at.begin(), at.end()), at.end());
+    for (size_t ci = 0; ci < counts.size(); ++ci) {
+        size_t lo = 0, hi = at.size() - 1, clusters;
+        while (lo < hi) {
+            size_t mid = (lo + hi) / 2;
+            if (cut(at[mid], &clusters).size() / 3 <= counts[ci]) hi = mid;
+            else lo = mid + 1;
+        }
+        std::vector<unsigned int> tris = cut(at[lo], &clusters);
+        std::string file = prefix.empty() ? "" : prefix + "-t" + count_names[ci] + ".ply";
+        if (!file.empty()) writePly(file, mesh, tris);
+        printf("%s{\"triangles_max\": %zu, \"error\": %.9g, \"triangles\": %zu, \"clusters\": %zu, \"file\": %s}", ci ? ", " : "",
+            counts[ci], at[lo] / diagonal, tris.size() / 3, clusters, file.empty() ? "null" : json(file).c_str());
     }
     printf("]}\n");
     return 0;

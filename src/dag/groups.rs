@@ -107,10 +107,11 @@ pub fn group(members: &[Member<'_>], class: &[u32], size: usize) -> Vec<Vec<u32>
     merge_small(groups, &group_of, &links, &centers, size)
 }
 
-/// Groups under half `size` (the leftovers a greedy sweep strands between full groups) joined
-/// to the neighbouring group they share most edges with, while that stays within 1.5 `size`:
-/// a small group has a long pinned border for its triangles, and halving it anyway gave the
-/// 1M scan's DAG its largest errors, which every coarser group then inherits.
+/// Groups under half `size` (those whose every neighbour was too large to join) joined to the
+/// neighbouring group they share most edges with, while that stays within 1.5 `size`, or, with
+/// no neighbour, to the nearest group along the Morton curve: a small group has a long pinned
+/// border for its triangles, and halving it anyway gave the 1M scan's DAG its largest errors
+/// (with the earlier greedy grouping), which every coarser group then inherits.
 fn merge_small(
     mut groups: Vec<Vec<u32>>,
     group_of: &[u32],
