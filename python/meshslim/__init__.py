@@ -124,6 +124,23 @@ def write(path: str, mesh: Mesh) -> None:
     _meshslim.write(str(path), mesh)
 
 
+def _input(mesh_or_vertices: Any, faces: Any, normals: Any, uvs: Any, colors: Any,
+           progress: Any) -> Mesh:
+    """The mesh a call was given, as a :class:`Mesh` or as arrays, and its progress callback
+    checked: what :func:`simplify` and :func:`dag` take alike."""
+    if isinstance(mesh_or_vertices, Mesh):
+        if faces is not None or colors is not None or uvs is not None or normals is not None:
+            raise ValueError("faces, colors, uvs and normals go with a vertex array, not a Mesh")
+        m = mesh_or_vertices
+    else:
+        if faces is None:
+            raise ValueError("faces: needed with a vertex array")
+        m = mesh(mesh_or_vertices, faces, normals=normals, uvs=uvs, colors=colors)
+    if progress is not None and not callable(progress):
+        raise ValueError("progress: expected a callable taking the fraction done")
+    return m
+
+
 def simplify(mesh_or_vertices: Any, faces: Any = None, *, ratio: Optional[float] = None,
              target_faces: Optional[int] = None, max_error: Optional[float] = None,
              method: str = "qem", backend: str = "cpu", lock_border: bool = False,
@@ -152,16 +169,7 @@ def simplify(mesh_or_vertices: Any, faces: Any = None, *, ratio: Optional[float]
     (``KeyboardInterrupt``). Other Python threads run meanwhile (the GIL is released). Bad
     arguments raise ``ValueError`` naming them.
     """
-    if isinstance(mesh_or_vertices, Mesh):
-        if faces is not None or colors is not None or uvs is not None or normals is not None:
-            raise ValueError("faces, colors, uvs and normals go with a vertex array, not a Mesh")
-        m = mesh_or_vertices
-    else:
-        if faces is None:
-            raise ValueError("faces: needed with a vertex array")
-        m = mesh(mesh_or_vertices, faces, normals=normals, uvs=uvs, colors=colors)
-    if progress is not None and not callable(progress):
-        raise ValueError("progress: expected a callable taking the fraction done")
+    m = _input(mesh_or_vertices, faces, normals, uvs, colors, progress)
     out, report = _meshslim.simplify(
         m, ratio=ratio, target_faces=target_faces, max_error=max_error, method=method,
         backend=backend, lock_border=lock_border, color_weight=color_weight,
@@ -298,16 +306,7 @@ def dag(mesh_or_vertices: Any, faces: Any = None, *, backend: str = "cpu",
     ``backend``: ``"cpu"`` (the greedy on many groups at once across the cores), or
     ``"cpu-parallel"`` / ``"gpu"`` (the rounds; the same bytes as each other), or ``"auto"``.
     The arguments otherwise are :func:`simplify`'s."""
-    if isinstance(mesh_or_vertices, Mesh):
-        if faces is not None or colors is not None or uvs is not None or normals is not None:
-            raise ValueError("faces, colors, uvs and normals go with a vertex array, not a Mesh")
-        m = mesh_or_vertices
-    else:
-        if faces is None:
-            raise ValueError("faces: needed with a vertex array")
-        m = mesh(mesh_or_vertices, faces, normals=normals, uvs=uvs, colors=colors)
-    if progress is not None and not callable(progress):
-        raise ValueError("progress: expected a callable taking the fraction done")
+    m = _input(mesh_or_vertices, faces, normals, uvs, colors, progress)
     for name, n in (("cluster_triangles", cluster_triangles),
                     ("cluster_vertices", cluster_vertices), ("group_size", group_size)):
         if not isinstance(n, (int, np.integer)) or n < 0:
