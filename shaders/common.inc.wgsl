@@ -12,6 +12,7 @@ const FLAG_BORDER: u32 = 1u;
 const FLAG_PINNED: u32 = 2u;
 const FLAG_SEAM: u32 = 4u;
 const FLAG_MOVED: u32 = 8u;
+const FLAG_CLOSED: u32 = 16u;
 
 const STATE_OUT: u32 = 0u;
 const STATE_CANDIDATE: u32 = 1u;
@@ -35,7 +36,7 @@ struct Params {
     max_error2: f32,
     attributes: u32,
     color_weight: f32,
-    _pad: u32,
+    groups: u32,
 }
 
 struct ScanParams {
@@ -58,6 +59,8 @@ const C_VERTICES_OUT: u32 = 8u;
 const C_FACES_OUT: u32 = 9u;
 const C_TENTATIVE: u32 = 10u;
 const C_LIVE: u32 = 11u;
+const C_OPEN_GROUPS: u32 = 12u;
+const C_OPEN_EXCESS: u32 = 13u;
 const COUNTERS: u32 = 16u;
 
 struct Counters {
@@ -73,7 +76,9 @@ struct Counters {
     faces_out: u32,
     tentative: u32,
     live: u32,
-    _pad: array<u32, 4>,
+    open_groups: u32,
+    open_excess: u32,
+    _pad: array<u32, 2>,
 }
 
 // Keep in sync with PlanState and Planned in src/compute/types.rs.

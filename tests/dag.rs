@@ -1,6 +1,6 @@
 //! Cluster DAGs (`meshslim::dag`): the clusters' limits, errors that only grow, cuts that stay
 //! closed from any view, the .mslod file and its reader's errors, the same bytes on any number
-//! of threads, and `gpu` = `cpu-parallel`.
+//! of threads, `gpu` = `cpu-parallel`, and the grouped rounds a level is simplified with.
 
 mod common;
 
@@ -290,6 +290,91 @@ fn bad_options_are_errors() {
     }
     let (d, r) = built(&Mesh::default(), &DagOptions::default());
     assert_eq!((d.clusters.len(), r.levels), (0, 1));
+}
+
+/// A noisy sphere in four groups by the signs of x and y, the vertices two groups share
+/// pinned, each group with its own target: half, a quarter, all of its faces (already met),
+/// a third.
+fn four_groups() -> (Mesh, Vec<u32>, Vec<u32>, Vec<u32>) {
+    let mut m = mesh::noisy_sphere(4, 0.01, 5);
+    let group: Vec<u32> = m
+        .triangles
+        .iter()
+        .map(|t| {
+            let c = t.map(|v| m.positions[v as usize]);
+            let x = c[0][0] + c[1][0] + c[2][0];
+            let y = c[0][1] + c[1][1] + c[2][1];
+            (x > 0.0) as u32 + 2 * (y > 0.0) as u32
+        })
+        .collect();
+    let mut owner = vec![u32::MAX; m.positions.len()];
+    let mut pin = Vec::new();
+    for (t, &g) in m.triangles.iter().zip(&group) {
+        for &v in t {
+            match owner[v as usize] {
+                u32::MAX => owner[v as usize] = g,
+                o if o != g && o != u32::MAX - 1 => {
+                    owner[v as usize] = u32::MAX - 1;
+                    pin.push(v);
+                }
+                _ => {}
+            }
+        }
+    }
+    let mut count = [0u32; 4];
+    for &g in &group {
+        count[g as usize] += 1;
+    }
+    let targets = vec![count[0] / 2, count[1] / 4, count[2], count[3] / 3];
+    m.face_groups = Some(group);
+    m.groups = (0..4).map(|g| format!("quarter {g}")).collect();
+    (m, targets, count.to_vec(), pin)
+}
+
+/// Grouped rounds (one run for every group of a DAG level): each group ends at or just under
+/// its own target, a group already at its target is left as it was, the shared border stays
+/// where it was, and each group's error is its own.
+#[test]
+fn grouped_rounds_land_each_group_on_its_own_target() {
+    let (m, targets, count, pin) = four_groups();
+    let opts = meshslim::SimplifyOptions {
+        pin: pin.clone(),
+        ..meshslim::SimplifyOptions::with_faces(0)
+    };
+    let run = |b| meshslim::rounds::simplify_grouped(&m, targets.clone(), b, &opts).unwrap();
+    let (out, errors) = run(Backend::CpuParallel);
+    let mut kept = [0u32; 4];
+    for &g in out.face_groups.as_ref().unwrap() {
+        kept[g as usize] += 1;
+    }
+    for g in 0..4 {
+        let (k, t) = (kept[g], targets[g]);
+        if t >= count[g] {
+            assert_eq!(k, count[g], "group {g} was at its target: untouched");
+            assert_eq!(errors[g], 0.0, "group {g}: no collapse, no error");
+        } else {
+            // A round removes a sixth of a group's faces or so: its last lands within that.
+            assert!(
+                k <= t && k * 4 >= t * 3,
+                "group {g}: {k} faces for a target of {t}"
+            );
+            assert!(errors[g] > 0.0, "group {g}: collapses without an error");
+        }
+    }
+    let positions: std::collections::HashSet<[u32; 3]> =
+        out.positions.iter().map(|p| p.map(f32::to_bits)).collect();
+    for &v in &pin {
+        let p = m.positions[v as usize].map(f32::to_bits);
+        assert!(positions.contains(&p), "pinned vertex {v} moved or went");
+    }
+    assert_closed_manifold("grouped rounds", &out);
+    if gpu_context().is_some() && rounds_like_the_cpu() {
+        let (g, ge) = run(Backend::Gpu);
+        assert_eq!(g.positions, out.positions);
+        assert_eq!(g.triangles, out.triangles);
+        assert_eq!(g.face_groups, out.face_groups);
+        assert_eq!(ge, errors);
+    }
 }
 
 #[test]

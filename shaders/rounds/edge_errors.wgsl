@@ -129,6 +129,8 @@ fn held(q: Quadric, k: u32, r: u32, map: vec4<u32>, o: vec3<f32>) -> Quadric {
 fn evaluate(a: u32, b: u32) -> Verdict {
     let fla = flags[a];
     let flb = flags[b];
+    // A closed group's vertex (grouped rounds) takes part in no collapse.
+    if (((fla | flb) & FLAG_CLOSED) != 0u) { return invalid(); }
     // Seam vertices keep their position like pinned ones.
     let fixed_a = (fla & (FLAG_PINNED | FLAG_SEAM)) != 0u;
     let fixed_b = (flb & (FLAG_PINNED | FLAG_SEAM)) != 0u;

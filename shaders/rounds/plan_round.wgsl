@@ -1,7 +1,7 @@
 // One invocation: the next round of a batch planned on the device from the last round's
 // counters (parameters, prefix-sum counts, indirect grids), so the host waits once a batch.
 // Relies on rounds only shrinking the mesh: once a round removes nothing, grows it or reaches
-// the target, every grid of the batch is zero and the rounds past the stop change nothing.
+// the target (grouped rounds: every group's), every grid of the batch is zero and the rounds past the stop change nothing.
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> counters: array<u32, 16>;
@@ -21,8 +21,12 @@ fn plan_round() {
     if (plan.stopped == 0u) {
         let nv = counters[C_VERTICES_OUT];
         let nf = counters[C_FACES_OUT];
-        // Twin of cpu::plan_round::goes_on.
-        if (nf < plan.faces && nv <= plan.vertices && nf > plan.target_faces) {
+        // Twin of cpu::plan_round::goes_on: grouped rounds go on while a group is open.
+        var above = nf > plan.target_faces;
+        if (params.groups != 0u) {
+            above = counters[C_OPEN_GROUPS] != 0u;
+        }
+        if (nf < plan.faces && nv <= plan.vertices && above) {
             plan.vertices = nv;
             plan.faces = nf;
             plan.executed = plan.executed + 1u;
@@ -44,7 +48,13 @@ fn plan_round() {
     // Twin of cpu::plan_round::next_params. 5 × needed fits in u32: a face takes 12 bytes of
     // an index binding, so no device holds 2^32 / 5 faces.
     var p = params;
-    let needed = nf - plan.target_faces;
+    // Grouped rounds need the open groups' excess, and never trim.
+    var needed = 0u;
+    if (params.groups != 0u) {
+        needed = counters[C_OPEN_EXCESS];
+    } else if (nf > plan.target_faces) {
+        needed = nf - plan.target_faces;
+    }
     p.vertex_count = nv;
     p.face_count = nf;
     p.target_faces = plan.target_faces;
@@ -56,7 +66,7 @@ fn plan_round() {
         wanted = 2u * half;
     }
     p.ceiling_wanted = max(max(wanted, nf / 4u), 1u);
-    p.trim = select(0u, 1u, 5u * needed < 2u * nf);
+    p.trim = select(0u, 1u, 5u * needed < 2u * nf && params.groups == 0u);
     planned.params = p;
     let counts = vec3<u32>(nv, nf, p.edge_capacity);
     for (var i = 0u; i < 3u; i = i + 1u) {

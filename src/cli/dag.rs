@@ -55,7 +55,7 @@ pub struct BuildArgs {
     #[arg(value_name = "OUT")]
     pub output: PathBuf,
     /// What simplifies the groups: cpu runs the greedy on many groups at once across the
-    /// cores; cpu-parallel and gpu run the rounds on one group after another
+    /// cores; cpu-parallel and gpu run the rounds once per level, each group to its own target
     #[arg(short, long, value_enum, default_value = "cpu")]
     pub backend: BackendArg,
     /// Triangles per cluster at most

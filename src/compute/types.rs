@@ -35,6 +35,9 @@ pub mod flag {
     /// Moved by a collapse: the output takes its new position (unmoved vertices keep their
     /// input coordinates bit for bit).
     pub const MOVED: u32 = 8;
+    /// Grouped rounds ([`super::Params::groups`]): a free vertex whose group has reached its
+    /// target; no edge at it competes. Set each round by `group_flags`.
+    pub const CLOSED: u32 = 16;
 }
 
 /// Per-edge selection state (`edge_state` buffer). Keep in sync with shaders/common.inc.wgsl.
@@ -81,7 +84,10 @@ pub struct Params {
     /// The colour channels' weight: a solved colour is clamped to `0..color_weight`, the
     /// weighted value of 0..1.
     pub color_weight: f32,
-    pub _pad: u32,
+    /// Groups with a target of their own (the cluster DAG's level: one run for all its
+    /// groups), 0 for one target over the mesh. Grouped rounds never trim, and stop when no
+    /// group is over its target.
+    pub groups: u32,
 }
 
 /// [`Params::attributes`]: `m` channels in all (bits 0-3), the first `colors` of them a colour
@@ -140,7 +146,11 @@ pub struct Counters {
     pub tentative: u32,
     /// Candidates under the ceiling, listed by `live_list` for the per-candidate stages.
     pub live: u32,
-    pub _pad: [u32; 4],
+    /// Grouped rounds: the groups still over their target after the round (`group_open`)...
+    pub open_groups: u32,
+    /// ...and the faces they have over it, the next round's `needed_faces`.
+    pub open_excess: u32,
+    pub _pad: [u32; 2],
 }
 
 /// What the rounds' planner (`plan_round`) keeps between the rounds of a batch: the mesh's

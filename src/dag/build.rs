@@ -23,7 +23,8 @@ pub struct DagOptions {
     /// Clusters per group at most (meshoptimizer's clusterlod uses 16).
     pub group_size: usize,
     /// What simplifies each group: `cpu` runs the greedy on every group at once across the
-    /// cores; `cpu-parallel` and `gpu` run the rounds, one group after another.
+    /// cores; `cpu-parallel` and `gpu` run the rounds once per level, every group to its own
+    /// target (`auto` picks one of those two as `simplify` does).
     pub backend: Backend,
     pub attributes: AttributeWeights,
     /// A group whose simplification keeps more than this fraction of its triangles is stuck: its
@@ -231,10 +232,21 @@ impl Builder {
             .map(|g| g.into_iter().map(|i| pool[i as usize]).collect())
             .collect();
         let shared = self.shared_classes(&groups);
-        let run = |g: &Vec<u32>| self.simplify_group(g, &shared, opts);
         let results: Vec<Result<Simplified>> = match opts.backend {
-            Backend::Cpu => groups.par_iter().map(run).collect(),
-            _ => groups.iter().map(run).collect(),
+            Backend::Cpu => groups
+                .par_iter()
+                .map(|g| self.simplify_group(g, &shared, opts))
+                .collect(),
+            Backend::Auto => {
+                let b = crate::simplify::auto_backend().0;
+                match self.simplify_level(&groups, &shared, opts, b) {
+                    Err(Error::Gpu(_) | Error::BufferTooLarge { .. }) if b == Backend::Gpu => {
+                        self.simplify_level(&groups, &shared, opts, Backend::CpuParallel)?
+                    }
+                    r => r?,
+                }
+            }
+            b => self.simplify_level(&groups, &shared, opts, b)?,
         };
         let (mut next, mut simplified, mut stuck) = (Vec::new(), 0, 0);
         for (g, r) in groups.iter().zip(results) {
@@ -272,23 +284,35 @@ impl Builder {
         shared
     }
 
-    /// The group's triangles as a mesh of their own, the shared border pinned, simplified to
-    /// half.
-    fn simplify_group(&self, g: &[u32], shared: &[bool], opts: &DagOptions) -> Result<Simplified> {
+    /// The triangles of `groups` as one mesh over the DAG vertices they use (`ids`, in order
+    /// of first use), each face's group in `face_groups`, the vertices on the borders between
+    /// groups (`shared` classes) pinned.
+    fn input_of(
+        &self,
+        groups: &[&[u32]],
+        shared: &[bool],
+        opts: &DagOptions,
+    ) -> (Mesh, Vec<u32>, Vec<u32>) {
         let mut local: FxHashMap<u32, u32> = FxHashMap::default();
         let mut ids: Vec<u32> = Vec::new();
         let mut tris: Vec<[u32; 3]> = Vec::new();
-        for &c in g {
-            for t in self.dag.triangles(&self.dag.clusters[c as usize]) {
-                tris.push(t.map(|v| {
-                    *local.entry(v).or_insert_with(|| {
-                        ids.push(v);
-                        ids.len() as u32 - 1
-                    })
-                }));
+        let mut face_groups: Vec<u32> = Vec::new();
+        for (gi, g) in groups.iter().enumerate() {
+            for &c in *g {
+                for t in self.dag.triangles(&self.dag.clusters[c as usize]) {
+                    tris.push(t.map(|v| {
+                        *local.entry(v).or_insert_with(|| {
+                            ids.push(v);
+                            ids.len() as u32 - 1
+                        })
+                    }));
+                    face_groups.push(gi as u32);
+                }
             }
         }
         let mut sub = self.store.submesh(&ids, tris);
+        sub.face_groups = Some(face_groups);
+        sub.groups = (0..groups.len()).map(|g| format!("group {g}")).collect();
         if opts.attributes.normal == 0.0 {
             // Normals out of the cost are made again from each result's faces, and differ
             // where two groups meet: carried in, they would be seams the next level's
@@ -298,6 +322,15 @@ impl Builder {
         let pin: Vec<u32> = (0..ids.len() as u32)
             .filter(|&l| shared[self.store.class[ids[l as usize] as usize] as usize])
             .collect();
+        (sub, ids, pin)
+    }
+
+    /// The group's triangles as a mesh of their own, the shared border pinned, simplified to
+    /// half.
+    fn simplify_group(&self, g: &[u32], shared: &[bool], opts: &DagOptions) -> Result<Simplified> {
+        let (mut sub, ids, pin) = self.input_of(&[g], shared, opts);
+        sub.face_groups = None;
+        sub.groups = Vec::new();
         let target = sub.triangles.len() / 2;
         let so = SimplifyOptions {
             backend: opts.backend,
@@ -307,7 +340,59 @@ impl Builder {
             ..SimplifyOptions::with_faces(target)
         };
         let diagonal = sub.bounds().map_or(0.0, |b| b.diagonal());
-        let (mut mesh, r) = crate::simplify(&sub, &so)?;
+        let (mesh, r) = crate::simplify(&sub, &so)?;
+        Ok(self.finish(&ids, mesh, r.max_collapse_error * diagonal))
+    }
+
+    /// Every group of a level simplified to half in one run of the rounds on `backend`, each
+    /// group to its own target; the result cut back into the groups.
+    fn simplify_level(
+        &self,
+        groups: &[Vec<u32>],
+        shared: &[bool],
+        opts: &DagOptions,
+        backend: Backend,
+    ) -> Result<Vec<Result<Simplified>>> {
+        let refs: Vec<&[u32]> = groups.iter().map(|g| g.as_slice()).collect();
+        let (sub, ids, pin) = self.input_of(&refs, shared, opts);
+        let targets: Vec<u32> = groups
+            .iter()
+            .map(|g| (self.triangles(g) / 2) as u32)
+            .collect();
+        let sum = targets.iter().map(|&t| t as usize).sum();
+        let so = SimplifyOptions {
+            backend,
+            pin,
+            attributes: opts.attributes,
+            cancel: opts.cancel.clone(),
+            ..SimplifyOptions::with_faces(sum)
+        };
+        let (mesh, errors) = crate::rounds::simplify_grouped(&sub, targets, backend, &so)?;
+        let parts = split_groups(&mesh, groups.len());
+        // Each group's own input vertices, as DAG ids, for `finish`'s look-up of the kept ones.
+        let mut group_ids: Vec<Vec<u32>> = vec![Vec::new(); groups.len()];
+        let fg = sub.face_groups.as_ref().expect("input_of sets them");
+        let mut seen = vec![u32::MAX; ids.len()];
+        for (t, &g) in sub.triangles.iter().zip(fg) {
+            for &l in t {
+                if seen[l as usize] != g {
+                    seen[l as usize] = g;
+                    group_ids[g as usize].push(ids[l as usize]);
+                }
+            }
+        }
+        Ok(parts
+            .into_par_iter()
+            .zip(group_ids)
+            .zip(errors)
+            .map(|((m, gids), e)| Ok(self.finish(&gids, m, e)))
+            .collect())
+    }
+
+    /// A group's simplified `mesh` (in mesh units, its largest collapse `error`) split into
+    /// clusters, each of its vertices matched to one of the group's input vertices `ids` (DAG
+    /// vertices) where its bits are theirs.
+    fn finish(&self, ids: &[u32], mut mesh: Mesh, error: f64) -> Simplified {
         if self.store.mesh.normals.is_some() && mesh.normals.is_none() {
             mesh.recompute_normals();
         }
@@ -317,18 +402,18 @@ impl Builder {
             .retain(|t| c(t[0]) != c(t[1]) && c(t[1]) != c(t[2]) && c(t[0]) != c(t[2]));
         let parts = split(&mesh.triangles, &mesh.positions, &class, self.limits);
         let mut by_bits: FxHashMap<[u32; 9], u32> = FxHashMap::default();
-        for (l, &g) in ids.iter().enumerate() {
-            by_bits.insert(vertex_bits(&sub, l), g);
+        for &g in ids {
+            by_bits.insert(vertex_bits(&self.store.mesh, g as usize), g);
         }
         let known = (0..mesh.positions.len())
             .map(|v| by_bits.get(&vertex_bits(&mesh, v)).copied().unwrap_or(NONE))
             .collect();
-        Ok(Simplified {
+        Simplified {
             mesh,
-            error: r.max_collapse_error * diagonal,
+            error,
             parts,
             known,
-        })
+        }
     }
 
     /// Records group `g` simplified into `r`: the group, and the clusters of its result.
@@ -516,6 +601,54 @@ impl Store {
             ..self.mesh.clone_without_geometry()
         }
     }
+}
+
+/// `mesh`'s faces split by their group (`face_groups`, below `n`), each group a mesh of the
+/// vertices its faces use, in order of first use.
+fn split_groups(mesh: &Mesh, n: usize) -> Vec<Mesh> {
+    let fg = mesh
+        .face_groups
+        .as_ref()
+        .expect("grouped rounds keep the faces' groups");
+    let mut tris: Vec<Vec<[u32; 3]>> = vec![Vec::new(); n];
+    for (t, &g) in mesh.triangles.iter().zip(fg) {
+        tris[g as usize].push(*t);
+    }
+    tris.into_par_iter()
+        .map(|tris| {
+            let mut local: FxHashMap<u32, u32> = FxHashMap::default();
+            let mut ids: Vec<u32> = Vec::new();
+            let triangles = tris
+                .iter()
+                .map(|t| {
+                    t.map(|v| {
+                        *local.entry(v).or_insert_with(|| {
+                            ids.push(v);
+                            ids.len() as u32 - 1
+                        })
+                    })
+                })
+                .collect();
+            let pick = |s: &[[f32; 3]]| ids.iter().map(|&v| s[v as usize]).collect::<Vec<_>>();
+            Mesh {
+                positions: pick(&mesh.positions),
+                triangles,
+                normals: mesh.normals.as_deref().map(pick),
+                uvs: mesh
+                    .uvs
+                    .as_ref()
+                    .map(|s| ids.iter().map(|&v| s[v as usize]).collect()),
+                colors: mesh
+                    .colors
+                    .as_ref()
+                    .map(|s| ids.iter().map(|&v| s[v as usize]).collect()),
+                face_groups: None,
+                face_materials: None,
+                groups: Vec::new(),
+                ..mesh.clone_without_geometry()
+            }
+        })
+        .collect()
 }
 
 /// Vertex `v` of `m` as bits: position, UV, colour (zero where absent). Not the normal: a

@@ -66,6 +66,18 @@ pub enum Buf {
     /// The next round as the planner wrote it ([`crate::compute::types::Planned`]): copied
     /// into `Params` and the scans' counts, and the indirect grids of a planned round.
     Planned,
+    /// Grouped rounds ([`Params::groups`]), a word each when there are none (bound, never
+    /// read). Per input face (`FaceExtra::origin`): its group; never compacted.
+    FaceGroup,
+    /// Per group: the faces it is to keep at most.
+    GroupTarget,
+    /// Per group: its faces after the round (`group_faces`), zero again once `group_open`
+    /// has read them.
+    GroupCount,
+    /// Per group: 1 once it has reached its target.
+    GroupClosed,
+    /// Per group: the largest squared error of its collapses, as f32 bits.
+    GroupErr,
 }
 
 /// A count a prefix sum runs over.
@@ -230,6 +242,20 @@ pub static COMPACT_FACES: Stage = crate::stage!(Buf; compact_faces in "rounds/co
 pub static PLAN_ROUND: Stage = crate::stage!(Buf; plan_round in "rounds/plan_round" over Grid::Planner;
     params: Uniform Params, counters: Read Counters, plan: ReadWrite Plan,
     planned: ReadWrite Planned, dispatch: ReadWrite Dispatch);
+pub static GROUP_FLAGS: Stage = crate::stage!(Buf; group_flags in "rounds/group_flags" over Each(Vertices);
+    params: Uniform Params, offsets: Read Offsets, vertex_faces: Read VertexFaces,
+    face_extra: Read FaceExtra, face_group: Read FaceGroup, group_closed: Read GroupClosed,
+    flags: ReadWrite Flags);
+pub static GROUP_ERRORS: Stage = crate::stage!(Buf; group_errors in "rounds/group_errors" over PerEdge;
+    params: Uniform Params, candidates: Read Candidates, edge_state: Read EdgeState,
+    edge_offsets: Read EdgeOffsets, offsets: Read Offsets, vertex_faces: Read VertexFaces,
+    face_extra: Read FaceExtra, face_group: Read FaceGroup, group_err: ReadWrite GroupErr);
+pub static GROUP_FACES: Stage = crate::stage!(Buf; group_faces in "rounds/group_faces" over Each(Faces);
+    params: Uniform Params, face_keep: Read FaceKeep, face_extra_out: Read FaceExtraOut,
+    face_group: Read FaceGroup, group_count: ReadWrite GroupCount);
+pub static GROUP_OPEN: Stage = crate::stage!(Buf; group_open in "rounds/group_open" over One;
+    params: Uniform Params, group_target: Read GroupTarget, group_count: ReadWrite GroupCount,
+    group_closed: ReadWrite GroupClosed, counters: ReadWrite Counters);
 pub static DRAW_ARGS: Stage = crate::stage!(Buf; draw_args in "rounds/draw_args" over One;
     params: Uniform Params, vertex_keep: Read VertexKeep, face_keep: Read FaceKeep,
     counters: ReadWrite Counters, draw: ReadWrite DrawArgs);
@@ -263,6 +289,10 @@ const OWN_STAGES: &[&Stage] = &[
     &COMPACT_FACES,
     &DRAW_ARGS,
     &PLAN_ROUND,
+    &GROUP_FLAGS,
+    &GROUP_ERRORS,
+    &GROUP_FACES,
+    &GROUP_OPEN,
 ];
 
 /// The rounds' own steps, beside the core's ([`crate::compute::schedule::Step`]).
@@ -303,6 +333,8 @@ pub enum When {
     /// batch. The CPU twin plans between rounds on the host ([`crate::rounds::cpu::CpuRounds`]
     /// runs `plan_round` there).
     Planned,
+    /// In every round of grouped rounds ([`Params::groups`] above 0).
+    Grouped,
 }
 
 use crate::compute::schedule::Step::{Clear, Own, PrefixSum, Run};
@@ -357,6 +389,13 @@ pub const TRIM: &[Step] = &[
     },
     Run(&TRIM_APPLY),
 ];
+/// Grouped rounds: the free vertices of the groups at their target are closed to collapses.
+pub const GROUP_START: &[Step] = &[Run(&GROUP_FLAGS)];
+/// Grouped rounds: each group's largest collapse error, before the collapses.
+pub const GROUP_ERRORS_PART: &[Step] = &[Run(&GROUP_ERRORS)];
+/// Grouped rounds: each group's faces after compaction, which groups are still open and the
+/// faces they are over, for the next round's plan.
+pub const GROUP_COUNT: &[Step] = &[Run(&GROUP_FACES), Run(&GROUP_OPEN)];
 /// The collapses, then compaction into the other half.
 pub const APPLY: &[Step] = &[
     Run(&COLLAPSE),
@@ -385,6 +424,7 @@ impl When {
             When::FirstRoundQuadrics => first && !carried,
             When::FirstRoundAttributes => first && p.attributes != 0,
             When::Trimming => p.trim != 0,
+            When::Grouped => p.groups != 0,
             When::EachSelectionPass | When::Planned => false,
         }
     }
@@ -397,6 +437,7 @@ pub const ROUND: &[(When, &[Step])] = &[
     (When::FirstRound, SETUP),
     (When::FirstRoundQuadrics, SETUP_QUADRICS),
     (When::FirstRoundAttributes, SETUP_ATTRIBUTES),
+    (When::Grouped, GROUP_START),
     (When::Always, EDGES),
     (When::Always, ERRORS),
     (When::Always, CEILING),
@@ -405,7 +446,9 @@ pub const ROUND: &[(When, &[Step])] = &[
     (When::EachSelectionPass, SELECTION_PASS),
     (When::Always, CHECK),
     (When::Trimming, TRIM),
+    (When::Grouped, GROUP_ERRORS_PART),
     (When::Always, APPLY),
+    (When::Grouped, GROUP_COUNT),
 ];
 
 /// The rounds' schedule against its WGSL, with the checks every family passes

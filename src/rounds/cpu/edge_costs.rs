@@ -142,6 +142,8 @@ pub enum CounterField {
     FacesOut = 9,
     Tentative = 10,
     Live = 11,
+    OpenGroups = 12,
+    OpenExcess = 13,
 }
 
 pub fn counter(counters: &[AtomicU32], f: CounterField) -> &AtomicU32 {

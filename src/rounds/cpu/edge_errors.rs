@@ -163,6 +163,10 @@ pub fn placement(
 ) -> Verdict {
     let ch = Channels::of(params);
     let (fla, flb) = (flags[a as usize], flags[b as usize]);
+    // A closed group's vertex (grouped rounds) takes part in no collapse.
+    if (fla | flb) & flag::CLOSED != 0 {
+        return Verdict::Invalid;
+    }
     let corners = Corners {
         indices,
         offsets,

@@ -17,6 +17,7 @@ pub mod edge_costs;
 pub mod edge_errors;
 pub mod edges;
 pub mod face_planes;
+pub mod groups;
 pub mod live_list;
 pub mod plan_round;
 pub mod prefix_sum;
@@ -203,6 +204,14 @@ pub struct CpuRounds {
     /// The planner's state and its next round, between the rounds of a batch.
     pub plan: PlanState,
     pub planned: Planned,
+    /// Grouped rounds ([`crate::rounds::UploadGroups`]; empty without): per input face its
+    /// group, per group its target, faces (zero between rounds), closed flag and largest
+    /// squared error's bits.
+    pub face_group: Vec<u32>,
+    pub group_target: Vec<u32>,
+    pub group_count: Vec<u32>,
+    pub group_closed: Vec<u32>,
+    pub group_err: Vec<u32>,
     out_positions: Vec<[f32; 4]>,
     out_quadrics: Vec<Quadric>,
     out_flags: Vec<u32>,
@@ -245,6 +254,20 @@ impl CpuRounds {
             attr_values: up.attr_values(),
             attr_sums: vec![0.0; up.attr_sums_len()],
             selection_passes,
+            face_group: up
+                .groups
+                .as_ref()
+                .map_or(Vec::new(), |g| g.face_group.clone()),
+            group_target: up.groups.as_ref().map_or(Vec::new(), |g| g.targets.clone()),
+            group_count: up
+                .groups
+                .as_ref()
+                .map_or(Vec::new(), |g| vec![0; g.targets.len()]),
+            group_closed: up.groups.as_ref().map_or(Vec::new(), |g| g.closed.clone()),
+            group_err: up
+                .groups
+                .as_ref()
+                .map_or(Vec::new(), |g| vec![0; g.targets.len()]),
             ..Default::default()
         }
     }
@@ -493,6 +516,7 @@ impl RoundRunner for CpuRounds {
             indices: self.indices.clone(),
             face_extra: self.face_extra.clone(),
             attr_values: self.attr_values.clone(),
+            group_err: self.group_err.clone(),
         })
     }
 

@@ -12,10 +12,18 @@ use crate::compute::types::*;
 /// Integer arithmetic, as the shader's: `nf / 4` is `nf × CEILING_MIN_SHARE` (0.25) rounded
 /// down exactly, and `5 × needed < 2 × nf` is `needed < TRIM_SHARE × nf` (0.4) for every count
 /// (the f64 product of 0.4 and an integer below 2³² rounds to that integer when they are equal).
-pub fn next_params(base: &Params, nv: u32, nf: u32, target: u32) -> Params {
+///
+/// Grouped rounds ([`Params::groups`]) need `open_excess`, the faces the open groups have over
+/// their targets, and never trim: a group's last round may take it under its target.
+pub fn next_params(base: &Params, nv: u32, nf: u32, target: u32, open_excess: u32) -> Params {
     use crate::rounds::{CEILING_FACTOR, CEILING_MIN_SHARE, TRIM_SHARE};
     const { assert!(CEILING_MIN_SHARE == 0.25 && TRIM_SHARE == 0.4 && CEILING_FACTOR == 2) };
-    let needed = nf.saturating_sub(target);
+    let grouped = base.groups != 0;
+    let needed = if grouped {
+        open_excess
+    } else {
+        nf.saturating_sub(target)
+    };
     Params {
         vertex_count: nv,
         face_count: nf,
@@ -27,16 +35,21 @@ pub fn next_params(base: &Params, nv: u32, nf: u32, target: u32) -> Params {
             .saturating_mul(CEILING_FACTOR)
             .max(nf / 4)
             .max(1),
-        trim: ((5 * needed as u64) < 2 * nf as u64) as u32,
+        trim: ((5 * needed as u64) < 2 * nf as u64 && !grouped) as u32,
         ..*base
     }
 }
 
 /// Whether a batch goes on after a round that left `c` from `plan`'s counts: it removed
-/// something, grew nothing, and is still above the target. The driver stops or retries
-/// (exhaustively) exactly where this says no.
-pub fn goes_on(plan: &PlanState, c: &Counters) -> bool {
-    c.faces_out < plan.faces && c.vertices_out <= plan.vertices && c.faces_out > plan.target_faces
+/// something, grew nothing, and is still above the target (`grouped`: a group is still above
+/// its own). The driver stops or retries (exhaustively) exactly where this says no.
+pub fn goes_on(plan: &PlanState, c: &Counters, grouped: bool) -> bool {
+    let above = if grouped {
+        c.open_groups != 0
+    } else {
+        c.faces_out > plan.target_faces
+    };
+    c.faces_out < plan.faces && c.vertices_out <= plan.vertices && above
 }
 
 /// Workgroups for `n` invocations of `per` each, split over y past `max_groups` (the shaders
@@ -58,7 +71,7 @@ pub fn plan_round(
     dispatch: &mut [u32],
 ) {
     if plan.stopped == 0 {
-        if goes_on(plan, counters) {
+        if goes_on(plan, counters, params.groups != 0) {
             plan.vertices = counters.vertices_out;
             plan.faces = counters.faces_out;
             plan.executed += 1;
@@ -72,7 +85,7 @@ pub fn plan_round(
         return;
     }
     let (nv, nf) = (plan.vertices, plan.faces);
-    let p = next_params(params, nv, nf, plan.target_faces);
+    let p = next_params(params, nv, nf, plan.target_faces, counters.open_excess);
     let m = plan.max_groups;
     planned.params = p;
     let counts = [nv, nf, p.edge_capacity];
@@ -175,10 +188,10 @@ mod tests {
     /// Near the target a round trims: 5 × 30 < 2 × 130.
     #[test]
     fn a_round_close_to_its_target_trims() {
-        let p = next_params(&Params::default(), 70, 130, 100);
+        let p = next_params(&Params::default(), 70, 130, 100, 0);
         assert_eq!((p.needed_faces, p.ceiling_wanted, p.trim), (30, 32, 1));
         // Exactly 0.4 of the faces still needed does not trim, as `needed < 0.4 × nf` says.
-        assert_eq!(next_params(&Params::default(), 70, 100, 60).trim, 0);
+        assert_eq!(next_params(&Params::default(), 70, 100, 60, 0).trim, 0);
     }
 
     /// A round that removed nothing, grew the mesh or reached the target stops the batch:
@@ -217,6 +230,37 @@ mod tests {
             );
             assert_eq!((plan.stopped, plan.executed), (1, 1));
         }
+    }
+
+    /// Grouped rounds go on while a group is open, whatever the face count says, need the
+    /// open groups' excess, and never trim; with every group closed the batch stops.
+    #[test]
+    fn grouped_rounds_plan_from_the_open_groups() {
+        let base = Params {
+            groups: 3,
+            ..Default::default()
+        };
+        let mut plan = state(520, 1000, 900);
+        let mut planned = Planned::default();
+        let mut dispatch = [0u32; 16];
+        // Under the targets' sum (900), but one group is 40 faces over its own.
+        let c = Counters {
+            open_groups: 1,
+            open_excess: 40,
+            ..after(420, 850)
+        };
+        plan_round(&base, &c, &mut plan, &mut planned, &mut dispatch);
+        assert_eq!(plan.stopped, 0);
+        let p = planned.params;
+        assert_eq!((p.needed_faces, p.trim, p.groups), (40, 0, 3));
+        assert_eq!(p.ceiling_wanted, 850 / 4);
+        let closed = Counters {
+            open_groups: 0,
+            ..after(400, 800)
+        };
+        plan_round(&base, &closed, &mut plan, &mut planned, &mut dispatch);
+        assert_eq!((plan.stopped, plan.faces), (1, 850));
+        assert_eq!(planned.grids, [[0; 4]; grid_slot::COUNT]);
     }
 
     /// A grid past the device's limit is split over y, as the host splits a direct one.

@@ -322,6 +322,48 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         let c: Counters = *bytemuck::from_bytes(bytemuck::cast_slice(&s.counters));
         plan_round::plan_round(p, &c, &mut s.plan, &mut s.planned, &mut s.dispatch)
     }),
+    (&schedule::GROUP_FLAGS, |s, p| {
+        groups::group_flags(
+            p,
+            &s.offsets,
+            &s.vertex_faces,
+            &s.face_extra,
+            &s.face_group,
+            &s.group_closed,
+            &mut s.flags,
+        )
+    }),
+    (&schedule::GROUP_ERRORS, |s, p| {
+        groups::group_errors(
+            p,
+            &s.candidates,
+            &s.edge_state,
+            &s.edge_offsets,
+            &s.offsets,
+            &s.vertex_faces,
+            &s.face_extra,
+            &s.face_group,
+            atomics(&mut s.group_err),
+        )
+    }),
+    (&schedule::GROUP_FACES, |s, p| {
+        groups::group_faces(
+            p,
+            &s.face_keep,
+            &s.out_face_extra,
+            &s.face_group,
+            atomics(&mut s.group_count),
+        )
+    }),
+    (&schedule::GROUP_OPEN, |s, p| {
+        groups::group_open(
+            p,
+            &s.group_target,
+            &mut s.group_count,
+            &mut s.group_closed,
+            atomics(&mut s.counters),
+        )
+    }),
 ];
 
 #[cfg(test)]

@@ -217,6 +217,16 @@ pub struct GpuRounds<'a> {
     attr_sums: wgpu::Buffer,
     /// Numbers in `attr_values`, for the read-back.
     attr_len: u64,
+    /// Grouped rounds ([`crate::rounds::UploadGroups`]; a word each without, bound and never
+    /// read): per input face its group, per group its target, faces, closed flag and largest
+    /// squared error's bits.
+    face_group: wgpu::Buffer,
+    group_target: wgpu::Buffer,
+    group_count: wgpu::Buffer,
+    group_closed: wgpu::Buffer,
+    group_err: wgpu::Buffer,
+    /// Groups (0 without), for the read-back.
+    groups: u64,
     readback: wgpu::Buffer,
     queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
     /// Stage of each timestamp pair recorded this round.
@@ -302,6 +312,7 @@ impl<'a> GpuRounds<'a> {
             });
             (set, resolve)
         });
+        let groups = up.groups.as_ref().map_or(0, |g| g.targets.len() as u64);
         let blocks = (cap + 1)
             .div_ceil(SCAN_BLOCK as u64)
             .max(nv.div_ceil(SCAN_BLOCK as u64))
@@ -371,6 +382,21 @@ impl<'a> GpuRounds<'a> {
             },
             attr_sums: mk("attr_sums", (up.attr_sums_len().max(1) * 4) as u64, SU)?,
             attr_len: up.attrs.as_ref().map_or(0, |a| a.values.len() as u64),
+            face_group: match &up.groups {
+                Some(g) => init("face_group", bytemuck::cast_slice(&g.face_group), SU)?,
+                None => mk("face_group", 4, SU)?,
+            },
+            group_target: match &up.groups {
+                Some(g) => init("group_target", bytemuck::cast_slice(&g.targets), SU)?,
+                None => mk("group_target", 4, SU)?,
+            },
+            group_closed: match &up.groups {
+                Some(g) => init("group_closed", bytemuck::cast_slice(&g.closed), SU)?,
+                None => mk("group_closed", 4, SU)?,
+            },
+            group_count: mk("group_count", groups.max(1) * 4, SU)?,
+            group_err: mk("group_err", groups.max(1) * 4, SU)?,
+            groups,
             readback: mk(
                 "readback",
                 batch::READBACK_BYTES,
@@ -572,6 +598,11 @@ impl Runner<Buf, schedule::Grid, Count, RoundStep> for GpuRounds<'_> {
             Buf::AttrSums => &self.attr_sums,
             Buf::Plan => &self.plan,
             Buf::Planned => &self.planned,
+            Buf::FaceGroup => &self.face_group,
+            Buf::GroupTarget => &self.group_target,
+            Buf::GroupCount => &self.group_count,
+            Buf::GroupClosed => &self.group_closed,
+            Buf::GroupErr => &self.group_err,
         }
     }
 

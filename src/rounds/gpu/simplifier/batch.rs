@@ -367,13 +367,14 @@ impl RoundRunner for GpuRounds<'_> {
         let t = Instant::now();
         let (nv, nf) = (self.live_counts.0 as u64, self.live_counts.1 as u64);
         let h = &self.half[self.cur];
-        let parts: [(&wgpu::Buffer, u64); 6] = [
+        let parts: [(&wgpu::Buffer, u64); 7] = [
             (&h.positions, nv * 16),
             (&h.flags, nv * 4),
             (&h.vertex_attr, nv * 4),
             (&h.indices, nf * 12),
             (&h.face_extra, if self.face_extra_out { nf * 16 } else { 0 }),
             (&self.attr_values, self.attr_len * 4),
+            (&self.group_err, self.groups * 4),
         ];
         let total: u64 = parts.iter().map(|p| p.1).sum();
         let dev = &self.sim.device;
@@ -413,6 +414,7 @@ impl RoundRunner for GpuRounds<'_> {
                 indices: bytemuck::pod_collect_to_vec(next(parts[3].1)),
                 face_extra: bytemuck::pod_collect_to_vec(next(parts[4].1)),
                 attr_values: bytemuck::pod_collect_to_vec(next(parts[5].1)),
+                group_err: bytemuck::pod_collect_to_vec(next(parts[6].1)),
             }
         };
         staging.unmap();
