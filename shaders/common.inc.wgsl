@@ -61,6 +61,7 @@ const C_TENTATIVE: u32 = 10u;
 const C_LIVE: u32 = 11u;
 const C_OPEN_GROUPS: u32 = 12u;
 const C_OPEN_EXCESS: u32 = 13u;
+const C_OPEN_FACES: u32 = 14u;
 const COUNTERS: u32 = 16u;
 
 struct Counters {
@@ -78,7 +79,8 @@ struct Counters {
     live: u32,
     open_groups: u32,
     open_excess: u32,
-    _pad: array<u32, 2>,
+    open_faces: u32,
+    _pad: array<u32, 1>,
 }
 
 // Keep in sync with PlanState and Planned in src/compute/types.rs.

@@ -1,5 +1,5 @@
 // Grouped rounds, one invocation after `group_faces`: which groups have reached their target,
-// how many have not and the faces they are over (the next round's plan), and the counts zeroed
+// how many have not, the faces they are over and all their faces (the next round's plan), and the counts zeroed
 // for the next round. A loop over the groups: a DAG level has a few thousand at most.
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -12,6 +12,7 @@
 fn group_open() {
     var open = 0u;
     var excess = 0u;
+    var faces = 0u;
     for (var g = 0u; g < params.groups; g = g + 1u) {
         let n = group_count[g];
         let t = group_target[g];
@@ -19,9 +20,11 @@ fn group_open() {
         if (n > t) {
             open = open + 1u;
             excess = excess + (n - t);
+            faces = faces + n;
         }
         group_count[g] = 0u;
     }
     atomicStore(&counters[C_OPEN_GROUPS], open);
     atomicStore(&counters[C_OPEN_EXCESS], excess);
+    atomicStore(&counters[C_OPEN_FACES], faces);
 }

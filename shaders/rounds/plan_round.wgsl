@@ -65,7 +65,12 @@ fn plan_round() {
     if (half <= 0x7fffffffu) {
         wanted = 2u * half;
     }
-    p.ceiling_wanted = max(max(wanted, nf / 4u), 1u);
+    // Grouped rounds let a share of the open groups' faces compete, not of the closed ones'.
+    var share = nf;
+    if (params.groups != 0u) {
+        share = counters[C_OPEN_FACES];
+    }
+    p.ceiling_wanted = max(max(wanted, share / 4u), 1u);
     p.trim = select(0u, 1u, 5u * needed < 2u * nf && params.groups == 0u);
     planned.params = p;
     let counts = vec3<u32>(nv, nf, p.edge_capacity);

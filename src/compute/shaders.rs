@@ -294,6 +294,7 @@ mod tests {
             ("C_LIVE", C::Live as u32),
             ("C_OPEN_GROUPS", C::OpenGroups as u32),
             ("C_OPEN_EXCESS", C::OpenExcess as u32),
+            ("C_OPEN_FACES", C::OpenFaces as u32),
             ("COUNTERS", (std::mem::size_of::<Counters>() / 4) as u32),
             ("GRID_VERTICES", grid_slot::VERTICES as u32),
             ("GRID_FACES", grid_slot::FACES as u32),

@@ -148,9 +148,11 @@ pub struct Counters {
     pub live: u32,
     /// Grouped rounds: the groups still over their target after the round (`group_open`)...
     pub open_groups: u32,
-    /// ...and the faces they have over it, the next round's `needed_faces`.
+    /// ...the faces they have over it, the next round's `needed_faces`...
     pub open_excess: u32,
-    pub _pad: [u32; 2],
+    /// ...and all their faces, of which the ceiling lets a share compete.
+    pub open_faces: u32,
+    pub _pad: [u32; 1],
 }
 
 /// What the rounds' planner (`plan_round`) keeps between the rounds of a batch: the mesh's

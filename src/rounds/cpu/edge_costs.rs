@@ -144,6 +144,7 @@ pub enum CounterField {
     Live = 11,
     OpenGroups = 12,
     OpenExcess = 13,
+    OpenFaces = 14,
 }
 
 pub fn counter(counters: &[AtomicU32], f: CounterField) -> &AtomicU32 {

@@ -14,8 +14,16 @@ use crate::compute::types::*;
 /// (the f64 product of 0.4 and an integer below 2³² rounds to that integer when they are equal).
 ///
 /// Grouped rounds ([`Params::groups`]) need `open_excess`, the faces the open groups have over
-/// their targets, and never trim: a group's last round may take it under its target.
-pub fn next_params(base: &Params, nv: u32, nf: u32, target: u32, open_excess: u32) -> Params {
+/// their targets, let a share of the open groups' `open_faces` compete (the closed groups'
+/// edges cannot), and never trim: a group's last round may take it under its target.
+pub fn next_params(
+    base: &Params,
+    nv: u32,
+    nf: u32,
+    target: u32,
+    open_excess: u32,
+    open_faces: u32,
+) -> Params {
     use crate::rounds::{CEILING_FACTOR, CEILING_MIN_SHARE, TRIM_SHARE};
     const { assert!(CEILING_MIN_SHARE == 0.25 && TRIM_SHARE == 0.4 && CEILING_FACTOR == 2) };
     let grouped = base.groups != 0;
@@ -33,7 +41,7 @@ pub fn next_params(base: &Params, nv: u32, nf: u32, target: u32, open_excess: u3
         ceiling_wanted: needed
             .div_ceil(2)
             .saturating_mul(CEILING_FACTOR)
-            .max(nf / 4)
+            .max(if grouped { open_faces } else { nf } / 4)
             .max(1),
         trim: ((5 * needed as u64) < 2 * nf as u64 && !grouped) as u32,
         ..*base
@@ -85,7 +93,14 @@ pub fn plan_round(
         return;
     }
     let (nv, nf) = (plan.vertices, plan.faces);
-    let p = next_params(params, nv, nf, plan.target_faces, counters.open_excess);
+    let p = next_params(
+        params,
+        nv,
+        nf,
+        plan.target_faces,
+        counters.open_excess,
+        counters.open_faces,
+    );
     let m = plan.max_groups;
     planned.params = p;
     let counts = [nv, nf, p.edge_capacity];
@@ -188,10 +203,10 @@ mod tests {
     /// Near the target a round trims: 5 × 30 < 2 × 130.
     #[test]
     fn a_round_close_to_its_target_trims() {
-        let p = next_params(&Params::default(), 70, 130, 100, 0);
+        let p = next_params(&Params::default(), 70, 130, 100, 0, 0);
         assert_eq!((p.needed_faces, p.ceiling_wanted, p.trim), (30, 32, 1));
         // Exactly 0.4 of the faces still needed does not trim, as `needed < 0.4 × nf` says.
-        assert_eq!(next_params(&Params::default(), 70, 100, 60, 0).trim, 0);
+        assert_eq!(next_params(&Params::default(), 70, 100, 60, 0, 0).trim, 0);
     }
 
     /// A round that removed nothing, grew the mesh or reached the target stops the batch:
@@ -247,13 +262,18 @@ mod tests {
         let c = Counters {
             open_groups: 1,
             open_excess: 40,
+            open_faces: 400,
             ..after(420, 850)
         };
         plan_round(&base, &c, &mut plan, &mut planned, &mut dispatch);
         assert_eq!(plan.stopped, 0);
         let p = planned.params;
         assert_eq!((p.needed_faces, p.trim, p.groups), (40, 0, 3));
-        assert_eq!(p.ceiling_wanted, 850 / 4);
+        assert_eq!(
+            p.ceiling_wanted,
+            400 / 4,
+            "a quarter of the open groups' faces"
+        );
         let closed = Counters {
             open_groups: 0,
             ..after(400, 800)
