@@ -2,12 +2,12 @@
 //!
 //! Backends of one idea (Garland & Heckbert, "Surface Simplification Using Quadric Error
 //! Metrics", SIGGRAPH 1997):
-//! - `cpu` ([`greedy`]): greedy edge collapse with a priority queue, in f64 — the quality
+//! - `cpu` (the `greedy` module): greedy edge collapse with a priority queue, in f64 — the quality
 //!   reference.
-//! - `gpu` ([`gpu`]): rounds of independent-set parallel collapses as WGSL compute passes
-//!   through wgpu; `shaders/` holds one file per stage.
-//! - `cpu-parallel` ([`cpu`]): the same rounds, stage for stage, on the CPU with rayon — the
-//!   validator of every GPU stage. [`parallel`] drives both:
+//! - `gpu` ([`rounds::gpu`]): rounds of independent-set parallel collapses as WGSL compute
+//!   passes through wgpu; `shaders/` holds one file per stage.
+//! - `cpu-parallel` ([`rounds::cpu`]): the same rounds, stage for stage, on the CPU with rayon —
+//!   the validator of every GPU stage. [`rounds`] drives both:
 //!
 //! ```text
 //! adjacency (count, prefix sum, fill, sort) -> [face planes, vertex flags, quadrics]

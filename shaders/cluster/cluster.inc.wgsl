@@ -1,5 +1,6 @@
 // Structs and helpers of the clustering stages; prepended (after common.wgsl) to the stages that
-// bind ClusterParams or RadixParams. Twin of the cluster structs in src/gpu/types.rs: keep in sync.
+// bind ClusterParams or RadixParams. Twin of the cluster structs in src/compute/types.rs: keep in
+// sync.
 
 // A locked vertex's key: one cell of its own, above every Morton key (< 2^30).
 const SINGLETON: u32 = 0x80000000u;

@@ -1,5 +1,5 @@
 // The floating cells' uniform and helpers; prepended (after common.wgsl and cluster.wgsl) to the
-// stages that bind FloatParams. Twin of FloatParams in src/gpu/types.rs and of
+// stages that bind FloatParams. Twin of FloatParams in src/compute/types.rs and of
 // cluster/floating.rs's radius and ranks: keep in sync.
 
 // Centres' radii spread over ±JITTER/2 about the nominal one (floating::JITTER).

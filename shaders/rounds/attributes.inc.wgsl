@@ -4,10 +4,10 @@
 // of the welded input: its m weighted values (attr_values) and its sums (attr_sums, stride
 // 4m + 1: G per channel (3 each), then D per channel, then W), relative to its vertex's
 // position like the quadrics; each face's p-only part is folded into the vertex quadric. Twin of
-// src/cpu/attributes.rs; prepended to the stages that bind attr_values and attr_sums.
+// src/rounds/cpu/attributes.rs; prepended to the stages that bind attr_values and attr_sums.
 
 // Params.attributes: m in bits 0-3, the colour channels (the first) in bits 4-7, bit 8 when two
-// UV channels follow them (src/gpu/types.rs's attr_layout).
+// UV channels follow them (src/compute/types.rs's attr_layout).
 fn attr_m() -> u32 { return params.attributes & 0xfu; }
 fn attr_colors() -> u32 { return (params.attributes >> 4u) & 0xfu; }
 fn attr_has_uv() -> bool { return ((params.attributes >> 8u) & 1u) != 0u; }

@@ -24,7 +24,7 @@
 @group(0) @binding(14) var<storage, read_write> attr_sums: array<f32>;      // per attribute vertex × (4m + 1)
 
 // The attribute vertex a corner of the removed vertex takes under map m (see NO_ATTR in
-// src/gpu/types.rs).
+// src/compute/types.rs).
 fn mapped(m: vec4<u32>, a: u32) -> u32 {
     if (m.x == NO_ATTR || a == m.x) { return m.y; }
     if (a == m.z) { return m.w; }
