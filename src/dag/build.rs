@@ -293,24 +293,19 @@ impl Builder {
         shared: &[bool],
         opts: &DagOptions,
     ) -> (Mesh, Vec<u32>, Vec<u32>) {
-        let mut local: FxHashMap<u32, u32> = FxHashMap::default();
-        let mut ids: Vec<u32> = Vec::new();
+        let mut local = Local::default();
         let mut tris: Vec<[u32; 3]> = Vec::new();
         let mut face_groups: Vec<u32> = Vec::new();
         for (gi, g) in groups.iter().enumerate() {
             for &c in *g {
                 for t in self.dag.triangles(&self.dag.clusters[c as usize]) {
-                    tris.push(t.map(|v| {
-                        *local.entry(v).or_insert_with(|| {
-                            ids.push(v);
-                            ids.len() as u32 - 1
-                        })
-                    }));
+                    tris.push(t.map(|v| local.id(v)));
                     face_groups.push(gi as u32);
                 }
             }
         }
-        let mut sub = self.store.submesh(&ids, tris);
+        let ids = local.ids;
+        let mut sub = submesh(&self.store.mesh, &ids, tris);
         sub.face_groups = Some(face_groups);
         sub.groups = (0..groups.len()).map(|g| format!("group {g}")).collect();
         if opts.attributes.normal == 0.0 {
@@ -580,27 +575,6 @@ impl Store {
             .filter(|t| c(t[0]) != c(t[1]) && c(t[1]) != c(t[2]) && c(t[0]) != c(t[2]))
             .collect()
     }
-
-    /// A mesh of the vertices `ids` (in that order) and `tris` over them.
-    fn submesh(&self, ids: &[u32], tris: Vec<[u32; 3]>) -> Mesh {
-        let pick = |s: &Vec<[f32; 3]>| ids.iter().map(|&v| s[v as usize]).collect::<Vec<_>>();
-        Mesh {
-            positions: pick(&self.mesh.positions),
-            triangles: tris,
-            normals: self.mesh.normals.as_ref().map(pick),
-            uvs: self
-                .mesh
-                .uvs
-                .as_ref()
-                .map(|s| ids.iter().map(|&v| s[v as usize]).collect()),
-            colors: self
-                .mesh
-                .colors
-                .as_ref()
-                .map(|s| ids.iter().map(|&v| s[v as usize]).collect()),
-            ..self.mesh.clone_without_geometry()
-        }
-    }
 }
 
 /// `mesh`'s faces split by their group (`face_groups`, below `n`), each group a mesh of the
@@ -616,39 +590,47 @@ fn split_groups(mesh: &Mesh, n: usize) -> Vec<Mesh> {
     }
     tris.into_par_iter()
         .map(|tris| {
-            let mut local: FxHashMap<u32, u32> = FxHashMap::default();
-            let mut ids: Vec<u32> = Vec::new();
-            let triangles = tris
-                .iter()
-                .map(|t| {
-                    t.map(|v| {
-                        *local.entry(v).or_insert_with(|| {
-                            ids.push(v);
-                            ids.len() as u32 - 1
-                        })
-                    })
-                })
-                .collect();
-            let pick = |s: &[[f32; 3]]| ids.iter().map(|&v| s[v as usize]).collect::<Vec<_>>();
-            Mesh {
-                positions: pick(&mesh.positions),
-                triangles,
-                normals: mesh.normals.as_deref().map(pick),
-                uvs: mesh
-                    .uvs
-                    .as_ref()
-                    .map(|s| ids.iter().map(|&v| s[v as usize]).collect()),
-                colors: mesh
-                    .colors
-                    .as_ref()
-                    .map(|s| ids.iter().map(|&v| s[v as usize]).collect()),
-                face_groups: None,
-                face_materials: None,
-                groups: Vec::new(),
-                ..mesh.clone_without_geometry()
-            }
+            let mut local = Local::default();
+            let triangles = tris.iter().map(|t| t.map(|v| local.id(v))).collect();
+            submesh(mesh, &local.ids, triangles)
         })
         .collect()
+}
+
+/// Vertices renumbered in order of first use.
+#[derive(Default)]
+struct Local {
+    of: FxHashMap<u32, u32>,
+    /// Per new id: the vertex it was.
+    ids: Vec<u32>,
+}
+
+impl Local {
+    fn id(&mut self, v: u32) -> u32 {
+        *self.of.entry(v).or_insert_with(|| {
+            self.ids.push(v);
+            self.ids.len() as u32 - 1
+        })
+    }
+}
+
+/// The vertices `ids` of `m` (in that order) and `tris` over them, without face materials or
+/// groups.
+fn submesh(m: &Mesh, ids: &[u32], tris: Vec<[u32; 3]>) -> Mesh {
+    fn pick<T: Copy>(ids: &[u32], s: &[T]) -> Vec<T> {
+        ids.iter().map(|&v| s[v as usize]).collect()
+    }
+    Mesh {
+        positions: pick(ids, &m.positions),
+        triangles: tris,
+        normals: m.normals.as_deref().map(|s| pick(ids, s)),
+        uvs: m.uvs.as_deref().map(|s| pick(ids, s)),
+        colors: m.colors.as_deref().map(|s| pick(ids, s)),
+        face_groups: None,
+        face_materials: None,
+        groups: Vec::new(),
+        ..m.clone_without_geometry()
+    }
 }
 
 /// Vertex `v` of `m` as bits: position, UV, colour (zero where absent). Not the normal: a

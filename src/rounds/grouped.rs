@@ -49,19 +49,22 @@ impl Upload {
         for x in &self.face_extra {
             count[face_group[x.origin as usize] as usize] += 1;
         }
-        let closed: Vec<u32> = count
-            .iter()
-            .zip(&targets)
-            .map(|(n, t)| (n <= t) as u32)
-            .collect();
-        let (mut open, mut excess, mut open_faces) = (0u32, 0u32, 0u32);
-        for (n, t) in count.iter().zip(&targets) {
-            if n > t {
-                open += 1;
-                excess += n - t;
-                open_faces += n;
-            }
-        }
+        // The first round's open groups as `group_open` finds them after a round.
+        let params = crate::compute::types::Params {
+            groups: targets.len() as u32,
+            ..Default::default()
+        };
+        let mut closed = vec![0u32; targets.len()];
+        let mut counters = [0u32; 16];
+        cpu::groups::group_open(
+            &params,
+            &targets,
+            &mut count,
+            &mut closed,
+            cpu::atomics(&mut counters),
+        );
+        let c: crate::compute::types::Counters = bytemuck::cast(counters);
+        let (open, excess, open_faces) = (c.open_groups, c.open_excess, c.open_faces);
         self.groups = Some(UploadGroups {
             face_group,
             targets,
