@@ -535,6 +535,9 @@ pub struct RoundsReport {
     /// Preparing the upload on the host before the rounds: weld, position classes, Morton
     /// order, normalization (gpu backend, `qem`; `hybrid`'s hand-over is in its clustering).
     pub prepare_seconds: f64,
+    /// Where the mesh was welded, ordered and normalized for the rounds: `device` (the
+    /// preparation's stages, for a plain mesh where the device has f64 in shaders) or `host`.
+    pub prepared_on: Option<String>,
     /// The rounds' waits, from each submission of a round or a batch of them to their counters
     /// read back: the GPU's work and the driver's (gpu backend).
     pub wait_seconds: f64,

@@ -231,9 +231,11 @@ fn write_rounds(out: &mut impl Write, rr: &crate::rounds::RoundsReport) -> std::
         )?;
         writeln!(
             out,
-            "host                {:.3} s preparing the upload; {:.3} s from the rounds' \
-             submissions to their counters",
-            rr.prepare_seconds, rr.wait_seconds
+            "host                {:.3} s preparing the upload (prepared on the {}); {:.3} s \
+             from the rounds' submissions to their counters",
+            rr.prepare_seconds,
+            rr.prepared_on.as_deref().unwrap_or("host"),
+            rr.wait_seconds
         )?;
         writeln!(
             out,

@@ -121,15 +121,17 @@ pub fn checked_buffer_init(
 
 /// What meshslim asks of a device, whoever creates it (the simplifier here, eframe for the
 /// viewer's window, the viewer's tests): the adapter's own limits, so that million-triangle
-/// meshes fit; timestamp queries for the per-stage table and line polygons for the viewer's
-/// wireframe, each only when the adapter has it.
+/// meshes fit; timestamp queries for the per-stage table, line polygons for the viewer's
+/// wireframe, and f64 in shaders for the preparation on the device, each only when the adapter
+/// has it.
 pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
     wgpu::DeviceDescriptor {
         label: Some("meshslim"),
         required_features: adapter.features()
             & (wgpu::Features::TIMESTAMP_QUERY
                 | wgpu::Features::POLYGON_MODE_LINE
-                | wgpu::Features::PIPELINE_CACHE),
+                | wgpu::Features::PIPELINE_CACHE
+                | wgpu::Features::SHADER_F64),
         required_limits: adapter.limits(),
         ..Default::default()
     }

@@ -30,6 +30,7 @@ mod tests {
     fn every_family_binds_what_its_shaders_declare() {
         crate::rounds::schedule::check_schedule();
         crate::cluster::gpu_schedule::check_schedule();
+        crate::rounds::prepare::check_schedule();
     }
 
     /// The pipeline cache is keyed by entry point: two families may name one entry only when it
@@ -44,7 +45,11 @@ mod tests {
             .iter()
             .flat_map(|l| l.iter())
             .map(|s| (s.entry, s.shader));
-        let all: Vec<(&str, &str)> = rounds.chain(cluster).collect();
+        let prepare = crate::rounds::prepare::STAGES
+            .iter()
+            .flat_map(|l| l.iter())
+            .map(|s| (s.entry, s.shader));
+        let all: Vec<(&str, &str)> = rounds.chain(cluster).chain(prepare).collect();
         for (i, (entry, shader)) in all.iter().enumerate() {
             for (e2, s2) in &all[..i] {
                 assert!(

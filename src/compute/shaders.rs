@@ -13,6 +13,8 @@ pub const SEAMS: &str = include_str!("../../shaders/rounds/seams.inc.wgsl");
 /// The rounds' appearance channels: their layout, sums and values, for the stages that bind
 /// `attr_values` and `attr_sums`.
 pub const ATTRIBUTES: &str = include_str!("../../shaders/rounds/attributes.inc.wgsl");
+/// The preparation on the device's uniform (f64: only its stages include it).
+pub const PREPARE: &str = include_str!("../../shaders/rounds/prepare.inc.wgsl");
 /// The clustering stages' structs and constants, for the stages that bind `ClusterParams` or
 /// `RadixParams`.
 pub const CLUSTER: &str = include_str!("../../shaders/cluster/cluster.inc.wgsl");
@@ -30,6 +32,7 @@ const INCLUDES: &[(&str, &str)] = &[
     ("mesh.inc", MESH),
     ("rounds/seams.inc", SEAMS),
     ("rounds/attributes.inc", ATTRIBUTES),
+    ("rounds/prepare.inc", PREPARE),
     ("cluster/cluster.inc", CLUSTER),
     ("cluster/floating.inc", FLOATING),
     ("cluster/floating_cells.inc", FLOATING_CELLS),
@@ -104,6 +107,13 @@ pub const SOURCES: &[Shader] = &[
     stage!("rounds/group_errors", [COMMON]),
     stage!("rounds/group_faces", [COMMON]),
     stage!("rounds/group_open", [COMMON]),
+    stage!("rounds/weld_insert", [COMMON, PREPARE]),
+    stage!("rounds/weld_resolve", [COMMON, PREPARE]),
+    stage!("rounds/morton_keys", [COMMON, PREPARE]),
+    stage!("rounds/class_rank", [COMMON, PREPARE]),
+    stage!("rounds/face_keys", [COMMON, PREPARE]),
+    stage!("rounds/prep_faces", [COMMON, PREPARE]),
+    stage!("rounds/prep_vertices", [COMMON, PREPARE]),
     stage!("cluster/cell_keys", [COMMON, CLUSTER]),
     stage!("cluster/radix_count", [COMMON, CLUSTER]),
     stage!("cluster/radix_scatter", [COMMON, CLUSTER]),
@@ -156,15 +166,25 @@ mod tests {
     use super::*;
     use crate::compute::types::*;
 
+    /// What a stage may use: f64 in the preparation's stages alone, which run only where the
+    /// device has SHADER_F64.
+    fn capabilities(stem: &str) -> naga::valid::Capabilities {
+        let prep = SOURCES
+            .iter()
+            .any(|s| s.path == stem && s.includes.contains(&PREPARE));
+        if prep {
+            naga::valid::Capabilities::FLOAT64
+        } else {
+            naga::valid::Capabilities::empty()
+        }
+    }
+
     fn parse(stem: &str, src: &str) -> naga::Module {
         let module = naga::front::wgsl::parse_str(src)
             .unwrap_or_else(|e| panic!("shaders/{stem}.wgsl: {}", e.emit_to_string(src)));
-        naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::empty(),
-        )
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("shaders/{stem}.wgsl does not validate: {e:?}"));
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities(stem))
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("shaders/{stem}.wgsl does not validate: {e:?}"));
         module
     }
 
@@ -337,6 +357,14 @@ mod tests {
         assert_eq!(size("ClusterParams"), size_of::<ClusterParams>());
         assert_eq!(size("RadixParams"), size_of::<RadixParams>());
         assert_eq!(size("ClusterPlaced"), size_of::<ClusterPlaced>());
+        let module = parse(
+            "rounds/weld_resolve",
+            &stage_source("rounds/weld_resolve").unwrap(),
+        );
+        assert_eq!(
+            struct_size(&module, "prepare.wgsl", "PrepParams"),
+            size_of::<PrepParams>()
+        );
         let module = parse("fc_quadrics", &stage_source("cluster/fc_quadrics").unwrap());
         assert_eq!(
             struct_size(&module, "floating.wgsl", "FloatParams"),

@@ -318,6 +318,34 @@ pub struct RadixParams {
     pub _pad: u32,
 }
 
+/// The preparation on the device (`crate::rounds::prepare`), a uniform. Keep in sync with
+/// `PrepParams` in shaders/rounds/prepare.inc.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct PrepParams {
+    /// Input vertices and faces.
+    pub vertex_count: u32,
+    pub face_count: u32,
+    /// Slots of the weld's hash table less one (a power of two, at least twice the vertices).
+    pub table_mask: u32,
+    pub _pad: u32,
+    /// The Morton grid over the box: its low corner (xyz) and its longest side (w), as
+    /// `mesh::morton::grid_codes` takes them.
+    pub grid: [f32; 4],
+    /// The frame: the box's centre (xyz) and one over its diagonal (w).
+    pub frame: [f64; 4],
+}
+
+/// What the preparation on the device counted, read back once (`PrepCounts` words in the
+/// shaders, which bind it as an array of atomics).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct PrepCounts {
+    /// Faces with three distinct classes.
+    pub kept: u32,
+    pub _pad: [u32; 3],
+}
+
 /// A cluster's vertex as `cluster_quadrics` writes it (its quadric, relative to `pos`, goes to
 /// a buffer of [`Quadric`] beside). Keep in sync with `ClusterPlaced` in shaders/cluster/cluster.inc.wgsl.
 #[repr(C)]

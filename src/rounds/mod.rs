@@ -13,6 +13,7 @@ pub mod attributes;
 pub mod cpu;
 pub mod gpu;
 mod grouped;
+pub mod prepare;
 pub mod schedule;
 
 pub use attributes::RoundAttributes;
@@ -122,6 +123,9 @@ pub struct Upload {
     pub attrs: Option<RoundAttributes>,
     /// Targets per group of faces ([`Upload::grouped`]); `None`: one target for the mesh.
     pub groups: Option<UploadGroups>,
+    /// Prepared on the device ([`Upload::on_device`]): the rounds' vertices and faces, whose
+    /// arrays are there alone (the ones here stay empty).
+    pub device_counts: Option<(u32, u32)>,
 }
 
 /// The attribute vertex (of the welded input) of every corner of the rounds' faces: a seam
@@ -332,11 +336,58 @@ impl Upload {
             face_planes,
             attrs: None,
             groups: None,
+            device_counts: None,
         }
     }
 
+    /// The upload of a plain `mesh` the device prepared ([`crate::rounds::prepare`]) into
+    /// `vertices` and `faces`, in the frame `(center, scale)`: the arrays stay on the device,
+    /// and the vertex and corner attributes there name `mesh`'s own vertices (the first input
+    /// vertex of each welded one), so the output is built from `mesh`
+    /// ([`Upload::output_base`]).
+    pub fn on_device(
+        mesh: &Mesh,
+        vertices: u32,
+        faces: u32,
+        (center, scale): ([f64; 3], f64),
+    ) -> Upload {
+        Upload {
+            welded: mesh.clone_without_geometry(),
+            positions: Vec::new(),
+            indices: Vec::new(),
+            flags: Vec::new(),
+            vertex_attr: Vec::new(),
+            face_extra: Vec::new(),
+            center,
+            scale,
+            dropped_degenerate: mesh.triangles.len() - faces as usize,
+            seams: 0,
+            quadrics: None,
+            face_planes: None,
+            attrs: None,
+            groups: None,
+            device_counts: Some((vertices, faces)),
+        }
+    }
+
+    /// The mesh the output's vertices come from: the welded input, or for an upload the device
+    /// prepared, `input` itself.
+    pub fn output_base<'m>(&'m self, input: &'m Mesh) -> &'m Mesh {
+        if self.device_counts.is_some() {
+            input
+        } else {
+            &self.welded
+        }
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.device_counts
+            .map_or(self.positions.len(), |(v, _)| v as usize)
+    }
+
     pub fn face_count(&self) -> usize {
-        self.face_extra.len()
+        self.device_counts
+            .map_or(self.face_extra.len(), |(_, f)| f as usize)
     }
 
     /// Whether the output needs the faces' extras read back: a seam corner's attribute vertex,
@@ -352,7 +403,7 @@ impl Upload {
         Params {
             attributes,
             color_weight,
-            vertex_count: self.positions.len() as u32,
+            vertex_count: self.vertex_count() as u32,
             face_count: self.face_count() as u32,
             edge_capacity: 3 * self.face_count() as u32,
             target_faces: opts.target_faces as u32,
@@ -371,10 +422,15 @@ impl Upload {
     /// corner keeps its own, any other corner takes its class's), moved vertices taken out of
     /// the normalized frame, materials and groups per face, unused vertices dropped.
     pub fn build_output(&self, d: &Download, normals: bool) -> Mesh {
+        self.build_output_on(&self.welded, d, normals)
+    }
+
+    /// As [`Upload::build_output`], the vertices taken from `base` ([`Upload::output_base`]).
+    pub fn build_output_on(&self, base: &Mesh, d: &Download, normals: bool) -> Mesh {
         let mut out = self.welded.clone_without_geometry();
-        out.positions = self.welded.positions.clone();
-        out.uvs = self.welded.uvs.clone();
-        out.colors = self.welded.colors.clone();
+        out.positions = base.positions.clone();
+        out.uvs = base.uvs.clone();
+        out.colors = base.colors.clone();
         for (v, p) in d.positions.iter().enumerate() {
             if d.flags[v] & flag::MOVED != 0 {
                 let q = [0, 1, 2].map(|i| (p[i] as f64 / self.scale + self.center[i]) as f32);
@@ -398,7 +454,7 @@ impl Upload {
         let mut normals = normals;
         if let Some(a) = &self.attrs {
             if a.keeps_normals() {
-                out.normals = self.welded.normals.clone();
+                out.normals = base.normals.clone();
             }
             a.write(&d.attr_values, &mut out);
             normals &= !a.keeps_normals();
@@ -606,7 +662,7 @@ pub fn simplify_rounds(
 ) -> Result<(Mesh, SimplifyReport)> {
     let driven = drive(runner, up, opts, progress)?;
     let down = runner.download()?;
-    let out = up.build_output(&down, input.normals.is_some());
+    let out = up.build_output_on(up.output_base(input), &down, input.normals.is_some());
     rounds_report.rounds = driven.removed.len();
     rounds_report.stage_seconds = runner.stage_times().clone();
     rounds_report.faces_removed_per_round = driven.removed;

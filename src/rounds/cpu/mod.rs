@@ -21,6 +21,7 @@ pub mod groups;
 pub mod live_list;
 pub mod plan_round;
 pub mod prefix_sum;
+pub mod prepare;
 pub mod select;
 pub mod trim;
 mod twins;

@@ -2,6 +2,7 @@
 //! shaders/rounds/ hold one file per stage; `rounds::cpu` holds their twins), on the process's
 //! device ([`shared`]) or a caller's.
 
+pub mod prepare;
 pub mod simplifier;
 
 pub use crate::compute::context::GpuContext;
@@ -55,6 +56,26 @@ pub fn simplify_with(
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
     let t = std::time::Instant::now();
+    // A plain mesh is prepared on the device where it has the preparation's stages; what the
+    // host does then is look at the mesh and take its box (a tile's pinned border is the
+    // host's to place). MESHSLIM_PREPARE=host keeps it on the host, to compare the two.
+    let host_asked = std::env::var_os("MESHSLIM_PREPARE").is_some_and(|v| v == "host");
+    let on_device = sim
+        .prepare_kernels()
+        .filter(|_| opts.pin.is_empty() && !host_asked)
+        .and_then(|k| Some((k, crate::rounds::prepare::eligible(mesh)?)));
+    if let Some((kernels, p)) = on_device {
+        let prepare = t.elapsed().as_secs_f64();
+        let adapter = Some(ctx.adapter_name.clone());
+        let start = Start::Prepare(kernels, &p);
+        let (out, mut rep, _) = run_rounds_from(sim, adapter, start, mesh, opts, false, progress)?;
+        if let Some(r) = rep.rounds.as_mut() {
+            r.prepare_seconds = prepare;
+            r.host_seconds += prepare;
+            r.prepared_on = Some("device".into());
+        }
+        return Ok((out, rep));
+    }
     let up = Upload::pinned(mesh, &opts.pin).attributes(&opts.attributes);
     let prepare = t.elapsed().as_secs_f64();
     let (out, mut rep) = simplify_upload(ctx, sim, &up, mesh, opts, progress)?;
@@ -62,8 +83,19 @@ pub fn simplify_with(
         r.prepare_seconds = prepare;
         // Preparing is the host's own work, before the rounds' call.
         r.host_seconds += prepare;
+        r.prepared_on = Some("host".into());
     }
     Ok((out, rep))
+}
+
+/// Where the rounds start from: an upload the host prepared, or the mesh itself, prepared on
+/// the device with its preparation kernels and uniform.
+enum Start<'u> {
+    Upload(&'u Upload),
+    Prepare(
+        &'u crate::compute::gpu::Kernels,
+        &'u crate::compute::types::PrepParams,
+    ),
 }
 
 /// The rounds on a prepared upload (`hybrid` carries its clusters' quadrics in it); `mesh` is
@@ -92,8 +124,37 @@ pub fn run_rounds<'a>(
     share_queue: bool,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport, GpuRounds<'a>)> {
+    run_rounds_from(
+        sim,
+        adapter,
+        Start::Upload(up),
+        mesh,
+        opts,
+        share_queue,
+        progress,
+    )
+}
+
+/// [`run_rounds`] from either start.
+fn run_rounds_from<'a>(
+    sim: &'a GpuSimplifier,
+    adapter: Option<String>,
+    start: Start,
+    mesh: &Mesh,
+    opts: &SimplifyOptions,
+    share_queue: bool,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(Mesh, SimplifyReport, GpuRounds<'a>)> {
     let t = std::time::Instant::now();
-    let mut rounds = GpuRounds::new(sim, up, SELECTION_PASSES)?;
+    let prepared;
+    let (mut rounds, up) = match start {
+        Start::Upload(up) => (GpuRounds::new(sim, up, SELECTION_PASSES)?, up),
+        Start::Prepare(kernels, p) => {
+            let (r, up) = GpuRounds::prepared(sim, kernels, mesh, p, SELECTION_PASSES)?;
+            prepared = up;
+            (r, &prepared)
+        }
+    };
     rounds.share_queue = share_queue;
     let report = RoundsReport {
         adapter,

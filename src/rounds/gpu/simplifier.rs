@@ -41,6 +41,9 @@ pub struct GpuSimplifier {
     device: wgpu::Device,
     queue: wgpu::Queue,
     kernels: Kernels,
+    /// The preparation's stages, where the device has f64 in shaders (`None` elsewhere: the
+    /// host prepares).
+    prep: Option<Kernels>,
     /// Seconds spent compiling shaders and creating pipelines.
     pub pipeline_seconds: f64,
     /// How they were found: `hit`, `miss` or `unsupported` ([`crate::compute::disk_cache`]),
@@ -62,6 +65,7 @@ impl GpuSimplifier {
         let device = cache.device();
         let before = cache.compiled().len();
         let kernels = Kernels::new(cache, schedule::STAGES, "the simplifier")?;
+        let prep = super::prepare::kernels(cache)?;
         let pipeline_cache = match cache.cache_status() {
             _ if cache.compiled().len() == before => "shared",
             crate::compute::disk_cache::CacheStatus::Hit => "hit",
@@ -72,14 +76,20 @@ impl GpuSimplifier {
             pipeline_cache,
             device: device.clone(),
             queue: queue.clone(),
-            pipeline_seconds: kernels.seconds,
+            pipeline_seconds: kernels.seconds + prep.as_ref().map_or(0.0, |k| k.seconds),
             kernels,
+            prep,
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
         })
     }
 
     pub fn has_timestamps(&self) -> bool {
         self.timestamps
+    }
+
+    /// The preparation's stages, where the device runs them.
+    pub fn prepare_kernels(&self) -> Option<&Kernels> {
+        self.prep.as_ref()
     }
 }
 
@@ -255,10 +265,43 @@ impl<'a> GpuRounds<'a> {
         up: &Upload,
         selection_passes: u32,
     ) -> Result<GpuRounds<'a>> {
+        GpuRounds::build(sim, up, selection_passes, None, Costs::default())
+    }
+
+    /// Prepares the plain `mesh` on the device (`p` from [`crate::rounds::prepare::eligible`],
+    /// the device's preparation `kernels`) and allocates the rounds around what it wrote: the
+    /// rounds and the upload that describes them, whose arrays stay on the device.
+    pub fn prepared(
+        sim: &'a GpuSimplifier,
+        kernels: &Kernels,
+        mesh: &crate::mesh::Mesh,
+        p: &PrepParams,
+        selection_passes: u32,
+    ) -> Result<(GpuRounds<'a>, Upload)> {
+        let prep_costs = super::prepare::PrepCosts::default();
+        let device = (&sim.device, &sim.queue);
+        let d = super::prepare::prepare(device, kernels, mesh, p, &prep_costs, MESH_USAGE)?;
+        let costs = Costs::from_preparation(&prep_costs);
+        super::prepare::check_counts(&d, mesh)?;
+        let frame = ([p.frame[0], p.frame[1], p.frame[2]], p.frame[3]);
+        let up = Upload::on_device(mesh, d.vertices, d.faces, frame);
+        let r = GpuRounds::build(sim, &up, selection_passes, Some(d), costs)?;
+        Ok((r, up))
+    }
+
+    /// The rounds' buffers for `up`: the first half uploaded from it, or the one the device
+    /// `prepared`.
+    fn build(
+        sim: &'a GpuSimplifier,
+        up: &Upload,
+        selection_passes: u32,
+        prepared: Option<super::prepare::DevicePrepared>,
+        costs: Costs,
+    ) -> Result<GpuRounds<'a>> {
         let t = Instant::now();
         let dev = &sim.device;
         let scope = ErrorScope::push(dev);
-        let nv = up.positions.len().max(1) as u64;
+        let nv = up.vertex_count().max(1) as u64;
         let nf = up.face_count().max(1) as u64;
         let cap = 3 * nf;
         let mk = |label: &str, size: u64, usage: wgpu::BufferUsages| {
@@ -271,22 +314,33 @@ impl<'a> GpuRounds<'a> {
         };
         let mesh_usage = MESH_USAGE;
         let qsize = std::mem::size_of::<Quadric>() as u64;
-        let half0 = Half {
-            positions: init("positions", bytemuck::cast_slice(&up.positions), mesh_usage)?,
-            // Quadrics carried in (`hybrid`'s clusters) are the first round's; otherwise the
-            // first round's `vertex_quadrics` writes them.
-            quadrics: match &up.quadrics {
-                Some(q) => init("quadrics", bytemuck::cast_slice(q), SU)?,
-                None => mk("quadrics", nv * qsize, SU)?,
+        let half0 = match prepared {
+            Some(d) => Half {
+                positions: d.positions,
+                quadrics: mk("quadrics", nv * qsize, SU)?,
+                flags: d.flags,
+                vertex_attr: d.vertex_attr,
+                indices: d.indices,
+                face_normals: mk("face_normals", nf * 16, SU)?,
+                face_extra: d.face_extra,
             },
-            flags: init("flags", bytemuck::cast_slice(&up.flags), SU)?,
-            vertex_attr: init("vertex_attr", bytemuck::cast_slice(&up.vertex_attr), SU)?,
-            indices: init("indices", bytemuck::cast_slice(&up.indices), mesh_usage)?,
-            face_normals: match &up.face_planes {
-                Some(p) => init("face_normals", bytemuck::cast_slice(p), SU)?,
-                None => mk("face_normals", nf * 16, SU)?,
+            None => Half {
+                positions: init("positions", bytemuck::cast_slice(&up.positions), mesh_usage)?,
+                // Quadrics carried in (`hybrid`'s clusters) are the first round's; otherwise the
+                // first round's `vertex_quadrics` writes them.
+                quadrics: match &up.quadrics {
+                    Some(q) => init("quadrics", bytemuck::cast_slice(q), SU)?,
+                    None => mk("quadrics", nv * qsize, SU)?,
+                },
+                flags: init("flags", bytemuck::cast_slice(&up.flags), SU)?,
+                vertex_attr: init("vertex_attr", bytemuck::cast_slice(&up.vertex_attr), SU)?,
+                indices: init("indices", bytemuck::cast_slice(&up.indices), mesh_usage)?,
+                face_normals: match &up.face_planes {
+                    Some(p) => init("face_normals", bytemuck::cast_slice(p), SU)?,
+                    None => mk("face_normals", nf * 16, SU)?,
+                },
+                face_extra: init("face_extra", bytemuck::cast_slice(&up.face_extra), SU)?,
             },
-            face_extra: init("face_extra", bytemuck::cast_slice(&up.face_extra), SU)?,
         };
         let half1 = Half {
             positions: mk("positions_out", nv * 16, mesh_usage)?,
@@ -321,7 +375,7 @@ impl<'a> GpuRounds<'a> {
             sim,
             half: [half0, half1],
             cur: 0,
-            live_counts: (up.positions.len() as u32, up.face_count() as u32),
+            live_counts: (up.vertex_count() as u32, up.face_count() as u32),
             draw_args: mk(
                 "draw_args",
                 std::mem::size_of::<DrawArgs>() as u64,
@@ -374,7 +428,7 @@ impl<'a> GpuRounds<'a> {
             planned_round: false,
             trimming: false,
             bind_groups: HashMap::new(),
-            costs: Costs::default(),
+            costs,
             face_extra_out: up.output_needs_face_extra(),
             attr_values: match &up.attrs {
                 Some(a) => init("attr_values", bytemuck::cast_slice(&a.values), SU)?,
@@ -414,7 +468,7 @@ impl<'a> GpuRounds<'a> {
         };
         // Draw arguments for the mesh as uploaded: a renderer can draw it before any round.
         let args = DrawArgs {
-            index_count: up.indices.len() as u32,
+            index_count: 3 * up.face_count() as u32,
             instance_count: 1,
             ..Default::default()
         };

@@ -38,6 +38,23 @@ impl Costs {
         counter.fetch_add(n, Relaxed);
     }
 
+    /// Costs that begin with the preparation's on the device.
+    pub(crate) fn from_preparation(p: &crate::rounds::gpu::prepare::PrepCosts) -> Costs {
+        let c = Costs::default();
+        for (to, from) in [
+            (&c.waits, &p.waits),
+            (&c.submits, &p.submits),
+            (&c.dispatches, &p.dispatches),
+            (&c.bind_groups, &p.bind_groups),
+            (&c.uploaded, &p.uploaded),
+            (&c.read_back, &p.read_back),
+            (&c.blocked_ns, &p.blocked_ns),
+        ] {
+            Costs::add(to, Costs::get(from));
+        }
+        c
+    }
+
     pub fn get(counter: &AtomicU64) -> u64 {
         counter.load(Relaxed)
     }
