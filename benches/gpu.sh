@@ -4,7 +4,8 @@
 # prints one table (every QEM backend, cluster and hybrid on cpu-parallel and gpu, hybrid also
 # on cpu, its default: the greedy queue after the clusters; meshopt; time, rounds, faces, mean
 # error), the GPU's stage times from timestamp queries and the time spent outside the rounds
-# (pipelines, upload and read-back, preparation); the same as JSON.
+# (pipelines, upload and read-back, preparation; `qem` on the GPU with the preparation on the
+# device and on the host); the same as JSON.
 #
 #   bash benches/gpu.sh [--quick] [--out DIR] [--repeat N] [MESH...]
 #
@@ -77,6 +78,13 @@ for m in "${meshes[@]}"; do
                     --json --quiet >"$out/simplify-$i.json"
                 i=$((i + 1))
             done
+            # `qem` on the GPU once more with the host's preparation, to see what moving it
+            # to the device saved (the `prep` column).
+            if [ "$method" = qem ]; then
+                MESHSLIM_PREPARE=host "$bin" simplify "$m" "$out/o.ply" --ratio "$r" \
+                    --method qem --backend gpu --json --quiet >"$out/simplify-$i.json"
+                i=$((i + 1))
+            fi
         done
     done
 done
@@ -172,10 +180,11 @@ for r in reports:
 print()
 print("what each rounds run cost on the device's side: waits (round trips), submits, dispatches,")
 print("bind groups made, bytes each way; host: the call less its time blocked on the device;")
-print("cache: the pipelines from the on-disk cache (hit), compiled into it (miss), or neither")
+print("cache: the pipelines from the on-disk cache (hit), compiled into it (miss), or neither;")
+print("prep: where the mesh was welded, ordered and normalized (device, or host)")
 print(f"{'mesh':<30} {'ratio':>5} {'method':<8} {'backend':<12} {'simplify':>8} {'waits':>5} "
       f"{'submits':>7} {'dispatch':>8} {'binds':>5} {'MB up':>7} {'MB back':>7} {'host s':>7} "
-      f"{'cache':>11}")
+      f"{'cache':>11} {'prep':>6}")
 for r in reports:
     rr = r.get("rounds")
     if not rr:
@@ -187,7 +196,7 @@ for r in reports:
           f"{rr.get('submits', 0):>7} {rr.get('dispatches', 0):>8} "
           f"{rr.get('bind_groups_created', 0):>5} {rr.get('bytes_uploaded', 0) / 1e6:>7.1f} "
           f"{rr.get('bytes_read_back', 0) / 1e6:>7.2f} {rr.get('host_seconds', 0.0):>7.3f} "
-          f"{rr.get('pipeline_cache') or '-':>11}")
+          f"{rr.get('pipeline_cache') or '-':>11} {rr.get('prepared_on') or '-':>6}")
 gpu_qem = [r for r in reports if r["backend"] == "gpu" and r.get("rounds")
            and r.get("clustering") is None and r["target_faces"] * 50 < r["input_faces"]]
 for r in gpu_qem:

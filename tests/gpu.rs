@@ -656,14 +656,10 @@ fn gpu_report_counts_waits_bind_groups_and_bytes() {
         .map(|l| l.len())
         .sum::<usize>() as u64;
     // Two halves, and the prefix sum's three stages over each scan it runs; the preparation
-    // on the device makes one a stage, one a radix pass for the sort's two stages, and three
-    // a scan (the welded vertices, two sorts' digits, the used classes).
+    // on the device makes one a stage, a second for each of the sort's two stages (the other
+    // half), and three a scan (the welded vertices, the sorts' digits, the used classes).
     let prepared = if rr.prepared_on.as_deref() == Some("device") {
-        let own = meshslim::rounds::prepare::STAGES[1].len() as u64;
-        let passes = (meshslim::rounds::prepare::VERTEX_SORT_PASSES
-            + meshslim::rounds::prepare::face_sort_passes(m.positions.len()))
-            as u64;
-        own + 2 * (passes - 1) + 3 * 4
+        meshslim::rounds::prepare::STAGES[1].len() as u64 + 2 + 3 * 3
     } else {
         0
     };

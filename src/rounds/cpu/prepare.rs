@@ -33,7 +33,8 @@ pub fn weld_insert(
     weld_table: &mut [u32],
     weld_slot: &mut [u32],
 ) {
-    for v in 0..p.vertex_count as usize {
+    let n = p.vertex_count as usize;
+    for (v, slot) in weld_slot.iter_mut().enumerate().take(n) {
         let k = weld_key(in_positions, v);
         let mut h = (weld_hash(k) & p.table_mask) as usize;
         loop {
@@ -48,7 +49,7 @@ pub fn weld_insert(
             }
             h = (h + 1) & p.table_mask as usize;
         }
-        weld_slot[v] = h as u32;
+        *slot = h as u32;
     }
 }
 

@@ -8,6 +8,11 @@ pub mod simplifier;
 pub use crate::compute::context::GpuContext;
 pub use simplifier::{GpuMesh, GpuRounds, GpuSimplifier};
 
+/// A bind group's key: the stage and the buffers it binds (wgpu's handles compare by
+/// identity), so that a stage whose buffers do not change with the half makes one group, not
+/// one a half (the rounds' passes and the preparation's alike).
+pub(crate) type BindKey = (&'static str, Vec<wgpu::Buffer>);
+
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::options::{SimplifyOptions, SimplifyReport};

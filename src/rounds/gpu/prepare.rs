@@ -61,16 +61,20 @@ struct GpuPrepare<'a> {
     /// The sort's (keys, values) halves; `cur` is the one a pass reads.
     halves: [[wgpu::Buffer; 2]; 2],
     cur: usize,
-    /// One uniform per radix pass: the Morton sort's, then the faces'.
-    radix: Vec<wgpu::Buffer>,
+    /// The radix pass's uniform, copied in before each pass from `radix_all` (every pass's,
+    /// the Morton sort's then the faces'): one uniform, so the sort's stages bind one group a
+    /// half rather than one a pass.
+    radix: wgpu::Buffer,
+    radix_all: wgpu::Buffer,
     pass: usize,
-    /// Prefix sums' counts: the vertices, and each sort's digit counts.
-    scans: [wgpu::Buffer; 3],
+    /// Prefix sums' counts: the vertices, and the digit counts of the sort under way (copied
+    /// in from `digit_scans`, the two sorts', before each sort).
+    scans: [wgpu::Buffer; 2],
+    digit_scans: wgpu::Buffer,
     n: usize,
     m: usize,
-    /// Bind groups made so far, by stage, radix pass (for the stages that bind one) and scan
-    /// (count and data): the prefix sums of a sort's passes share theirs.
-    bind_groups: HashMap<(&'static str, usize, Option<(PCount, PBuf)>), wgpu::BindGroup>,
+    /// Bind groups made so far, by stage and the buffers bound.
+    bind_groups: HashMap<super::BindKey, wgpu::BindGroup>,
 }
 
 impl GpuPrepare<'_> {
@@ -98,7 +102,10 @@ impl GpuPrepare<'_> {
 
     /// `passes` radix passes of `steps`, the halves swapping after each.
     fn sort(&mut self, enc: &mut wgpu::CommandEncoder, steps: &[PStep], passes: u32) {
+        let which = u64::from(self.pass >= VERTEX_SORT_PASSES as usize);
+        enc.copy_buffer_to_buffer(&self.digit_scans, 16 * which, &self.scans[1], 0, 16);
         for _ in 0..passes {
+            enc.copy_buffer_to_buffer(&self.radix_all, 16 * self.pass as u64, &self.radix, 0, 16);
             self.record(enc, steps);
             self.cur = 1 - self.cur;
             self.pass += 1;
@@ -113,10 +120,9 @@ impl crate::compute::gpu::Runner<PBuf, PGrid, PCount, std::convert::Infallible> 
             PBuf::SortVals => &self.halves[self.cur][1],
             PBuf::SortKeysOut => &self.halves[1 - self.cur][0],
             PBuf::SortValsOut => &self.halves[1 - self.cur][1],
-            PBuf::Radix => &self.radix[self.pass],
+            PBuf::Radix => &self.radix,
             PBuf::ScanCount => match scan.map(|s| s.0) {
-                Some(PCount::VertexDigits) => &self.scans[1],
-                Some(PCount::FaceDigits) => &self.scans[2],
+                Some(PCount::VertexDigits | PCount::FaceDigits) => &self.scans[1],
                 _ => &self.scans[0],
             },
             PBuf::ScanData => &self.bufs[&scan.map_or(PBuf::WeldedId, |s| s.1)],
@@ -138,18 +144,18 @@ impl crate::compute::gpu::Runner<PBuf, PGrid, PCount, std::convert::Infallible> 
             PGrid::One => 1,
         };
         add(&self.costs.dispatches, 1);
-        let per_pass = stage.bindings.iter().any(|b| b.buf == PBuf::Radix);
-        let key = (
-            stage.entry,
-            if per_pass { self.pass } else { usize::MAX },
-            scan,
-        );
+        let bound = stage
+            .bindings
+            .iter()
+            .map(|b| self.buffer(b.buf, scan).clone())
+            .collect();
+        let key = (stage.entry, bound);
         if !self.bind_groups.contains_key(&key) {
             add(&self.costs.bind_groups, 1);
             let bg = self
                 .kernels
                 .bind_group(self.device, stage, |b| self.buffer(b, scan));
-            self.bind_groups.insert(key, bg);
+            self.bind_groups.insert(key.clone(), bg);
         }
         let bg = &self.bind_groups[&key];
         self.kernels
@@ -231,29 +237,27 @@ pub fn prepare(
     );
     bufs.insert(PBuf::Prep, init("params", bytemuck::bytes_of(p), uniform)?);
     let face_passes = face_sort_passes(n);
-    let radix = (0..VERTEX_SORT_PASSES + face_passes)
+    let passes: Vec<RadixParams> = (0..VERTEX_SORT_PASSES + face_passes)
         .map(|pass| {
             let (keys, shift) = if pass < VERTEX_SORT_PASSES {
                 (n, pass)
             } else {
                 (m, pass - VERTEX_SORT_PASSES)
             };
-            let r = RadixParams {
+            RadixParams {
                 n: keys as u32,
                 blocks: sort_blocks(keys),
                 shift: 8 * shift,
                 _pad: 0,
-            };
-            init("radix", bytemuck::bytes_of(&r), uniform)
+            }
         })
-        .collect::<Result<Vec<_>>>()?;
-    let scan = |count: u32| {
-        let s = ScanParams {
-            n: count,
-            _pad: [0; 3],
-        };
-        init("scan", bytemuck::bytes_of(&s), uniform)
+        .collect();
+    let copied = wgpu::BufferUsages::COPY_SRC;
+    let scan = |count: u32| ScanParams {
+        n: count,
+        _pad: [0; 3],
     };
+    let digit_counts = [scan(256 * sort_blocks(n)), scan(256 * sort_blocks(m))];
     let half = |label: &str| -> Result<[wgpu::Buffer; 2]> {
         Ok([
             mk(&format!("sort_keys{label}"), sorted * 4, SU)?,
@@ -265,13 +269,14 @@ pub fn prepare(
         kernels,
         costs,
         scans: [
-            scan(n as u32)?,
-            scan(256 * sort_blocks(n))?,
-            scan(256 * sort_blocks(m))?,
+            init("scan", bytemuck::bytes_of(&scan(n as u32)), uniform)?,
+            mk("scan_digits", 16, uniform)?,
         ],
+        digit_scans: init("digit_scans", bytemuck::cast_slice(&digit_counts), copied)?,
         halves: [half("")?, half("_out")?],
         cur: 0,
-        radix,
+        radix: mk("radix", 16, uniform)?,
+        radix_all: init("radix_all", bytemuck::cast_slice(&passes), copied)?,
         pass: 0,
         bufs,
         n,

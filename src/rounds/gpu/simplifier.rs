@@ -4,6 +4,7 @@
 //! state and each round's counters (and the stage timestamps when the device has them); the
 //! submissions and read-backs are in [`batch`].
 
+use super::BindKey;
 use crate::compute::context::{checked_buffer, checked_buffer_init};
 use crate::compute::gpu::{ErrorScope, Groups, Kernels, Pipelines, Runner};
 use crate::compute::types::*;
@@ -32,9 +33,6 @@ const EXHAUSTIVE_CHUNK: u32 = 8;
 const COUNTERS_BYTES: u64 = std::mem::size_of::<Counters>() as u64;
 /// `Counters::tentative`, cleared before each selection pass.
 const TENTATIVE_OFFSET: u64 = std::mem::offset_of!(Counters, tentative) as u64;
-
-/// A bind group's key: the stage, the half that is current, and the prefix sum's (count, data).
-type BindKey = (&'static str, usize, Option<(Count, Buf)>);
 
 /// Compute pipelines of every stage, made once for a device and reused for every mesh.
 pub struct GpuSimplifier {
@@ -213,8 +211,8 @@ pub struct GpuRounds<'a> {
     planned_round: bool,
     /// ...and its trim: the planner's trim grids.
     trimming: bool,
-    /// Every bind group made so far: the buffers never change, so each stage binds each
-    /// half's once.
+    /// Every bind group made so far: the buffers never change, so each stage binds each set
+    /// of them (a half's, a scan's) once.
     bind_groups: HashMap<BindKey, wgpu::BindGroup>,
     /// What the simplification cost on the device's side.
     pub costs: Costs,
@@ -703,14 +701,18 @@ impl Runner<Buf, schedule::Grid, Count, RoundStep> for GpuRounds<'_> {
             }
             _ => None,
         };
-        let key: BindKey = (stage.entry, self.cur, scan);
+        let bound = stage.bindings.iter();
+        let key: BindKey = (
+            stage.entry,
+            bound.map(|b| self.buffer(b.buf, scan).clone()).collect(),
+        );
         if !self.bind_groups.contains_key(&key) {
             let bg = self
                 .sim
                 .kernels
                 .bind_group(&self.sim.device, stage, |b| self.buffer(b, scan));
             Costs::add(&self.costs.bind_groups, 1);
-            self.bind_groups.insert(key, bg);
+            self.bind_groups.insert(key.clone(), bg);
         }
         let bg = &self.bind_groups[&key];
         self.sim
