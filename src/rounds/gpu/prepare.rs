@@ -3,7 +3,7 @@
 //! one read-back brings the counts the rounds' uniforms need. Recorded in one command buffer,
 //! the sorts' passes included (a uniform per pass, as the clustering's).
 
-use crate::compute::context::{checked_buffer, checked_buffer_init};
+use crate::compute::context::{checked_buffer, checked_buffer_write};
 use crate::compute::gpu::{ErrorScope, Groups, Kernels};
 use crate::compute::types::{
     FaceExtra, PrepCounts, PrepParams, RadixParams, SCAN_BLOCK, ScanParams, WG,
@@ -191,13 +191,8 @@ pub fn prepare(
     };
     let init = |label: &str, data: &[u8], usage: wgpu::BufferUsages| {
         add(&costs.uploaded, data.len() as u64);
-        checked_buffer_init(
-            dev,
-            &format!("meshslim.prep.{label}"),
-            data,
-            data.len(),
-            usage,
-        )
+        let label = format!("meshslim.prep.{label}");
+        checked_buffer_write(dev, queue, &label, data, usage)
     };
     let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
     let sorted = n1.max(m1);

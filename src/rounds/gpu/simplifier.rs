@@ -5,7 +5,7 @@
 //! submissions and read-backs are in [`batch`].
 
 use super::BindKey;
-use crate::compute::context::{checked_buffer, checked_buffer_init};
+use crate::compute::context::{checked_buffer, checked_buffer_init, checked_buffer_write};
 use crate::compute::gpu::{ErrorScope, Groups, Kernels, Pipelines, Runner};
 use crate::compute::types::*;
 use crate::error::{Error, Result};
@@ -308,7 +308,7 @@ impl<'a> GpuRounds<'a> {
         let uploaded = std::cell::Cell::new(0u64);
         let init = |label: &str, data: &[u8], usage: wgpu::BufferUsages| {
             uploaded.set(uploaded.get() + data.len() as u64);
-            checked_buffer_init(dev, &format!("meshslim.{label}"), data, data.len(), usage)
+            checked_buffer_write(dev, &sim.queue, &format!("meshslim.{label}"), data, usage)
         };
         let mesh_usage = MESH_USAGE;
         let qsize = std::mem::size_of::<Quadric>() as u64;
