@@ -2,7 +2,7 @@
 //! non-manifold edge taken apart) to an intermediate count, then QEM to the exact target
 //! (Garland & Shaffer's multiphase simplification, 2002). On `cpu` (the default) the second
 //! phase is the greedy queue on the clustered surface, faster and lower in error than the
-//! rounds (docs/PERFORMANCE.md, "Stop 37"); on `cpu-parallel` and `gpu` it is the rounds from
+//! rounds (docs/PERFORMANCE.md, "`hybrid`"); on `cpu-parallel` and `gpu` it is the rounds from
 //! the clusters' quadrics, the same upload on both (twins). The clustering stays on the CPU on
 //! every backend: its split of cells by connectivity is a union-find, and its repairs
 //! ([`super::repair`]) are worked out from the build before.
@@ -22,11 +22,11 @@ pub const HYBRID_FACTOR: f64 = 2.0;
 /// the target alone the mean error at 10% was 1.07× the greedy's on the oversampled 1M scan but
 /// 1.33× on horse and 1.25× on igea; at 3× the 1M scan's hybrid fell below meshoptimizer's
 /// speed; 2× + 20,000 gave 1.06×, 1.09× and 1.13× with the 1M scan 1.18× meshoptimizer's
-/// speed (docs/PERFORMANCE.md, "Clustering").
+/// speed (docs/PERFORMANCE.md, "`hybrid`").
 pub const HYBRID_EXTRA: f64 = 20_000.0;
 /// ...but to no fewer than this share of the input's faces: cells coarse enough for 2% of the
 /// 1M scan left errors the rounds could not undo (mean 1.38× the greedy's at 1%, against
-/// 1.10× from 5%; docs/PERFORMANCE.md, "hybrid").
+/// 1.10× from 5%; docs/PERFORMANCE.md, "`hybrid`").
 pub const HYBRID_MIN_SHARE: f64 = 0.05;
 /// ...unless that is more than this share of the input: merging only pairs of vertices costs a
 /// clustering without saving rounds, so the rounds start from the input.
@@ -57,7 +57,7 @@ pub(super) fn intermediate(target: usize, input: usize) -> usize {
 /// The backend the hybrid's second phase runs on from the clusters `c`: the greedy queue
 /// (`cpu`) where `opts` asks for `cpu` or `auto` and no appearance channel is in the cost; the
 /// rounds (`cpu-parallel`, or `gpu` when asked for) otherwise: on painted scans at 1% the
-/// greedy's colour error was up to 1.05× the rounds' (docs/PERFORMANCE.md, "Stop 37"). Without
+/// greedy's colour error was up to 1.05× the rounds' (docs/PERFORMANCE.md, "`hybrid`"). Without
 /// clusters (a target too close to the input for them to pay) every backend runs the rounds
 /// ([`rounds_upload`]): the greedy queue there would be `qem`'s own, whose mean error on the
 /// small shared models (teapot, suzanne, spot) is up to 1.14× the rounds'.

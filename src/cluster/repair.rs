@@ -1,6 +1,6 @@
 //! The hybrid's repairs: clusters that pinch a non-manifold edge or fold a face over, found
 //! and taken apart until none is left, each repair worked out from the build before rather
-//! than built again (docs/PERFORMANCE.md, "`hybrid`: its repairs worked out, not built again").
+//! than built again (its cost on the 1M scan: docs/PERFORMANCE.md, "Speed against meshoptimizer").
 
 use super::grid::Grid;
 use super::stages::face_plane;

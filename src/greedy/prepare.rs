@@ -73,10 +73,10 @@ pub(crate) struct Prepared {
 ///
 /// The clusters' quadrics are not carried: the queue ranks collapses by the clustered
 /// surface's own planes. Measured on the four shared scans and both 1M meshes at 10% and 1%,
-/// that gave a mean error 4–19% below the rounds' from the carried quadrics, and 3–17% below
-/// this queue's from them (docs/PERFORMANCE.md, "Stop 37"). Summed over a whole cell, the
-/// members' planes charge every collapse for the cell's spread of orientations, where the
-/// clustered surface keeps only what is left of it.
+/// that gave a mean error 4–19% below the rounds' from the carried quadrics (docs/PERFORMANCE.md,
+/// "`hybrid`"), and 3–17% below this queue's from them. Summed over a whole cell, the members'
+/// planes charge every collapse for the cell's spread of orientations, where the clustered
+/// surface keeps only what is left of it.
 pub(crate) struct Carried<'a> {
     pub frame: ([f64; 3], f64),
     pub normals: &'a [[f32; 3]],
