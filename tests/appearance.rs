@@ -2,7 +2,7 @@
 //! colours and UVs weighed in the collapse cost and solved for the survivors, on generated,
 //! painted meshes.
 
-mod common;
+use crate::common;
 
 use common::*;
 use meshslim::mesh::{self, Mesh};

@@ -2,7 +2,7 @@
 //! row with every field, each of ours is held against its meshoptimizer peer under the table,
 //! the plot has one series per backend, bad usage exits 2.
 
-mod common;
+use crate::common;
 use common::{expect_code, meshslim};
 
 /// 1280 faces, one repeat, few samples: the whole run takes a fraction of a second.

@@ -1,6 +1,6 @@
 //! The `meshslim` binary end to end: arguments, exit codes, messages, files written.
 
-mod common;
+use crate::common;
 use common::{expect_code, meshslim};
 use std::path::{Path, PathBuf};
 use std::process::Output;

@@ -1,6 +1,6 @@
 //! `meshslim remesh` and `simplify --remesh` end to end: files written, reports, usage errors.
 
-mod common;
+use crate::common;
 
 #[test]
 fn the_commands_remesh_and_simplify_then_remesh() {

@@ -2,7 +2,7 @@
 //! closed from any view, the .mslod file and its reader's errors, the same bytes on any number
 //! of threads, `gpu` = `cpu-parallel`, and the grouped rounds a level is simplified with.
 
-mod common;
+use crate::common;
 
 use common::*;
 use meshslim::dag::{self, CameraCut, Dag, DagOptions, NONE};

@@ -1,7 +1,7 @@
 //! Vertex decimation (`--method decimate`): hand-built fans with known outcomes, the loop
 //! splitting of a polygon with a known best diagonal, and the invariants on generated meshes.
 
-mod common;
+use crate::common;
 
 use common::{check_invariants, generated_meshes};
 use glam::DVec3;

@@ -2,7 +2,7 @@
 //! CPU twin after a round from the same input, the whole pipeline against `cpu-parallel`, the
 //! invariants, determinism. With CI=true a missing adapter fails instead of skipping.
 
-mod common;
+use crate::common;
 
 use common::*;
 use meshslim::compute::common::{length, sub, xyz};

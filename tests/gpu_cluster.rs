@@ -2,8 +2,8 @@
 //! twin (src/cluster/twins.rs) on generated meshes, integers exactly and floats within 1e-4, and
 //! the whole GPU build against the CPU driver's. With CI=true a missing adapter fails.
 
-mod cluster_twins;
-mod common;
+use crate::cluster_twins;
+use crate::common;
 
 use cluster_twins as twins;
 use common::{gpu_context, pod, unit_close};

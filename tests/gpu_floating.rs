@@ -4,8 +4,8 @@
 //! twins' chain; and `simplify` on the GPU against cpu-parallel. With CI=true a missing adapter
 //! fails.
 
-mod cluster_twins;
-mod common;
+use crate::cluster_twins;
+use crate::common;
 
 use cluster_twins as twins;
 use cluster_twins::floating as ft;

@@ -4,7 +4,7 @@
 //! same backend started from the host's preparation, byte for byte. With CI=true a missing
 //! adapter fails instead of skipping, and so does lavapipe without f64 in shaders.
 
-mod common;
+use crate::common;
 
 use common::*;
 use meshslim::compute::types::FaceExtra;

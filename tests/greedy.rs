@@ -1,7 +1,7 @@
 //! The greedy reference backend (`cpu`): invariants on generated meshes at 50%, 10% and 1%, tiny
 //! hand-built cases with exact results, and the shared scans when they are present.
 
-mod common;
+use crate::common;
 
 use common::*;
 use meshslim::mesh::{self, topology};

@@ -2,7 +2,7 @@
 //! and (when present) the reference models in `shared/models`; hostile inputs are in
 //! tests/io_hostile.rs.
 
-mod io_support;
+use crate::io_support;
 
 use std::path::{Path, PathBuf};
 

@@ -2,7 +2,7 @@
 //! give an error naming the file and the offset, or a mesh, never a panic or a runaway
 //! allocation; writes are atomic and validated.
 
-mod io_support;
+use crate::io_support;
 
 use io_support::*;
 use meshslim::Mesh;

@@ -1,7 +1,7 @@
 //! The round-based backend on the CPU (`cpu-parallel`): the greedy reference's invariants on
 //! generated meshes, determinism, tiny exact cases, and the shared scans when present.
 
-mod common;
+use crate::common;
 
 use common::*;
 use meshslim::{Backend, Mesh, SimplifyOptions, StopReason, simplify};

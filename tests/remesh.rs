@@ -1,7 +1,7 @@
 //! Isotropic remeshing on generated meshes: what it must keep (manifoldness, Euler
 //! characteristic, borders, sharp edges, orientation) and where its vertices end up.
 
-mod common;
+use crate::common;
 
 use meshslim::Mesh;
 use meshslim::mesh::{self, topology};

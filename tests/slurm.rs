@@ -4,7 +4,7 @@
 //! of `tiles run --jobs 2`. Without the packages (or root) the test says so and passes, unless
 //! CI=true, where it fails: .ci/run installs them.
 
-mod common;
+use crate::common;
 
 use common::{expect_code, meshslim};
 use std::path::{Path, PathBuf};

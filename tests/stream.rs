@@ -2,7 +2,7 @@
 //! every pass give the clustering the whole-mesh path gives; options it cannot honour are
 //! refused with a clear message; the command line streams on request or when the budget says so.
 
-mod common;
+use crate::common;
 
 use common::{expect_code, meshslim};
 use meshslim::cluster::stream::{Target, simplify_file_in_blocks};

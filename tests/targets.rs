@@ -2,7 +2,7 @@
 //! faces), never above, unless no valid collapse is left — and then the report says why. The
 //! rounds reach every target the greedy reference reaches.
 
-mod common;
+use crate::common;
 use common::{generated_meshes, gpu_context, shared_models};
 use meshslim::{Backend, Mesh, SimplifyOptions, StopReason, simplify};
 

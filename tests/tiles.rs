@@ -3,7 +3,7 @@
 //! and thins the former borders like the rest; a tile's output does not depend on who ran it.
 //! The run under a real Slurm is tests/slurm.rs.
 
-mod common;
+use crate::common;
 
 use common::{expect_code, gpu_context, meshslim};
 use meshslim::cluster::stream::Target;

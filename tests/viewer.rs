@@ -2,7 +2,7 @@
 //! simplifier's own buffers cover the mesh's part of the image, each mode gives a different
 //! image, and the screenshot command writes a PNG. With CI=true a missing adapter fails.
 
-mod common;
+use crate::common;
 
 use common::*;
 use meshslim::UvOrigin;

@@ -4,8 +4,8 @@
 //! it; modes, side by side and the LOD scene change what is drawn; shortcuts are ignored while a
 //! text field has the keyboard. With CI=true a missing adapter fails.
 
-mod common;
-mod viewer_support;
+use crate::common;
+use crate::viewer_support;
 
 use common::*;
 use eframe::egui;

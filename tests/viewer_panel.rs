@@ -3,8 +3,8 @@
 //! starts on and why, the ratio slider, Enter in the faces field, the idle frame line. With
 //! CI=true a missing adapter fails.
 
-mod common;
-mod viewer_support;
+use crate::common;
+use crate::viewer_support;
 
 use common::*;
 use eframe::egui;
