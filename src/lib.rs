@@ -30,6 +30,21 @@
 //!   single local-minimum pass removed 8–9%).
 //! - B. Karis, R. Stubbe, G. Wihlidal. A Deep Dive into Nanite Virtualized Geometry. SIGGRAPH
 //!   2021 (the cluster DAG of [`dag`]).
+//!
+//! The other families:
+//! - J. Rossignac, P. Borrel. Multi-Resolution 3D Approximations for Rendering Complex Scenes.
+//!   1993 (uniform vertex clustering, `cluster`).
+//! - K.-L. Low, T.-S. Tan. Model Simplification Using Vertex-Clustering. I3D 1997 (floating
+//!   cells, `cluster`).
+//! - P. Lindstrom. Out-of-Core Simplification of Large Polygonal Models. SIGGRAPH 2000 (a
+//!   cluster's quadric, the hybrid's first phase, and the streaming of [`io::stream`] and
+//!   [`tiles`]).
+//! - W. Schroeder, J. Zarge, W. Lorensen. Decimation of Triangle Meshes. SIGGRAPH 1992
+//!   ([`decimate`]).
+//! - M. Botsch, L. Kobbelt. A Remeshing Approach to Multiresolution Modeling. SGP 2004
+//!   (isotropic remeshing, [`remesh`]).
+//! - K. Deb, A. Pratap, S. Agarwal, T. Meyarivan. A Fast and Elitist Multiobjective Genetic
+//!   Algorithm: NSGA-II. IEEE TEC 2002 (the Pareto levels of detail of [`lod`]).
 
 #[cfg(feature = "bench")]
 pub mod bench;

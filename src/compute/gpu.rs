@@ -247,6 +247,28 @@ impl Kernels {
         )
     }
 
+    /// One dispatch of `stage` into an open compute pass, with a bind group made by
+    /// [`Kernels::bind_group`]: a family that records many dispatches back to back puts them
+    /// in one pass, since wgpu encodes each pass into command buffers of its own.
+    pub fn dispatch_in<B, G>(
+        &self,
+        pass: &mut wgpu::ComputePass,
+        stage: &Stage<B, G>,
+        bg: &wgpu::BindGroup,
+        groups: Groups,
+        indirect: Option<&wgpu::Buffer>,
+    ) {
+        dispatch_in(
+            pass,
+            &self.pipelines,
+            stage,
+            bg,
+            groups,
+            self.max_workgroups,
+            indirect,
+        )
+    }
+
     /// One compute pass of `stage` into `enc`: see [`pass`].
     #[allow(clippy::too_many_arguments)]
     pub fn pass<'b, B: Copy, G>(
@@ -342,15 +364,23 @@ pub trait Runner<B: Copy + 'static, G: 'static, C: Copy, X: Copy> {
     fn own(&mut self, enc: &mut wgpu::CommandEncoder, step: X);
     /// The three passes of the family's prefix sum (`shared_stages!`'s `PREFIX_SUM`).
     fn prefix_sum(&self) -> [&'static Stage<B, G>; 3];
+    /// Ends the compute pass [`Runner::run`] left open, if it keeps one: a clear or a copy
+    /// records on the encoder itself, which an open pass locks. A runner that keeps passes
+    /// open ends them before its own steps and its own uses of the encoder too.
+    fn end_pass(&mut self) {}
 }
 
-/// Records a family's `steps` into `enc`: the one interpreter of the steps on the GPU.
+/// Records a family's `steps` into `enc`: the one interpreter of the steps on the GPU. A pass
+/// the runner keeps open stays open after the last step ([`Runner::end_pass`]).
 pub fn record<B: Copy + 'static, G: 'static, C: Copy, X: Copy>(
     runner: &mut impl Runner<B, G, C, X>,
     enc: &mut wgpu::CommandEncoder,
     steps: &[Step<B, G, C, X>],
 ) {
     for step in steps {
+        if matches!(step, Step::Clear(_) | Step::CopyBuffer(..)) {
+            runner.end_pass();
+        }
         match *step {
             Step::Clear(buf) => enc.clear_buffer(runner.buffer(buf, None), 0, None),
             Step::CopyBuffer(from, to) => {
@@ -427,11 +457,24 @@ fn dispatch<B, G>(
     indirect: Option<&wgpu::Buffer>,
     timestamps: Option<wgpu::ComputePassTimestampWrites>,
 ) {
-    let (label, pipeline) = (stage.entry, &pipelines[stage.entry]);
     let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-        label: Some(label),
+        label: Some(stage.entry),
         timestamp_writes: timestamps,
     });
+    dispatch_in(&mut pass, pipelines, stage, bg, groups, max_x, indirect)
+}
+
+/// One dispatch of `stage` into an open compute pass (see [`pass`]).
+fn dispatch_in<B, G>(
+    pass: &mut wgpu::ComputePass,
+    pipelines: &HashMap<&'static str, wgpu::ComputePipeline>,
+    stage: &Stage<B, G>,
+    bg: &wgpu::BindGroup,
+    groups: Groups,
+    max_x: u32,
+    indirect: Option<&wgpu::Buffer>,
+) {
+    let (label, pipeline) = (stage.entry, &pipelines[stage.entry]);
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, bg, &[]);
     match (groups, indirect) {

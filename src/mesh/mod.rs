@@ -374,16 +374,19 @@ impl Mesh {
             .par_iter_mut()
             .with_min_len(1 << 14)
             .for_each(|t| *t = t.map(|v| place[v as usize]));
-        fn pick<T: Copy + Send + Sync>(order: &[u32], src: &[T]) -> Vec<T> {
-            order
-                .par_iter()
-                .with_min_len(1 << 14)
-                .map(|&v| src[v as usize])
-                .collect()
-        }
         self.positions = pick(&order, &self.positions);
         self.normals = self.normals.as_deref().map(|s| pick(&order, s));
         self.uvs = self.uvs.as_deref().map(|s| pick(&order, s));
         self.colors = self.colors.as_deref().map(|s| pick(&order, s));
     }
+}
+
+/// The entries of `src` at `order`, in that order (a renumbering's vertex data), on every core.
+pub(crate) fn pick<T: Copy + Send + Sync>(order: &[u32], src: &[T]) -> Vec<T> {
+    use rayon::prelude::*;
+    order
+        .par_iter()
+        .with_min_len(1 << 14)
+        .map(|&v| src[v as usize])
+        .collect()
 }

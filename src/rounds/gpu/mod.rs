@@ -73,10 +73,12 @@ pub fn simplify_with(
         let prepare = t.elapsed().as_secs_f64();
         let adapter = Some(ctx.adapter_name.clone());
         let start = Start::Prepare(kernels, &p);
-        let (out, mut rep, _) = run_rounds_from(sim, adapter, start, mesh, opts, false, progress)?;
+        let (out, mut rep, rounds) =
+            run_rounds_from(sim, adapter, start, mesh, opts, false, progress)?;
+        let retire = retire(rounds);
         if let Some(r) = rep.rounds.as_mut() {
             r.prepare_seconds = prepare;
-            r.host_seconds += prepare;
+            r.host_seconds += prepare + retire;
             r.prepared_on = Some("device".into());
         }
         return Ok((out, rep));
@@ -114,8 +116,20 @@ pub fn simplify_upload(
     progress: &mut dyn FnMut(f32),
 ) -> Result<(Mesh, SimplifyReport)> {
     let adapter = Some(ctx.adapter_name.clone());
-    let (out, rep, _) = run_rounds(sim, adapter, up, mesh, opts, false, progress)?;
+    let (out, mut rep, rounds) = run_rounds(sim, adapter, up, mesh, opts, false, progress)?;
+    let retire = retire(rounds);
+    if let Some(r) = rep.rounds.as_mut() {
+        r.host_seconds += retire;
+    }
     Ok((out, rep))
+}
+
+/// Hands `rounds` to [`GpuRounds::retire`]; the seconds that took this thread, which are the
+/// call's too.
+fn retire(rounds: GpuRounds) -> f64 {
+    let t = std::time::Instant::now();
+    rounds.retire();
+    t.elapsed().as_secs_f64()
 }
 
 /// The rounds on `up` with `sim`'s pipelines, the rounds given back with the result in their

@@ -15,14 +15,16 @@ use std::collections::HashMap;
 use std::time::Instant;
 
 mod batch;
+mod passes;
 pub use batch::Costs;
 
 const SU: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
     .union(wgpu::BufferUsages::COPY_DST)
     .union(wgpu::BufferUsages::COPY_SRC);
 
-/// Timestamp slots per submission (a round, or a batch of them): two per compute pass, up to
-/// the 4096 queries a WebGPU query set may hold.
+/// Timestamp slots per submission (a round, or a batch of them): one per dispatch and one per
+/// compute pass (two per dispatch where stamps only bracket passes), up to the 4096 queries a
+/// WebGPU query set may hold.
 const QUERY_CAP: u32 = 4096;
 
 /// Selection passes recorded between two read-backs in an exhaustive round: a pass with nothing
@@ -48,6 +50,9 @@ pub struct GpuSimplifier {
     /// or `shared` when another family on the device had made them all.
     pub pipeline_cache: &'static str,
     timestamps: bool,
+    /// Timestamps can be written between the dispatches of a pass: the rounds then record
+    /// their dispatches in few passes and still time each.
+    stamps_in_passes: bool,
 }
 
 impl GpuSimplifier {
@@ -78,6 +83,9 @@ impl GpuSimplifier {
             kernels,
             prep,
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
+            stamps_in_passes: device
+                .features()
+                .contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES),
         })
     }
 
@@ -237,8 +245,14 @@ pub struct GpuRounds<'a> {
     groups: u64,
     readback: wgpu::Buffer,
     queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
-    /// Stage of each timestamp pair recorded this round.
-    query_stages: Vec<&'static str>,
+    /// Stage of each dispatch timed this submission, with the slot of the stamp before it
+    /// (the one after it is the next slot).
+    query_stages: Vec<(&'static str, u32)>,
+    /// The first timestamp slot not written yet this submission.
+    next_slot: u32,
+    /// The compute pass the dispatches are going into, left open across consecutive
+    /// dispatches ([`Runner::end_pass`] ends it), and the slot of its last stamp.
+    pass: Option<(wgpu::ComputePass<'static>, Option<u32>)>,
     times: StageTimes,
     selection_passes: u32,
     /// The upload brought the face planes and quadrics: the first round skips
@@ -456,6 +470,8 @@ impl<'a> GpuRounds<'a> {
             )?,
             queries,
             query_stages: Vec::new(),
+            next_slot: 0,
+            pass: None,
             times: StageTimes::default(),
             selection_passes,
             carried_quadrics: up.quadrics.is_some(),
@@ -476,6 +492,99 @@ impl<'a> GpuRounds<'a> {
         let mut r = r;
         r.transfer_seconds += t.elapsed().as_secs_f64();
         Ok(r)
+    }
+
+    /// Frees the rounds' buffers on a thread of their own, so that the call returns without
+    /// waiting for it: on lavapipe, whose device memory is the process's, unmapping the 1M
+    /// scan's buffers took 0.03-0.04 s, more than the rest of the host's part of the call.
+    pub fn retire(self) {
+        let GpuRounds {
+            half,
+            draw_args,
+            params,
+            scan_v,
+            scan_f,
+            scan_e,
+            offsets,
+            cursor,
+            vertex_faces,
+            edge_offsets,
+            edges,
+            candidates,
+            edge_state,
+            histogram,
+            trim_histogram,
+            live,
+            face_best,
+            face_id,
+            vertex_lock,
+            remap,
+            vertex_keep,
+            face_keep,
+            marks,
+            tentative,
+            dispatch,
+            neighbours,
+            block_sums,
+            counters,
+            plan,
+            planned,
+            attr_values,
+            attr_sums,
+            face_group,
+            group_target,
+            group_count,
+            group_closed,
+            group_err,
+            readback,
+            bind_groups,
+            queries,
+            ..
+        } = self;
+        let buffers = [
+            draw_args,
+            params,
+            scan_v,
+            scan_f,
+            scan_e,
+            offsets,
+            cursor,
+            vertex_faces,
+            edge_offsets,
+            edges,
+            candidates,
+            edge_state,
+            histogram,
+            trim_histogram,
+            live,
+            face_best,
+            face_id,
+            vertex_lock,
+            remap,
+            vertex_keep,
+            face_keep,
+            marks,
+            tentative,
+            dispatch,
+            neighbours,
+            block_sums,
+            counters,
+            plan,
+            planned,
+            attr_values,
+            attr_sums,
+            face_group,
+            group_target,
+            group_count,
+            group_closed,
+            group_err,
+            readback,
+        ];
+        let resources = (half, buffers, bind_groups, queries);
+        // A thread that cannot start leaves the freeing to this one.
+        let _ = std::thread::Builder::new()
+            .name("meshslim-free".into())
+            .spawn(move || drop(resources));
     }
 
     /// Records the steps in `steps` with the round's parameters `p`.
@@ -590,171 +699,5 @@ impl<'a> GpuRounds<'a> {
         scope.check("reading back")?;
         Costs::add(&self.costs.read_back, bytes);
         Ok(data)
-    }
-}
-
-impl Runner<Buf, schedule::Grid, Count, RoundStep> for GpuRounds<'_> {
-    /// The buffer bound for `buf`; `scan` is the prefix sum's (count, data) when one runs.
-    fn buffer(&self, buf: Buf, scan: Option<(Count, Buf)>) -> &wgpu::Buffer {
-        let (h, o) = (&self.half[self.cur], &self.half[1 - self.cur]);
-        match buf {
-            Buf::Params => &self.params,
-            Buf::ScanCount => match scan.map(|s| s.0) {
-                Some(Count::Faces) => &self.scan_f,
-                Some(Count::EdgeSlots) => &self.scan_e,
-                // A prefix sum always names its count; vertices otherwise.
-                Some(Count::Vertices) | None => &self.scan_v,
-            },
-            Buf::ScanData => match scan {
-                Some((_, data)) if data != Buf::ScanData => self.buffer(data, None),
-                _ => &self.offsets,
-            },
-            Buf::BlockSums => &self.block_sums,
-            Buf::Positions => &h.positions,
-            Buf::Quadrics => &h.quadrics,
-            Buf::Flags => &h.flags,
-            Buf::VertexAttr => &h.vertex_attr,
-            Buf::Indices => &h.indices,
-            Buf::FaceNormals => &h.face_normals,
-            Buf::FaceExtra => &h.face_extra,
-            Buf::PositionsOut => &o.positions,
-            Buf::QuadricsOut => &o.quadrics,
-            Buf::FlagsOut => &o.flags,
-            Buf::VertexAttrOut => &o.vertex_attr,
-            Buf::IndicesOut => &o.indices,
-            Buf::FaceNormalsOut => &o.face_normals,
-            Buf::FaceExtraOut => &o.face_extra,
-            Buf::Offsets => &self.offsets,
-            Buf::Cursor => &self.cursor,
-            Buf::VertexFaces => &self.vertex_faces,
-            Buf::EdgeOffsets => &self.edge_offsets,
-            Buf::Neighbours => &self.neighbours,
-            Buf::Remap => &self.remap,
-            Buf::Edges => &self.edges,
-            Buf::Candidates => &self.candidates,
-            Buf::EdgeState => &self.edge_state,
-            Buf::Histogram => &self.histogram,
-            Buf::Live => &self.live,
-            Buf::VertexLock => &self.vertex_lock,
-            Buf::FaceBest => &self.face_best,
-            Buf::FaceId => &self.face_id,
-            Buf::Tentative => &self.tentative,
-            Buf::TrimHistogram => &self.trim_histogram,
-            Buf::Marks => &self.marks,
-            Buf::VertexKeep => &self.vertex_keep,
-            Buf::FaceKeep => &self.face_keep,
-            Buf::Counters => &self.counters,
-            Buf::Dispatch => &self.dispatch,
-            Buf::DrawArgs => &self.draw_args,
-            Buf::AttrValues => &self.attr_values,
-            Buf::AttrSums => &self.attr_sums,
-            Buf::Plan => &self.plan,
-            Buf::Planned => &self.planned,
-            Buf::FaceGroup => &self.face_group,
-            Buf::GroupTarget => &self.group_target,
-            Buf::GroupCount => &self.group_count,
-            Buf::GroupClosed => &self.group_closed,
-            Buf::GroupErr => &self.group_err,
-        }
-    }
-
-    /// One compute pass of `stage` with its bindings in the shader's order, over its grid.
-    fn run(
-        &mut self,
-        enc: &mut wgpu::CommandEncoder,
-        stage: &'static Stage,
-        scan: Option<(Count, Buf)>,
-    ) {
-        let p = &self.round_params;
-        let wg = |n: u32| Groups::Direct(n.div_ceil(WG));
-        let planned = match stage.grid {
-            _ if !self.planned_round => None,
-            grid => Self::planned_grid(grid, scan.map(|s| s.0), self.trimming),
-        };
-        let (groups, args) = match (planned, stage.grid) {
-            (Some(at), _) => (Groups::Indirect(at), &self.planned),
-            (None, schedule::Grid::Each(count)) => (wg(count.of(p)), &self.dispatch),
-            (None, schedule::Grid::VerticesOrFaces) => {
-                (wg(p.vertex_count.max(p.face_count)), &self.dispatch)
-            }
-            (None, schedule::Grid::ScanBlocks) => {
-                let n = scan.map_or(p.vertex_count, |(count, _)| count.of(p));
-                (Groups::Direct(n.div_ceil(SCAN_BLOCK)), &self.dispatch)
-            }
-            (None, schedule::Grid::One | schedule::Grid::Planner) => {
-                (Groups::Direct(1), &self.dispatch)
-            }
-            (None, indirect) => (
-                Groups::Indirect(indirect.indirect_offset().unwrap_or(0)),
-                &self.dispatch,
-            ),
-        };
-        let qi = self.query_stages.len() as u32 * 2;
-        let timestamps = match &self.queries {
-            Some((set, _)) if qi + 2 <= QUERY_CAP => {
-                self.query_stages.push(stage.entry);
-                Some(wgpu::ComputePassTimestampWrites {
-                    query_set: set,
-                    beginning_of_pass_write_index: Some(qi),
-                    end_of_pass_write_index: Some(qi + 1),
-                })
-            }
-            _ => None,
-        };
-        let bound = stage.bindings.iter();
-        let key: BindKey = (
-            stage.entry,
-            bound.map(|b| self.buffer(b.buf, scan).clone()).collect(),
-        );
-        if !self.bind_groups.contains_key(&key) {
-            let bg = self
-                .sim
-                .kernels
-                .bind_group(&self.sim.device, stage, |b| self.buffer(b, scan));
-            Costs::add(&self.costs.bind_groups, 1);
-            self.bind_groups.insert(key.clone(), bg);
-        }
-        let bg = &self.bind_groups[&key];
-        self.sim
-            .kernels
-            .pass_bound(enc, stage, bg, groups, Some(args), timestamps);
-        Costs::add(&self.costs.dispatches, 1);
-        if self.share_queue {
-            // Submit this pass alone and wait for it, so that work others put on the queue
-            // meanwhile (the viewer's frames) runs between passes instead of after the round.
-            let done = std::mem::replace(
-                enc,
-                self.sim
-                    .device
-                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                        label: Some("meshslim.round"),
-                    }),
-            );
-            let index = self.submit(done);
-            // A failed wait shows up at the round's own wait, which reports it.
-            let t = Instant::now();
-            let _ = self.sim.device.poll(wgpu::PollType::Wait {
-                submission_index: Some(index),
-                timeout: None,
-            });
-            Costs::add(&self.costs.waits, 1);
-            Costs::add(&self.costs.blocked_ns, t.elapsed().as_nanos() as u64);
-        }
-    }
-
-    fn own(&mut self, enc: &mut wgpu::CommandEncoder, step: RoundStep) {
-        match step {
-            RoundStep::ClearTentative => {
-                enc.clear_buffer(&self.counters, TENTATIVE_OFFSET, Some(4))
-            }
-            // The GPU's winners are checked by the tests against the CPU twin; nothing on the
-            // device writes through unchecked host memory.
-            RoundStep::CheckWinners => {}
-            RoundStep::ApplyPlan => self.apply_plan(enc),
-        }
-    }
-
-    fn prefix_sum(&self) -> [&'static Stage; 3] {
-        schedule::PREFIX_SUM
     }
 }

@@ -175,6 +175,7 @@ impl GpuRounds<'_> {
                             // recorded and read the last pass's tentative count; none means
                             // no candidate is left to settle.
                             Selection::Exhaustive if pass > 0 && pass % EXHAUSTIVE_CHUNK == 0 => {
+                                self.end_pass();
                                 let done = std::mem::replace(enc, self.encoder());
                                 self.submit(done);
                                 let now: Counters = *bytemuck::from_bytes(
@@ -199,6 +200,7 @@ impl GpuRounds<'_> {
             }
         }
         self.planned_round = false;
+        self.end_pass();
         Ok(())
     }
 
@@ -210,12 +212,14 @@ impl GpuRounds<'_> {
             })
     }
 
-    /// Timestamp pairs into the stage times, or the wall time when the device has none.
+    /// The stamps before and after each timed dispatch into the stage times, or the wall
+    /// time when the device has none.
     fn add_times(&mut self, stamps: &[u64], wall: f64) {
         if self.queries.is_some() && !stamps.is_empty() {
             let period = self.sim.queue.get_timestamp_period() as f64 * 1e-9;
-            for (i, stage) in self.query_stages.iter().enumerate() {
-                let d = stamps[2 * i + 1].saturating_sub(stamps[2 * i]);
+            for &(stage, at) in &self.query_stages {
+                let at = at as usize;
+                let d = stamps[at + 1].saturating_sub(stamps[at]);
                 self.times.add(stage, d as f64 * period);
             }
         } else {
@@ -225,7 +229,7 @@ impl GpuRounds<'_> {
 
     /// Resolves the pass timestamps recorded so far into the read-back at `at`; the slots used.
     fn resolve_times(&self, enc: &mut wgpu::CommandEncoder, at: u64) -> u32 {
-        let used = self.query_stages.len() as u32 * 2;
+        let used = self.next_slot;
         if let Some((set, resolve)) = &self.queries
             && used > 0
         {
@@ -267,6 +271,7 @@ impl RoundRunner for GpuRounds<'_> {
         let scope = ErrorScope::push(&self.sim.device);
         self.write_params(p);
         self.query_stages.clear();
+        self.next_slot = 0;
         let mut enc = self.encoder();
         enc.clear_buffer(&self.counters, 0, None);
         if let Err(e) = self.record_round(&mut enc, p, first, false, selection) {
@@ -312,11 +317,13 @@ impl RoundRunner for GpuRounds<'_> {
         };
         self.write(&self.plan, 0, bytemuck::bytes_of(&plan));
         self.query_stages.clear();
+        self.next_slot = 0;
         let cur = self.cur;
         let mut enc = self.encoder();
         for j in 0..most {
             if j > 0 {
                 self.record(&mut enc, p, schedule::PLAN);
+                self.end_pass();
             }
             enc.clear_buffer(&self.counters, 0, None);
             if let Err(e) =
