@@ -67,15 +67,6 @@ impl Method {
             Method::Decimate => "decimate",
         }
     }
-
-    /// Whether the result may have other topology than the input (clustering merges vertices
-    /// that no edge joined).
-    pub fn changes_topology(self) -> bool {
-        matches!(
-            self,
-            Method::Cluster | Method::FloatingCell | Method::Hybrid
-        )
-    }
 }
 
 /// How the hole is filled.

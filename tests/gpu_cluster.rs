@@ -1,5 +1,5 @@
 //! `--method cluster` and `hybrid` on the gpu backend (lavapipe in CI): every stage's buffers against its CPU
-//! twin (src/cluster/twins.rs) on generated meshes, integers exactly and floats within 1e-4, and
+//! twin (tests/cluster_twins/) on generated meshes, integers exactly and floats within 1e-4, and
 //! the whole GPU build against the CPU driver's. With CI=true a missing adapter fails.
 
 use crate::cluster_twins;

@@ -62,13 +62,13 @@ fn families_on_one_device_share_its_pipelines() {
         rounds_stages.len() + cluster_stages.len() - shared,
         "the shared stages compiled once"
     );
+    let compiled = cache.compiled().len();
     let again = GpuSimplifier::on(&cache, &ctx.queue).unwrap();
     assert_eq!(again.pipeline_cache, "shared", "made by the first");
-    assert!(
-        again.pipeline_seconds < rounds.pipeline_seconds,
-        "nothing left to compile: {} s against {} s",
-        again.pipeline_seconds,
-        rounds.pipeline_seconds
+    assert_eq!(
+        cache.compiled().len(),
+        compiled,
+        "nothing left to compile: the second simplifier took every pipeline from the cache"
     );
 }
 

@@ -57,14 +57,14 @@ fn sweep(name: &str, mesh: &Mesh) {
 }
 
 #[test]
-fn every_backend_lands_on_the_target_or_one_below_on_generated_meshes() {
+fn every_backend_lands_on_the_target_or_one_below_or_says_why_not_on_generated_meshes() {
     for (name, mesh) in generated_meshes() {
         sweep(name, &mesh);
     }
 }
 
 #[test]
-fn every_backend_lands_on_the_target_or_one_below_on_the_shared_models() {
+fn every_backend_lands_on_the_target_or_one_below_or_says_why_not_on_the_shared_models() {
     let Some(dir) = shared_models() else {
         eprintln!("note: ../shared/models absent, the shared models' sweep is skipped");
         return;

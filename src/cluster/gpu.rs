@@ -68,19 +68,6 @@ pub fn shared() -> Result<&'static GpuClusterer> {
         .map_err(|e| Error::Gpu(e.trim_start_matches("GPU: ").to_string()))
 }
 
-/// One clustering of `positions` (normalized frame, w = 1) and `faces` at `grid`, on the shared
-/// device; `locked` vertices are clusters of their own. The same result as the CPU driver's build
-/// with its gather (the twins' `run` in tests/cluster_twins is the stage-by-stage reference). For
-/// several builds of one mesh, make a [`GpuClusterMesh`] once and call its `build`.
-pub fn build_gpu(
-    positions: &[[f32; 4]],
-    faces: &[[u32; 3]],
-    locked: &[bool],
-    grid: &Grid,
-) -> Result<ClusterBuild> {
-    GpuClusterMesh::new(shared()?, positions, faces, locked)?.build(grid)
-}
-
 /// A part of a build, recorded on its own (the tests read the buffers after each).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Part {

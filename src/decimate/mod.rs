@@ -105,10 +105,6 @@ impl Decimator {
         self.e.faces
     }
 
-    pub fn is_alive(&self, v: u32) -> bool {
-        self.e.alive.get(v as usize).copied().unwrap_or(false)
-    }
-
     /// The position of engine vertex `v`, as in the input.
     pub fn position(&self, v: u32) -> [f32; 3] {
         let p = &self.e.p;

@@ -95,11 +95,6 @@ pub fn read_into(path: &Path, sink: &mut dyn Sink) -> Result<()> {
     }
 }
 
-/// The positions of a PLY's or an OBJ's vertices, the faces not read.
-pub fn read_positions(path: &Path) -> Result<Vec<[f32; 3]>> {
-    Ok(read_vertices(path, false)?.0)
-}
-
 /// Linear RGBA per vertex.
 pub type Colors = Vec<[f32; 4]>;
 
