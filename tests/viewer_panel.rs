@@ -1,7 +1,7 @@
 //! The window's panel and smaller behaviours, on the real eframe app driven headless by
-//! egui_kittest (lavapipe in CI): the mode a painted mesh opens in, the backend the window
-//! starts on and why, the ratio slider, Enter in the faces field, the idle frame line. With
-//! CI=true a missing adapter fails.
+//! egui_kittest (lavapipe in CI): the mode a painted or textured mesh opens in, what a mode key
+//! the mesh cannot show says, the backend the window starts on and why, the ratio slider, Enter
+//! in the faces field, the idle frame line. With CI=true a missing adapter fails.
 
 use crate::common;
 use crate::viewer_support;
@@ -45,6 +45,74 @@ fn a_coloured_mesh_opens_in_colour_mode() {
     assert_eq!(h.state().view.style.mode, Mode::Color);
     h.state_mut().set_style(style, Some(Mode::Shaded));
     assert_eq!(h.state().view.style.mode, Mode::Shaded);
+}
+
+/// A mesh with UVs and a texture opens in texture mode, as a painted one opens in colour mode.
+#[test]
+fn a_textured_mesh_opens_in_texture_mode() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let mut model = Model::from_mesh("textured torus".into(), seamed_torus()).unwrap();
+    // A 2x2 checker: the texture mode's frame differs from the shaded one.
+    let texel = |on: bool| {
+        if on {
+            [250, 40, 40, 255]
+        } else {
+            [20, 20, 220, 255]
+        }
+    };
+    model.texture = Some(meshslim::viewer::Image {
+        rgba: [true, false, false, true]
+            .iter()
+            .flat_map(|&t| texel(t))
+            .collect(),
+        size: (2, 2),
+    });
+    let mut h = harness(model);
+    h.step();
+    assert_eq!(
+        h.state().view.style.mode,
+        Mode::Texture,
+        "{}",
+        h.state().status
+    );
+    let textured = h.state().pane_rgba(0).unwrap().0;
+    h.key_press(egui::Key::Num1);
+    h.step();
+    assert_eq!(h.state().view.style.mode, Mode::Shaded);
+    assert_ne!(
+        h.state().pane_rgba(0).unwrap().0,
+        textured,
+        "the texture looks shaded"
+    );
+}
+
+/// Keys 4 and 6 on a mesh with no texture and no colours change nothing and say why in the
+/// status line, as the disabled buttons' hovers do.
+#[test]
+fn a_mode_key_the_mesh_cannot_show_says_why() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let mut h = harness(
+        Model::from_mesh("torus".into(), meshslim::mesh::torus(1.0, 0.35, 48, 24)).unwrap(),
+    );
+    h.step();
+    assert_eq!(h.state().view.style.mode, Mode::Shaded);
+    h.key_press(egui::Key::Num4);
+    h.step();
+    assert_eq!(h.state().view.style.mode, Mode::Shaded);
+    let status = h.state().status.clone();
+    assert!(
+        status.starts_with("texture: ") && status.contains("no UVs"),
+        "{status}"
+    );
+    h.key_press(egui::Key::Num6);
+    h.step();
+    assert_eq!(h.state().view.style.mode, Mode::Shaded);
+    let status = h.state().status.clone();
+    assert_eq!(status, "vertex colour: the mesh has no vertex colours");
 }
 
 /// On a software adapter (lavapipe here) the window starts on cpu-parallel, as the library's

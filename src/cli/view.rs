@@ -198,11 +198,16 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     check_directory(&png, "the screenshot's directory")?;
     let model = model(input)?;
     let style = crate::viewer::Style {
-        mode: args.mode.unwrap_or(if model.mesh.colors.is_some() {
-            crate::viewer::Mode::Color
-        } else {
-            crate::viewer::Mode::Shaded
-        }),
+        // As the window opens it: a textured mesh in texture mode, a painted one in colour.
+        mode: args
+            .mode
+            .unwrap_or(if model.mesh.uvs.is_some() && model.texture.is_some() {
+                crate::viewer::Mode::Texture
+            } else if model.mesh.colors.is_some() {
+                crate::viewer::Mode::Color
+            } else {
+                crate::viewer::Mode::Shaded
+            }),
         ..style
     };
     let size = args.size.unwrap_or((1024, 768));

@@ -38,6 +38,7 @@ impl ViewerApp {
             Action::FrameToFit => self.view.frame_to_fit(&self.scene, &mut self.eye),
             Action::ResetView => self.reset_view(),
             Action::SetUp(up) => self.set_up(up),
+            Action::Say(line) => self.status = line,
         }
     }
 
@@ -354,14 +355,16 @@ impl ViewerApp {
         let has_colors = original.has_colors;
         self.scene.set_model(m, original);
         self.scene.texture_changed(note);
-        if self.view.style.mode == Mode::Texture && !self.view.renderer.has_texture() {
+        let textured = self.view.mode_available(Mode::Texture, &self.scene);
+        if self.view.style.mode == Mode::Texture && !textured {
             self.view.style.mode = Mode::Shaded;
         }
-        // A painted scan is looked at for its colours: shown by default, and a mesh without
-        // them falls back to shading.
-        match (has_colors, self.view.style.mode) {
-            (true, Mode::Shaded) => self.view.style.mode = Mode::Color,
-            (false, Mode::Color) => self.view.style.mode = Mode::Shaded,
+        // A textured or painted scan is looked at for its appearance: shown by default (the
+        // texture first, as its file names it), and a mesh without it falls back to shading.
+        match (textured, has_colors, self.view.style.mode) {
+            (true, _, Mode::Shaded) => self.view.style.mode = Mode::Texture,
+            (false, true, Mode::Shaded) => self.view.style.mode = Mode::Color,
+            (_, false, Mode::Color) => self.view.style.mode = Mode::Shaded,
             _ => {}
         }
         let m = self.scene.model.clone().expect("set just above");

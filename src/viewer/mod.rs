@@ -21,7 +21,7 @@ use crate::error::{Error, Result};
 use crate::options::{Backend, SimplifyOptions};
 pub use app::{Start, ViewerApp};
 pub use render::{Mode, Renderer, Style, encode_png};
-pub use scene::Model;
+pub use scene::{Image, Model};
 
 /// What `screenshot` did, for the command line to report.
 #[derive(Debug, Clone)]

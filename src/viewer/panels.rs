@@ -37,6 +37,8 @@ pub enum Action {
     ResetView,
     /// Draw the model with this axis up (None: its file's).
     SetUp(Option<Up>),
+    /// Put this in the status line (a key that could not do what it names says why).
+    Say(String),
 }
 
 /// What the panel reads of the other owners.
@@ -193,8 +195,12 @@ impl Panel {
             Key::Num6,
         ];
         for (k, mode) in modes.into_iter().zip(Mode::ALL) {
-            if pressed(k) && view.mode_available(mode, seen.scene) {
-                view.style.mode = mode;
+            if pressed(k) {
+                // A key that changes nothing says why, as the disabled button's hover does.
+                match view.mode_unavailable(mode, seen.scene) {
+                    None => view.style.mode = mode,
+                    Some(why) => act.push(Action::Say(format!("{}: {why}", mode.label()))),
+                }
             }
         }
         act
@@ -236,15 +242,8 @@ impl Panel {
                 if r.clicked() {
                     view.style.mode = m;
                 }
-                if !ok && m == Mode::Texture {
-                    r.on_disabled_hover_text(
-                        scene
-                            .texture_note
-                            .clone()
-                            .unwrap_or_else(|| "the mesh has no UVs or no texture".into()),
-                    );
-                } else if !ok && m == Mode::Color {
-                    r.on_disabled_hover_text("the mesh has no vertex colours");
+                if let Some(why) = view.mode_unavailable(m, scene) {
+                    r.on_disabled_hover_text(why);
                 }
             }
         });
@@ -571,14 +570,22 @@ const METHODS: [(Method, &str); 5] = [
 /// The device, the frame time, the counts before and after, and the result's run.
 fn stats_ui(ui: &mut egui::Ui, view: &View3d, seen: &Seen, animating: bool) {
     ui.label(format!("device: {}", seen.gpu.adapter));
-    // The time between the last frames drawn, while the window draws on its own: a few times
-    // a second during a job, continuously in the LOD scene and fly mode. Otherwise it draws on
-    // input alone, and the gap between frames is the user's, not the renderer's.
-    let dt = view.clock.smoothed;
-    ui.label(if animating && dt > 0.0 {
-        format!("frames: {:.1} ms apart ({:.0} FPS)", dt * 1e3, 1.0 / dt)
-    } else {
-        "frames: drawn on input (idle)".into()
+    // The time between the pictures the user sees, while the window draws on its own (a few
+    // times a second during a job, continuously in the LOD scene and fly mode) or a picture is
+    // still being drawn (a drag on a large mesh). Otherwise it draws on input alone, and the
+    // gap between frames is the user's, not the renderer's.
+    // A poll that does not wait runs the callbacks of the renders the device has finished.
+    let _ = seen.gpu.device.poll(wgpu::PollType::Poll);
+    let shown = view.clock.shown_gap(std::time::Instant::now());
+    ui.label(match shown {
+        Some(dt) if animating || view.clock.pending() => {
+            format!(
+                "frames shown: {:.1} ms apart ({:.1} FPS)",
+                dt * 1e3,
+                1.0 / dt
+            )
+        }
+        _ => "frames: drawn on input (idle)".into(),
     });
     let Some(m) = &seen.scene.model else { return };
     let simplified = seen.scene.simplified.as_ref();

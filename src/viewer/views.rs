@@ -30,26 +30,81 @@ struct Pane {
     id: egui::TextureId,
 }
 
-/// Frame time, smoothed.
-#[derive(Debug, Default, Clone, Copy)]
+/// Frame time, smoothed: the window's frames (`smoothed`, egui's cadence) and the frames the
+/// user sees (`shown`, the 3D view's renders as the device finishes them). On a slow device the
+/// two differ: lavapipe drew a 4.3M-face scan about once a second while egui's frames came at
+/// 15 FPS, so the window's cadence said nothing of what was on the screen.
+#[derive(Debug, Default)]
 pub struct FrameClock {
     last: Option<Instant>,
     /// Seconds per frame, exponentially smoothed.
     pub smoothed: f64,
+    /// The 3D view's renders submitted...
+    submitted: u64,
+    /// ...and finished, written by the device's callback.
+    shown: std::sync::Arc<std::sync::Mutex<Shown>>,
+}
+
+/// The renders the device has finished: when the last was, and the smoothed gap between them.
+#[derive(Debug, Default, Clone, Copy)]
+struct Shown {
+    last: Option<Instant>,
+    smoothed: f64,
+    done: u64,
+}
+
+/// `smoothed` moved a tenth of the way to `dt` (to `dt` itself at first).
+fn smooth(smoothed: f64, dt: f64) -> f64 {
+    if smoothed == 0.0 {
+        dt
+    } else {
+        0.9 * smoothed + 0.1 * dt
+    }
+}
+
+impl Shown {
+    fn finished(&mut self, now: Instant) {
+        if let Some(l) = self.last {
+            self.smoothed = smooth(self.smoothed, (now - l).as_secs_f64());
+        }
+        self.last = Some(now);
+        self.done += 1;
+    }
 }
 
 impl FrameClock {
     fn tick(&mut self) {
         let now = Instant::now();
         if let Some(l) = self.last {
-            let dt = (now - l).as_secs_f64();
-            self.smoothed = if self.smoothed == 0.0 {
-                dt
-            } else {
-                0.9 * self.smoothed + 0.1 * dt
-            };
+            self.smoothed = smooth(self.smoothed, (now - l).as_secs_f64());
         }
         self.last = Some(now);
+    }
+
+    /// A render of the 3D view was submitted: its end is timed when the device has done it.
+    fn submitted(&mut self, queue: &wgpu::Queue) {
+        self.submitted += 1;
+        let shown = self.shown.clone();
+        queue.on_submitted_work_done(move || {
+            let mut s = shown.lock().unwrap_or_else(|p| p.into_inner());
+            s.finished(Instant::now());
+        });
+    }
+
+    /// Whether a render is still on the device: the screen shows an older picture.
+    pub fn pending(&self) -> bool {
+        self.shown.lock().map_or(0, |s| s.done) < self.submitted
+    }
+
+    /// Seconds between the pictures the user sees, at `now`: the smoothed gap between finished
+    /// renders, or the time since the last one while a later one is still drawing, if longer.
+    pub fn shown_gap(&self, now: Instant) -> Option<f64> {
+        let s = *self.shown.lock().unwrap_or_else(|p| p.into_inner());
+        let waiting = (s.done < self.submitted)
+            .then(|| s.last.map(|l| (now - l).as_secs_f64()))
+            .flatten();
+        let gap = s.smoothed.max(waiting.unwrap_or(0.0));
+        (gap > 0.0).then_some(gap)
     }
 }
 
@@ -130,6 +185,22 @@ impl View3d {
             Mode::Color => scene.original.as_ref().is_some_and(|o| o.has_colors),
             _ => true,
         }
+    }
+
+    /// Why `mode` cannot draw the scene, for the status line and the button's hover; `None`
+    /// when it can.
+    pub fn mode_unavailable(&self, mode: Mode, scene: &Scene) -> Option<String> {
+        if self.mode_available(mode, scene) {
+            return None;
+        }
+        Some(match mode {
+            Mode::Texture => scene
+                .texture_note
+                .clone()
+                .unwrap_or_else(|| "the mesh has no UVs or no texture".into()),
+            Mode::Color => "the mesh has no vertex colours".into(),
+            _ => "nothing to draw".into(),
+        })
     }
 
     /// The pixels of pane `k` as last drawn (RGBA8 rows) and its size.
@@ -310,6 +381,7 @@ impl View3d {
             );
             gpu.queue.submit([enc.finish()]);
         }
+        self.clock.submitted(&gpu.queue);
         scope.check("drawing the view")
     }
 
@@ -523,6 +595,26 @@ pub fn ramp_color(t: f32) -> egui::Color32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_frames_shown_are_timed_from_the_renders_finished() {
+        let clock = FrameClock::default();
+        let t0 = Instant::now();
+        let at = |s: f64| t0 + std::time::Duration::from_secs_f64(s);
+        assert_eq!(clock.shown_gap(at(0.0)), None, "nothing drawn yet");
+        let mut clock = clock;
+        clock.submitted = 2;
+        clock.shown.lock().unwrap().finished(at(0.0));
+        clock.shown.lock().unwrap().finished(at(0.1));
+        let gap = clock.shown_gap(at(0.1)).unwrap();
+        assert!((gap - 0.1).abs() < 1e-9, "{gap}");
+        assert!(!clock.pending());
+        // A third render on the device for 1.8 s: the screen has shown one picture that long.
+        clock.submitted = 3;
+        assert!(clock.pending());
+        let gap = clock.shown_gap(at(1.9)).unwrap();
+        assert!((gap - 1.8).abs() < 1e-9, "{gap}");
+    }
 
     #[test]
     fn the_legend_ramp_is_the_shader_ramp() {
