@@ -346,8 +346,8 @@ fn one_dispatch_and_one_owner_per_viewer_concern() {
 
 /// A family is a folder: every stage in shaders/rounds/ and shaders/core/ has its CPU twin, a
 /// function of the stage's name, in src/rounds/cpu/ (the rounds' `cpu-parallel` backend, which
-/// also runs the core stages), and every stage in shaders/cluster/ in tests/cluster_twins/ (the
-/// clustering's twins are test code); a family's runner (an `impl Runner` of the compute core)
+/// also runs the core stages), every stage in shaders/cluster/ in tests/cluster_twins/ (the
+/// clustering's twins are test code), and every stage in shaders/dag/ in src/dag/; a family's runner (an `impl Runner` of the compute core)
 /// lives in its own folder.
 #[test]
 fn each_family_is_a_folder_with_a_twin_for_every_stage() {
@@ -380,6 +380,7 @@ fn each_family_is_a_folder_with_a_twin_for_every_stage() {
         ("rounds", "src/rounds/cpu"),
         ("core", "src/rounds/cpu"),
         ("cluster", "tests/cluster_twins"),
+        ("dag", "src/dag"),
     ] {
         let twins_text = text_of(&root.join(twins));
         for entry in std::fs::read_dir(root.join("shaders").join(shaders)).unwrap() {
@@ -403,7 +404,11 @@ fn each_family_is_a_folder_with_a_twin_for_every_stage() {
             let l = l.trim_start();
             l.starts_with("impl") && (l.contains("Runner<") || l.contains("RoundRunner for"))
         });
-        if runs && !(rel.starts_with("rounds") || rel.starts_with("cluster")) {
+        if runs
+            && !["rounds", "cluster", "dag"]
+                .iter()
+                .any(|f| rel.starts_with(f))
+        {
             missing.push(format!(
                 "src/{}: a runner outside its family's folder",
                 rel.display()

@@ -19,6 +19,7 @@ mod dag;
 mod decimate;
 mod gpu;
 mod gpu_cluster;
+mod gpu_dag;
 mod gpu_floating;
 mod gpu_prepare;
 mod greedy;

@@ -209,6 +209,48 @@ pub fn check_buffer(limits: &wgpu::Limits, label: &str, size: u64) -> Result<()>
     Ok(())
 }
 
+/// The first `bytes` of `buf` (a multiple of 4, `COPY_SRC`), copied to a staging buffer after
+/// the work already submitted and read with one wait; `doing` says what for in an error.
+pub fn read_back(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    buf: &wgpu::Buffer,
+    bytes: u64,
+    doing: &str,
+) -> Result<Vec<u8>> {
+    let scope = crate::compute::gpu::ErrorScope::push(device);
+    let staging = checked_buffer(
+        device,
+        "meshslim.read_back",
+        bytes,
+        wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+    )?;
+    let mut enc = device.create_command_encoder(&Default::default());
+    if bytes > 0 {
+        enc.copy_buffer_to_buffer(buf, 0, &staging, 0, bytes);
+    }
+    queue.submit([enc.finish()]);
+    let (tx, rx) = std::sync::mpsc::channel();
+    staging.map_async(wgpu::MapMode::Read, .., move |r| {
+        let _ = tx.send(r);
+    });
+    let read = device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| Error::Gpu(format!("{doing}: waiting for the device: {e}")))
+        .and_then(|_| {
+            rx.recv()
+                .map_err(|_| Error::Gpu(format!("{doing}: the device dropped a read-back")))?
+                .map_err(|e| Error::Gpu(format!("{doing}: mapping a read-back buffer: {e}")))
+        })
+        .and_then(|()| {
+            let view = staging
+                .get_mapped_range(..)
+                .map_err(|e| Error::Gpu(format!("{doing}: {e}")))?;
+            Ok(view[..bytes as usize].to_vec())
+        });
+    scope.check_with(doing, read)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

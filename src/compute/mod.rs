@@ -31,6 +31,7 @@ mod tests {
         crate::rounds::schedule::check_schedule();
         crate::cluster::gpu_schedule::check_schedule();
         crate::rounds::prepare::check_schedule();
+        crate::dag::schedule::check_schedule();
     }
 
     /// The pipeline cache is keyed by entry point: two families may name one entry only when it
@@ -49,7 +50,11 @@ mod tests {
             .iter()
             .flat_map(|l| l.iter())
             .map(|s| (s.entry, s.shader));
-        let all: Vec<(&str, &str)> = rounds.chain(cluster).chain(prepare).collect();
+        let dag = crate::dag::schedule::STAGES
+            .iter()
+            .flat_map(|l| l.iter())
+            .map(|s| (s.entry, s.shader));
+        let all: Vec<(&str, &str)> = rounds.chain(cluster).chain(prepare).chain(dag).collect();
         for (i, (entry, shader)) in all.iter().enumerate() {
             for (e2, s2) in &all[..i] {
                 assert!(

@@ -114,6 +114,7 @@ pub const SOURCES: &[Shader] = &[
     stage!("rounds/face_keys", [COMMON, PREPARE]),
     stage!("rounds/prep_faces", [COMMON, PREPARE]),
     stage!("rounds/prep_vertices", [COMMON, PREPARE]),
+    stage!("dag/dag_cut", [COMMON]),
     stage!("cluster/cell_keys", [COMMON, CLUSTER]),
     stage!("cluster/radix_count", [COMMON, CLUSTER]),
     stage!("cluster/radix_scatter", [COMMON, CLUSTER]),
@@ -370,6 +371,10 @@ mod tests {
             struct_size(&module, "floating.wgsl", "FloatParams"),
             size_of::<FloatParams>()
         );
+        let module = parse("dag_cut", &stage_source("dag/dag_cut").unwrap());
+        let size = |name: &str| struct_size(&module, "dag_cut.wgsl", name);
+        assert_eq!(size("CutParams"), size_of::<CutParams>());
+        assert_eq!(size("CutCluster"), size_of::<CutCluster>());
     }
 
     /// The floating cells' radius spread (shaders/cluster/floating.inc.wgsl) against its Rust twin: the

@@ -371,3 +371,38 @@ pub struct FloatParams {
     pub slot: u32,
     pub _pad: [u32; 2],
 }
+
+/// A DAG cut's camera (`crate::dag::cut`), a uniform. Keep in sync with `CutParams` in
+/// shaders/dag/dag_cut.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct CutParams {
+    /// The eye (w unused).
+    pub eye: [f32; 4],
+    /// The view frustum's planes, inside where `n·p + w >= 0`.
+    pub planes: [[f32; 4]; 6],
+    /// Pixels per unit of error at unit distance, over the threshold in pixels.
+    pub scale: f32,
+    pub clusters: u32,
+    /// 1: clusters outside the frustum are not drawn.
+    pub cull: u32,
+    pub _pad: u32,
+}
+
+/// A DAG's cluster as the cut reads it: its spheres and errors, its group's, its triangles.
+/// Keep in sync with `CutCluster` in shaders/dag/dag_cut.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct CutCluster {
+    pub lod_sphere: [f32; 4],
+    pub bounds: [f32; 4],
+    /// The sphere of the group that simplifies it (unused for a root).
+    pub group_sphere: [f32; 4],
+    pub error: f32,
+    pub group_error: f32,
+    pub first_triangle: u32,
+    pub triangle_count: u32,
+    /// 1 for a root.
+    pub root: u32,
+    pub _pad: [u32; 3],
+}

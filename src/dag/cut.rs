@@ -4,6 +4,7 @@
 //! one of the two sets is drawn, and the surface stays closed (Karis 2021).
 
 use super::{Cluster, Dag};
+use crate::compute::types::{CutCluster, CutParams, DrawArgs};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 
@@ -37,22 +38,20 @@ impl CameraCut {
         }
     }
 
-    /// The error `error` at the sphere `s` as seen from the eye, in pixels: its size at the
-    /// sphere's nearest point (infinite from inside a sphere, unless the error is 0).
-    pub fn projected(&self, s: [f32; 4], error: f32) -> f64 {
-        if error <= 0.0 {
-            return 0.0;
-        }
-        let d = (0..3)
-            .map(|i| (s[i] as f64 - self.eye[i]).powi(2))
-            .sum::<f64>()
-            .sqrt()
-            - s[3] as f64;
-        if d <= 0.0 || !error.is_finite() {
-            return f64::INFINITY;
-        }
+    /// The camera as the cut stage's uniform, for `clusters` clusters and no frustum: the eye
+    /// in f32 and the pixels per unit of error at unit distance over the threshold, which is
+    /// all [`passes`] needs.
+    pub fn params(&self, clusters: usize) -> CutParams {
         let per_unit = self.height / (2.0 * (self.fov_deg.to_radians() * 0.5).tan());
-        error as f64 / d * per_unit
+        let e = self.eye.map(|x| x as f32);
+        CutParams {
+            eye: [e[0], e[1], e[2], 0.0],
+            planes: [[0.0, 0.0, 0.0, 1.0]; 6],
+            scale: (per_unit / self.pixels) as f32,
+            clusters: clusters as u32,
+            cull: 0,
+            _pad: 0,
+        }
     }
 }
 
@@ -64,16 +63,35 @@ impl Dag {
     }
 
     /// The clusters whose projected error from `cam` is at most `cam.pixels` and whose group's
-    /// is over it.
+    /// is over it: the test the window's cut runs on the device ([`passes`], [`dag_cut`]), so
+    /// the two agree cluster for cluster.
     pub fn cut_from_camera(&self, cam: &CameraCut) -> Vec<u32> {
-        self.select(|c| {
-            let own = cam.projected(c.lod_sphere, c.error);
-            let group = match self.groups.get(c.group as usize) {
-                Some(g) => cam.projected(g.sphere, g.error),
-                None => f64::INFINITY,
-            };
-            own <= cam.pixels && group > cam.pixels
-        })
+        let p = cam.params(self.clusters.len());
+        let clusters = self.cut_clusters();
+        (0..clusters.len() as u32)
+            .filter(|&i| in_cut(&p, &clusters[i as usize]))
+            .collect()
+    }
+
+    /// The clusters as the cut stage reads them, each with its group's sphere and error.
+    pub fn cut_clusters(&self) -> Vec<CutCluster> {
+        self.clusters
+            .iter()
+            .map(|c| {
+                let g = self.groups.get(c.group as usize);
+                CutCluster {
+                    lod_sphere: c.lod_sphere,
+                    bounds: c.bounds,
+                    group_sphere: g.map_or([0.0; 4], |g| g.sphere),
+                    error: c.error,
+                    group_error: g.map_or(0.0, |g| g.error),
+                    first_triangle: c.first_triangle,
+                    triangle_count: c.triangle_count,
+                    root: g.is_none() as u32,
+                    _pad: [0; 3],
+                }
+            })
+            .collect()
     }
 
     /// The finest object-space cut with at most `triangles` triangles (the root's cut when
@@ -118,5 +136,84 @@ impl Dag {
             .collect();
         m.remove_unused_vertices();
         m
+    }
+}
+
+/// Whether the error `e` at the sphere `s` projects to at most the threshold of `p`, with no
+/// square root or division, so the GPU's f32 gives the CPU's answer: `e * scale / (|s - eye| -
+/// r) <= 1`, i.e. `(e * scale + r)^2 <= |s - eye|^2` (from inside the sphere the projection is
+/// unbounded and the test fails, unless `e` is 0). Twin of `passes` in
+/// shaders/dag/dag_cut.wgsl, term for term.
+pub fn passes(p: &CutParams, s: [f32; 4], e: f32) -> bool {
+    if e <= 0.0 {
+        return true;
+    }
+    let d = [0, 1, 2].map(|i| s[i] - p.eye[i]);
+    let reach = e * p.scale + s[3];
+    reach * reach <= d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+}
+
+/// Whether cluster `k` is in the cut: its own error passes, its group's does not (a root has
+/// none, and is always coarse enough).
+pub fn in_cut(p: &CutParams, k: &CutCluster) -> bool {
+    passes(p, k.lod_sphere, k.error) && (k.root != 0 || !passes(p, k.group_sphere, k.group_error))
+}
+
+/// Whether the sphere `b` meets the frustum of `p`. Twin of `in_view` in
+/// shaders/dag/dag_cut.wgsl.
+pub fn in_view(p: &CutParams, b: [f32; 4]) -> bool {
+    p.planes
+        .iter()
+        .all(|n| n[0] * b[0] + n[1] * b[1] + n[2] * b[2] + n[3] >= -b[3])
+}
+
+/// The frustum of the view-projection `view_proj` (clip depth 0..1, as wgpu's) as six planes,
+/// inside where `n·p + w >= 0`, each scaled to a unit normal so a sphere's radius compares
+/// with its distance (Gribb & Hartmann 2001); a plane with no normal (the far plane of an
+/// infinite projection) holds everything.
+pub fn frustum_planes(view_proj: glam::Mat4) -> [[f32; 4]; 6] {
+    let r = [0, 1, 2, 3].map(|i| view_proj.row(i));
+    [
+        r[3] + r[0],
+        r[3] - r[0],
+        r[3] + r[1],
+        r[3] - r[1],
+        r[2],
+        r[3] - r[2],
+    ]
+    .map(|p| {
+        let len = p.truncate().length();
+        if len > 0.0 && len.is_finite() {
+            (p / len).to_array()
+        } else {
+            [0.0, 0.0, 0.0, 1.0]
+        }
+    })
+}
+
+/// Per cluster: whether it is in the cut for `p` and, with `p.cull`, in the view, as its
+/// indexed indirect draw (one instance when drawn, the instance its number); `counts` gets
+/// the clusters in the cut, the clusters drawn and their triangles. Twin of `dag_cut` in
+/// shaders/dag/dag_cut.wgsl.
+pub fn dag_cut(
+    p: &CutParams,
+    clusters: &[CutCluster],
+    draws: &mut [DrawArgs],
+    counts: &mut [u32; 4],
+) {
+    *counts = [0; 4];
+    for (c, (k, d)) in clusters.iter().zip(draws.iter_mut()).enumerate() {
+        let cut = in_cut(p, k);
+        let drawn = cut && (p.cull == 0 || in_view(p, k.bounds));
+        *d = DrawArgs {
+            index_count: 3 * k.triangle_count,
+            instance_count: drawn as u32,
+            first_index: 3 * k.first_triangle,
+            base_vertex: 0,
+            first_instance: c as u32,
+        };
+        counts[0] += cut as u32;
+        counts[1] += drawn as u32;
+        counts[2] += if drawn { k.triangle_count } else { 0 };
     }
 }

@@ -13,8 +13,10 @@
 pub mod build;
 pub mod cut;
 pub mod file;
+pub mod gpu;
 pub mod groups;
 pub mod meshlets;
+pub mod schedule;
 
 pub use build::{DagOptions, DagReport, build, build_with_progress};
 pub use cut::CameraCut;

@@ -1,0 +1,115 @@
+//! The DAG's cut on the device (`meshslim::dag::gpu`, lavapipe in CI): every cluster's draw and
+//! the counts against the CPU twin (`dag::cut::dag_cut`) from several cameras, with and without
+//! the frustum; the drawn set with no frustum is the command line's `cut_from_camera`, cluster
+//! for cluster. With CI=true a missing adapter fails.
+
+use crate::common;
+
+use common::*;
+use glam::{Mat4, Vec3};
+use meshslim::compute::types::DrawArgs;
+use meshslim::dag::cut::{dag_cut, frustum_planes};
+use meshslim::dag::gpu::GpuCut;
+use meshslim::dag::{self, CameraCut, DagOptions};
+use meshslim::mesh;
+
+/// The draws and counts both ways, equal to the bit on an adapter that rounds as the CPU does;
+/// elsewhere a fused multiply-add may flip a cluster within an ulp of the threshold, so at most
+/// one in a thousand may differ.
+fn compare(what: &str, gpu: &(Vec<DrawArgs>, [u32; 4]), cpu: &(Vec<DrawArgs>, [u32; 4])) {
+    if rounds_like_the_cpu() {
+        assert_eq!(gpu.0, cpu.0, "{what}: draws");
+        assert_eq!(gpu.1, cpu.1, "{what}: counts");
+    } else {
+        let differ = gpu.0.iter().zip(&cpu.0).filter(|(g, c)| g != c).count();
+        assert!(
+            differ * 1000 <= cpu.0.len(),
+            "{what}: {differ} draws differ"
+        );
+    }
+}
+
+#[test]
+fn the_device_cut_is_its_twins_draw_for_draw() {
+    let Some(ctx) = gpu_context() else { return };
+    for (name, m) in [
+        ("noisy_sphere", mesh::noisy_sphere(5, 0.01, 7)),
+        ("torus", mesh::torus(1.0, 0.3, 160, 80)),
+    ] {
+        let (d, _) = dag::build(&m, &DagOptions::default()).unwrap();
+        let clusters = d.cut_clusters();
+        let mut gpu = GpuCut::new(&ctx.pipelines, &ctx.queue, &clusters).unwrap();
+        assert_eq!(gpu.clusters() as usize, d.clusters.len());
+        let r = d.diagonal;
+        let mut any_culled = false;
+        for (eye, pixels) in [
+            ([0.0, 0.0, 0.6 * r], 1.0),
+            ([0.0, 0.0, 3.0 * r], 1.0),
+            ([r, -r, r], 0.25),
+            ([0.1 * r, 0.45 * r, 0.0], 4.0),
+            ([0.0, 0.0, 40.0 * r], 1.0),
+        ] {
+            let cam = CameraCut {
+                eye,
+                pixels,
+                fov_deg: 60.0,
+                height: 720.0,
+            };
+            let at = format!("{name} from {eye:?} at {pixels} px");
+            // No frustum: the drawn clusters are the command line's cut.
+            let p = cam.params(clusters.len());
+            let mut cpu = (vec![DrawArgs::default(); clusters.len()], [0; 4]);
+            dag_cut(&p, &clusters, &mut cpu.0, &mut cpu.1);
+            let got = gpu.run(&p).unwrap();
+            compare(&at, &got, &cpu);
+            let drawn: Vec<u32> = (0..clusters.len() as u32)
+                .filter(|&c| cpu.0[c as usize].instance_count == 1)
+                .collect();
+            assert_eq!(
+                drawn,
+                d.cut_from_camera(&cam),
+                "{at}: the command line's cut"
+            );
+            assert_eq!(cpu.1[0], cpu.1[1], "{at}: nothing culled without a frustum");
+            let tris: u32 = drawn
+                .iter()
+                .map(|&c| d.clusters[c as usize].triangle_count)
+                .sum();
+            assert_eq!(cpu.1[2], tris, "{at}: triangles drawn");
+            // Looking at the origin from the eye, a narrow view: what is drawn is in the cut,
+            // and what is culled lies outside the frustum.
+            let e = Vec3::from_array(eye.map(|x| x as f32));
+            let view = Mat4::look_at_rh(e, Vec3::ZERO, Vec3::Y);
+            let view = if e.length() < 1e-6 {
+                Mat4::look_at_rh(e, Vec3::X, Vec3::Y)
+            } else {
+                view
+            };
+            let proj = Mat4::perspective_rh(20f32.to_radians(), 16.0 / 9.0, 0.01, 1000.0);
+            let mut p = p;
+            p.planes = frustum_planes(proj * view);
+            p.cull = 1;
+            let mut culled = (vec![DrawArgs::default(); clusters.len()], [0; 4]);
+            dag_cut(&p, &clusters, &mut culled.0, &mut culled.1);
+            compare(&format!("{at}, culled"), &gpu.run(&p).unwrap(), &culled);
+            assert_eq!(
+                culled.1[0], cpu.1[0],
+                "{at}: the frustum does not change the cut"
+            );
+            assert!(culled.1[1] <= cpu.1[1], "{at}");
+            for (c, (a, b)) in culled.0.iter().zip(&cpu.0).enumerate() {
+                assert!(a.instance_count <= b.instance_count, "{at}: cluster {c}");
+                if a.instance_count < b.instance_count {
+                    any_culled = true;
+                    let s = d.clusters[c].bounds;
+                    let centre = proj * view * Vec3::new(s[0], s[1], s[2]).extend(1.0);
+                    let inside = centre.w > 0.0
+                        && (centre.x / centre.w).abs() <= 1.0
+                        && (centre.y / centre.w).abs() <= 1.0;
+                    assert!(!inside, "{at}: cluster {c} culled with its centre in view");
+                }
+            }
+        }
+        assert!(any_culled, "{name}: the narrow views culled nothing");
+    }
+}
