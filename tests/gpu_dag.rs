@@ -7,7 +7,7 @@ use crate::common;
 
 use common::*;
 use glam::{Mat4, Vec3};
-use meshslim::compute::types::DrawArgs;
+use meshslim::compute::types::CornerDraw;
 use meshslim::dag::cut::{dag_cut, frustum_planes};
 use meshslim::dag::gpu::GpuCut;
 use meshslim::dag::{self, CameraCut, DagOptions};
@@ -16,7 +16,7 @@ use meshslim::mesh;
 /// The draws and counts both ways, equal to the bit on an adapter that rounds as the CPU does;
 /// elsewhere a fused multiply-add may flip a cluster within an ulp of the threshold, so at most
 /// one in a thousand may differ.
-fn compare(what: &str, gpu: &(Vec<DrawArgs>, [u32; 4]), cpu: &(Vec<DrawArgs>, [u32; 4])) {
+fn compare(what: &str, gpu: &(Vec<CornerDraw>, [u32; 4]), cpu: &(Vec<CornerDraw>, [u32; 4])) {
     if rounds_like_the_cpu() {
         assert_eq!(gpu.0, cpu.0, "{what}: draws");
         assert_eq!(gpu.1, cpu.1, "{what}: counts");
@@ -58,7 +58,7 @@ fn the_device_cut_is_its_twins_draw_for_draw() {
             let at = format!("{name} from {eye:?} at {pixels} px");
             // No frustum: the drawn clusters are the command line's cut.
             let p = cam.params(clusters.len());
-            let mut cpu = (vec![DrawArgs::default(); clusters.len()], [0; 4]);
+            let mut cpu = (vec![CornerDraw::default(); clusters.len()], [0; 4]);
             dag_cut(&p, &clusters, &mut cpu.0, &mut cpu.1);
             let got = gpu.run(&p).unwrap();
             compare(&at, &got, &cpu);
@@ -89,7 +89,7 @@ fn the_device_cut_is_its_twins_draw_for_draw() {
             let mut p = p;
             p.planes = frustum_planes(proj * view);
             p.cull = 1;
-            let mut culled = (vec![DrawArgs::default(); clusters.len()], [0; 4]);
+            let mut culled = (vec![CornerDraw::default(); clusters.len()], [0; 4]);
             dag_cut(&p, &clusters, &mut culled.0, &mut culled.1);
             compare(&format!("{at}, culled"), &gpu.run(&p).unwrap(), &culled);
             assert_eq!(
@@ -111,5 +111,112 @@ fn the_device_cut_is_its_twins_draw_for_draw() {
             }
         }
         assert!(any_culled, "{name}: the narrow views culled nothing");
+    }
+}
+
+/// On screen, from several cameras, the cut at 1 px drawn from the device's draws leaves no
+/// hole: no background pixel where the full mesh's render, two pixels in from its silhouette,
+/// is covered; far, it draws fewer triangles than the mesh has, and near, not what is out of
+/// view.
+#[test]
+fn a_cut_drawn_from_the_device_has_no_cracks_on_screen() {
+    use meshslim::viewer::camera::Camera;
+    use meshslim::viewer::dag::{DagScene, home_camera, leaves};
+    use meshslim::viewer::render::{Renderer, Style, Target};
+    let Some(ctx) = gpu_context() else { return };
+    let size = (320u32, 240u32);
+    for (name, m) in [
+        ("noisy_sphere", mesh::noisy_sphere(5, 0.01, 7)),
+        ("double_torus", mesh::double_torus(14)),
+    ] {
+        let (d, _) = dag::build(&m, &DagOptions::default()).unwrap();
+        let model = leaves(&d, name.into()).unwrap();
+        let full = model.original(&ctx.device).unwrap();
+        let mut scene = DagScene::new(ctx, &d, &model).unwrap();
+        let mut renderer = Renderer::new(&ctx.device, &ctx.queue);
+        let style = Style::default();
+        let home = home_camera(&model, size);
+        // A frame of `items` from `cam`, after what `first` records (a cut).
+        let render = |renderer: &mut Renderer,
+                      first: &mut dyn FnMut(&mut wgpu::CommandEncoder),
+                      items: &[(&meshslim::viewer::render::SceneMesh, Mat4)],
+                      cam: &Camera| {
+            let target = Target::new(&ctx.device, size).unwrap();
+            let mut enc = ctx.device.create_command_encoder(&Default::default());
+            first(&mut enc);
+            renderer.draw(
+                &ctx.device,
+                &ctx.queue,
+                &mut enc,
+                &target,
+                cam,
+                &style,
+                items,
+            );
+            ctx.queue.submit([enc.finish()]);
+            target.read_rgba(&ctx.device, &ctx.queue).unwrap()
+        };
+        let background = render(&mut renderer, &mut |_| {}, &[], &home)[..4].to_vec();
+        for (k, (yaw, zoom)) in [(0.35f32, 1.0f32), (2.0, 1.0), (-1.2, 0.45), (0.8, 0.25)]
+            .into_iter()
+            .enumerate()
+        {
+            let cam = Camera {
+                yaw,
+                distance: home.distance * zoom,
+                ..home
+            };
+            let whole = render(&mut renderer, &mut |_| {}, &[(&full, cam.model)], &cam);
+            let p = scene.cut_params(&cam, size, 1.0);
+            let items = [(&scene.scene, cam.model)];
+            let cut = &mut scene.cut;
+            let drawn = render(&mut renderer, &mut |enc| cut.record(enc, &p), &items, &cam);
+            let (w, h) = (size.0 as i64, size.1 as i64);
+            let bg = |img: &[u8], x: i64, y: i64| {
+                let i = ((y * w + x) * 4) as usize;
+                img[i..i + 4] == background[..]
+            };
+            let mut inside = 0;
+            for y in 2..h - 2 {
+                for x in 2..w - 2 {
+                    let covered = (-2..=2).all(|dy| (-2..=2).all(|dx| !bg(&whole, x + dx, y + dy)));
+                    if covered {
+                        inside += 1;
+                        assert!(
+                            !bg(&drawn, x, y),
+                            "{name}, camera {k}: a hole at ({x}, {y}) inside the silhouette"
+                        );
+                    }
+                }
+            }
+            assert!(
+                inside > 1000,
+                "{name}, camera {k}: the mesh covers {inside} pixels"
+            );
+            let counts = meshslim::compute::context::read_back(
+                &ctx.device,
+                &ctx.queue,
+                &scene.cut.counts,
+                16,
+                "the counts",
+            )
+            .unwrap();
+            let counts: [u32; 4] = bytemuck::pod_read_unaligned(&counts);
+            assert!(counts[2] > 0, "{name}, camera {k}: nothing drawn");
+            // From the window's first view the far side and the small detail go coarse; from
+            // the nearest, part of the surface is out of view and not drawn.
+            if k == 0 {
+                assert!(
+                    (counts[2] as usize) < m.triangles.len(),
+                    "{name}, first view: {} of {} triangles",
+                    counts[2],
+                    m.triangles.len()
+                );
+            }
+            // (The double torus's cut is its root from every one of these views: one cluster.)
+            if k == 3 && name == "noisy_sphere" {
+                assert!(counts[1] < counts[0], "{name}, nearest view: {counts:?}");
+            }
+        }
     }
 }

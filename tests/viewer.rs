@@ -304,6 +304,71 @@ fn screenshot_command_writes_a_png() {
     );
 }
 
+/// `view X.mslod --screenshot --frames N --json`: the DAG's cut drawn and timed, with fewer
+/// triangles than the mesh it was built from draws the same way; the options that make no
+/// sense for it are usage errors.
+#[test]
+fn a_dag_screenshot_draws_its_cut_and_times_its_frames() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let build = meshslim(
+        &["dag", "build", "builtin:bumpy-sphere", "s.mslod"],
+        dir.path(),
+    );
+    expect_code(&build, 0);
+    let json = |args: &[&str]| -> serde_json::Value {
+        let o = meshslim(args, dir.path());
+        expect_code(&o, 0);
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let size = ["--size", "160x120", "--frames", "3", "--json"];
+    let dag = json(&[&["view", "s.mslod", "--screenshot", "dag.png"][..], &size].concat());
+    let mesh = json(
+        &[
+            &["view", "builtin:bumpy-sphere", "--screenshot", "m.png"][..],
+            &size,
+        ]
+        .concat(),
+    );
+    assert_eq!(dag["frames"], 3);
+    assert_eq!(dag["frame_seconds_each"].as_array().unwrap().len(), 3);
+    assert!(dag["frame_seconds"].as_f64().unwrap() > 0.0, "{dag}");
+    assert!(mesh["frame_seconds"].as_f64().unwrap() > 0.0, "{mesh}");
+    let (d, m) = (
+        dag["triangles_drawn"].as_u64().unwrap(),
+        mesh["triangles_drawn"].as_u64().unwrap(),
+    );
+    assert!(d > 0 && d < m, "the cut draws {d} triangles, the mesh {m}");
+    assert!(dag["clusters_drawn"].as_u64().unwrap() <= dag["clusters_in_cut"].as_u64().unwrap());
+    assert_eq!(dag["pixels"], 1.0);
+    assert!(mesh["clusters_drawn"].is_null());
+    let img = Pixmap::decode_png(&std::fs::read(dir.path().join("dag.png")).unwrap()).unwrap();
+    assert!(
+        img.data().chunks(4).any(|p| !is_background(p)),
+        "the cut is drawn"
+    );
+    for bad in [
+        &["view", "s.mslod", "--screenshot", "x.png", "--ratio", "0.5"][..],
+        &[
+            "view",
+            "builtin:torus",
+            "--screenshot",
+            "x.png",
+            "--pixels",
+            "1",
+        ],
+        &["view", "s.mslod", "--screenshot", "x.png", "--pixels", "0"],
+        &["view", "builtin:torus", "--frames", "2"],
+        &["view", "s.mslod"],
+    ] {
+        let o = meshslim(bad, dir.path());
+        assert_ne!(o.status.code(), Some(0), "{bad:?}");
+        assert!(!o.stderr.is_empty(), "{bad:?}: says why");
+    }
+}
+
 /// The size of the box of non-background pixels.
 /// `--side-by-side` saves what the window's B shows: the original in the left half and the
 /// result in the right, each with its label in its top left corner.

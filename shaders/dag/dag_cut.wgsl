@@ -1,7 +1,7 @@
 // Per cluster of a DAG: whether it is in the cut for the camera (its own error projects to at
 // most the threshold, its group's to more: Karis et al. 2021), whether its bounds meet the view
-// frustum, and its indexed indirect draw (one instance when drawn, none otherwise; the instance
-// is the cluster's number, for the cluster colours). Twin of src/dag/cut.rs::dag_cut; the
+// frustum, and its indirect draw over its triangles' corners (the viewer pulls its vertices:
+// one instance when drawn, none otherwise). Twin of src/dag/cut.rs::dag_cut; the
 // command line's `dag cut --camera` runs the same test (`passes`), so the two agree.
 
 // Twin of crate::compute::types::CutParams.
@@ -16,6 +16,15 @@ struct CutParams {
     // 1: clusters outside the frustum are not drawn.
     cull: u32,
     _pad: u32,
+}
+
+// Twin of crate::compute::types::CornerDraw: a non-indexed indirect draw, the corners of
+// `vertex_count / 3` triangles from corner `first_vertex`.
+struct CornerDraw {
+    vertex_count: u32,
+    instance_count: u32,
+    first_vertex: u32,
+    first_instance: u32,
 }
 
 // Twin of crate::compute::types::CutCluster.
@@ -37,7 +46,7 @@ struct CutCluster {
 
 @group(0) @binding(0) var<uniform> cut: CutParams;
 @group(0) @binding(1) var<storage, read> clusters: array<CutCluster>;
-@group(0) @binding(2) var<storage, read_write> draws: array<DrawArgs>;           // per cluster
+@group(0) @binding(2) var<storage, read_write> draws: array<CornerDraw>;           // per cluster
 // In the cut, drawn, triangles drawn, (unused).
 @group(0) @binding(3) var<storage, read_write> cut_counts: array<atomic<u32>, 4>;
 
@@ -77,12 +86,11 @@ fn dag_cut(
     let in_cut = passes(k.lod_sphere, k.error)
         && (k.root != 0u || !passes(k.group_sphere, k.group_error));
     let drawn = in_cut && (cut.cull == 0u || in_view(k.bounds));
-    var d: DrawArgs;
-    d.index_count = 3u * k.triangle_count;
+    var d: CornerDraw;
+    d.vertex_count = 3u * k.triangle_count;
     d.instance_count = select(0u, 1u, drawn);
-    d.first_index = 3u * k.first_triangle;
-    d.base_vertex = 0;
-    d.first_instance = c;
+    d.first_vertex = 3u * k.first_triangle;
+    d.first_instance = 0u;
     draws[c] = d;
     if (in_cut) {
         atomicAdd(&cut_counts[0], 1u);

@@ -29,8 +29,15 @@ calls for (L toggles LOD; the panel shows the frame time with and without). X.pa
 side by side with the original), Ctrl+click to choose members for the LOD scene. The panel's
 Search runs the same NSGA-II on the open mesh.
 
+A cluster DAG (X.mslod, from 'meshslim dag build') is drawn with --screenshot as a renderer
+draws it: per frame the device picks each cluster's coarsest version whose error projects under
+--pixels (default 1) and that is in view, and draws from those draws with no read-back.
+--frames N draws and times N more frames from the same camera, and --json prints the median
+frame time and the triangles a frame drew, for a DAG and a plain mesh alike.
+
 Examples:
   meshslim view ../shared/models/horse.ply
+  meshslim view horse.mslod --screenshot dag.png --pixels 1 --frames 20 --json
   meshslim view ../shared/models/spot/spot_triangulated.obj --mode texture --screenshot spot.png
   meshslim view ../shared/models/horse.ply --screenshot horse.png --ratio 0.1
   meshslim view ../shared/models/horse.ply --screenshot both.png --ratio 0.01 --side-by-side
@@ -87,11 +94,39 @@ pub struct ViewArgs {
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
 
+    /// With --screenshot of a DAG (X.mslod): the projected error each cluster may show, in
+    /// pixels of the image's height
+    #[arg(long, value_name = "P", value_parser = parse_pixels)]
+    pub pixels: Option<f64>,
+
+    /// With --screenshot: draw and time this many frames more from the same camera (for a
+    /// DAG, each with its cut on the device)
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub frames: usize,
+
+    /// With --screenshot: print what was drawn as JSON (frame_seconds, the median of --frames;
+    /// triangles_drawn per frame) instead of a line
+    #[arg(long)]
+    pub json: bool,
+
     /// The mesh's axis drawn up: x, y, z, -x, -y, -z, or auto (the largest silhouette).
     /// Default: +Y for glTF (its specification) and generated meshes; for PLY, OBJ and STL the
     /// side the mesh rests on (horse.ply stands on +Z), else the file's convention (+Y, STL +Z)
     #[arg(long, value_enum, value_name = "AXIS", allow_hyphen_values = true)]
     pub up: Option<crate::viewer::camera::Up>,
+}
+
+/// A threshold in pixels: finite and above zero.
+fn parse_pixels(s: &str) -> std::result::Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(p) if p.is_finite() && p > 0.0 => Ok(p),
+        _ => Err(format!("{s}: the pixels must be a number above 0")),
+    }
+}
+
+/// Whether `input` is a cluster DAG file.
+fn is_dag(input: &Input) -> bool {
+    matches!(input, Input::File(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("mslod")))
 }
 
 pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
@@ -127,6 +162,31 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
             }
         }
     };
+    let dag_only = |what: &str| -> Result<()> {
+        match &args.input {
+            Some(i) if is_dag(i) => Ok(()),
+            _ => Err(UsageError(format!("{what} is for the screenshot of a DAG (X.mslod)")).into()),
+        }
+    };
+    if args.pixels.is_some() {
+        dag_only("--pixels")?;
+    }
+    if args.screenshot.is_none() {
+        if args.frames > 0 || args.json {
+            return Err(UsageError("--frames and --json go with --screenshot".into()).into());
+        }
+        if let Some(i) = args.input.as_ref().filter(|i| is_dag(i)) {
+            return Err(UsageError(format!(
+                "{}: a DAG is drawn with --screenshot for now; the window opens meshes and \
+                 manifests",
+                i.display()
+            ))
+            .into());
+        }
+    }
+    if args.frames > 0 && args.side_by_side {
+        return Err(UsageError("--frames times one view: not with --side-by-side".into()).into());
+    }
     let Some(png) = args.screenshot.clone() else {
         // A file that cannot be opened fails here, not in a window that opens to say so.
         if let Some(Input::File(p)) = &args.input {
@@ -196,7 +256,35 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     }
     // Before any reading or rendering: a screenshot with nowhere to go fails at once.
     check_directory(&png, "the screenshot's directory")?;
-    let model = model(input)?;
+    let dag = if is_dag(input) {
+        let Input::File(path) = input else {
+            unreachable!("is_dag holds for files")
+        };
+        if args.ratio.is_some() || args.side_by_side {
+            return Err(UsageError(
+                "a DAG is drawn as its cut: --ratio and --side-by-side are for meshes".into(),
+            )
+            .into());
+        }
+        Some(
+            progress
+                .spinner(format!("reading {}", path.display()), || {
+                    crate::dag::file::read(path)
+                })
+                .map_err(lib)
+                .context("cannot read the DAG")?,
+        )
+    } else {
+        None
+    };
+    let model = match &dag {
+        Some(d) => {
+            let mut m = crate::viewer::dag::leaves(d, input.display()).map_err(lib)?;
+            m.up_axis = args.up.unwrap_or(m.up_axis);
+            m
+        }
+        None => model(input)?,
+    };
     let style = crate::viewer::Style {
         // As the window opens it: a textured mesh in texture mode, a painted one in colour.
         mode: args
@@ -219,6 +307,8 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
                 style,
                 size,
                 side_by_side: args.side_by_side,
+                frames: args.frames,
+                dag: dag.as_ref().map(|d| (d, args.pixels.unwrap_or(1.0))),
             };
             crate::viewer::shoot(&model, shot)
         })
@@ -226,6 +316,26 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     crate::io::write_atomic(&png, |w| w.write_all(&frame.png))
         .map_err(lib)
         .context("cannot write the screenshot")?;
+    if args.json {
+        let mut times = frame.frame_seconds.clone();
+        times.sort_by(f64::total_cmp);
+        let median = (!times.is_empty()).then(|| times[times.len() / 2]);
+        let json = serde_json::json!({
+            "screenshot": png,
+            "adapter": frame.adapter,
+            "size": [size.0, size.1],
+            "faces": frame.faces,
+            "triangles_drawn": frame.triangles_drawn,
+            "clusters_drawn": frame.clusters_drawn.map(|c| c.0),
+            "clusters_in_cut": frame.clusters_drawn.map(|c| c.1),
+            "pixels": dag.as_ref().map(|_| args.pixels.unwrap_or(1.0)),
+            "frames": frame.frame_seconds.len(),
+            "frame_seconds": median,
+            "frame_seconds_each": frame.frame_seconds,
+        });
+        println!("{}", serde_json::to_string_pretty(&json)?);
+        return Ok(ExitCode::SUCCESS);
+    }
     let heat = if style.mode == crate::viewer::Mode::Heatmap {
         format!(", heatmap red at {:.3e} of the diagonal", frame.max_error)
     } else {
@@ -234,7 +344,7 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     println!(
         "{}: {} faces drawn from the GPU buffers on {}, {}x{}{heat}",
         png.display(),
-        frame.faces,
+        frame.triangles_drawn,
         frame.adapter,
         size.0,
         size.1

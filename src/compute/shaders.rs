@@ -375,6 +375,7 @@ mod tests {
         let size = |name: &str| struct_size(&module, "dag_cut.wgsl", name);
         assert_eq!(size("CutParams"), size_of::<CutParams>());
         assert_eq!(size("CutCluster"), size_of::<CutCluster>());
+        assert_eq!(size("CornerDraw"), size_of::<CornerDraw>());
     }
 
     /// The floating cells' radius spread (shaders/cluster/floating.inc.wgsl) against its Rust twin: the

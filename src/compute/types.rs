@@ -406,3 +406,15 @@ pub struct CutCluster {
     pub root: u32,
     pub _pad: [u32; 3],
 }
+
+/// A non-indexed indirect draw over the corners of `vertex_count / 3` triangles from corner
+/// `first_vertex` (wgpu's `DrawIndirectArgs`; the viewer's vertex shader pulls each corner's
+/// vertex). Keep in sync with `CornerDraw` in shaders/dag/dag_cut.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct CornerDraw {
+    pub vertex_count: u32,
+    pub instance_count: u32,
+    pub first_vertex: u32,
+    pub first_instance: u32,
+}

@@ -4,7 +4,7 @@
 //! one of the two sets is drawn, and the surface stays closed (Karis 2021).
 
 use super::{Cluster, Dag};
-use crate::compute::types::{CutCluster, CutParams, DrawArgs};
+use crate::compute::types::{CornerDraw, CutCluster, CutParams};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 
@@ -192,25 +192,24 @@ pub fn frustum_planes(view_proj: glam::Mat4) -> [[f32; 4]; 6] {
 }
 
 /// Per cluster: whether it is in the cut for `p` and, with `p.cull`, in the view, as its
-/// indexed indirect draw (one instance when drawn, the instance its number); `counts` gets
+/// indirect draw over its corners (one instance when drawn, none otherwise); `counts` gets
 /// the clusters in the cut, the clusters drawn and their triangles. Twin of `dag_cut` in
 /// shaders/dag/dag_cut.wgsl.
 pub fn dag_cut(
     p: &CutParams,
     clusters: &[CutCluster],
-    draws: &mut [DrawArgs],
+    draws: &mut [CornerDraw],
     counts: &mut [u32; 4],
 ) {
     *counts = [0; 4];
-    for (c, (k, d)) in clusters.iter().zip(draws.iter_mut()).enumerate() {
+    for (k, d) in clusters.iter().zip(draws.iter_mut()) {
         let cut = in_cut(p, k);
         let drawn = cut && (p.cull == 0 || in_view(p, k.bounds));
-        *d = DrawArgs {
-            index_count: 3 * k.triangle_count,
+        *d = CornerDraw {
+            vertex_count: 3 * k.triangle_count,
             instance_count: drawn as u32,
-            first_index: 3 * k.first_triangle,
-            base_vertex: 0,
-            first_instance: c as u32,
+            first_vertex: 3 * k.first_triangle,
+            first_instance: 0,
         };
         counts[0] += cut as u32;
         counts[1] += drawn as u32;

@@ -5,7 +5,7 @@
 use super::schedule::{self as sched, DagBuf, DagGrid};
 use crate::compute::context::{checked_buffer, checked_buffer_write, read_back};
 use crate::compute::gpu::{ErrorScope, Groups, Kernels, Pipelines, Runner, record};
-use crate::compute::types::{CutCluster, CutParams, DrawArgs, WG};
+use crate::compute::types::{CornerDraw, CutCluster, CutParams, WG};
 use crate::error::{Error, Result};
 
 /// A DAG's clusters on the device and the buffers of its cut.
@@ -16,7 +16,7 @@ pub struct GpuCut {
     clusters: u32,
     cut: wgpu::Buffer,
     cluster_buf: wgpu::Buffer,
-    /// Per cluster: its indexed indirect draw ([`DrawArgs`]), for `multi_draw_indexed_indirect`.
+    /// Per cluster: its indirect draw ([`CornerDraw`]), for `multi_draw_indirect`.
     pub draws: wgpu::Buffer,
     /// Clusters in the cut, clusters drawn, triangles drawn, a spare word.
     pub counts: wgpu::Buffer,
@@ -50,7 +50,7 @@ impl GpuCut {
         let draws = checked_buffer(
             &device,
             "meshslim.dag_cut.draws",
-            clusters.len() as u64 * std::mem::size_of::<DrawArgs>() as u64,
+            clusters.len() as u64 * std::mem::size_of::<CornerDraw>() as u64,
             U::STORAGE | U::INDIRECT | U::COPY_SRC,
         )?;
         let counts = checked_buffer(
@@ -99,13 +99,13 @@ impl GpuCut {
 
     /// The cut for `p`, run and read back: every cluster's draw and the counts (what the
     /// tests compare with the twin, and what `view --json` reports).
-    pub fn run(&mut self, p: &CutParams) -> Result<(Vec<DrawArgs>, [u32; 4])> {
+    pub fn run(&mut self, p: &CutParams) -> Result<(Vec<CornerDraw>, [u32; 4])> {
         let scope = ErrorScope::push(&self.device);
         let mut enc = self.device.create_command_encoder(&Default::default());
         self.record(&mut enc, p);
         self.queue.submit([enc.finish()]);
         scope.check("cutting the DAG")?;
-        let bytes = self.clusters as u64 * std::mem::size_of::<DrawArgs>() as u64;
+        let bytes = self.clusters as u64 * std::mem::size_of::<CornerDraw>() as u64;
         let draws = read_back(
             &self.device,
             &self.queue,

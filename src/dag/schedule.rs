@@ -1,6 +1,6 @@
 //! The DAG's cut on the GPU, described as every family's stages are
 //! ([`crate::compute::schedule`]): one stage, `dag_cut`, run once per frame over the clusters,
-//! writing each cluster's indexed indirect draw; its CPU twin is [`super::cut::dag_cut`], and
+//! writing each cluster's indirect draw; its CPU twin is [`super::cut::dag_cut`], and
 //! `compute::tests` checks the description against its WGSL through naga.
 
 /// A buffer of the cut.
@@ -10,7 +10,7 @@ pub enum DagBuf {
     Cut,
     /// Per cluster: [`crate::compute::types::CutCluster`].
     Clusters,
-    /// Per cluster: its [`crate::compute::types::DrawArgs`], a renderer's indirect draws.
+    /// Per cluster: its [`crate::compute::types::CornerDraw`], a renderer's indirect draws.
     Draws,
     /// Clusters in the cut, clusters drawn, triangles drawn, and a spare word.
     CutCounts,

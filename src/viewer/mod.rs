@@ -7,6 +7,7 @@
 mod actions;
 pub mod app;
 pub mod camera;
+pub mod dag;
 pub mod device;
 mod file_browser;
 pub mod front;
@@ -32,6 +33,13 @@ pub struct Frame {
     /// the heatmap's colour ramp); 0 when not simplified.
     pub max_error: f64,
     pub png: Vec<u8>,
+    /// Seconds of each frame drawn after the picture ([`Shot::frames`]), each submitted and
+    /// waited for: a DAG's cut and the draw.
+    pub frame_seconds: Vec<f64>,
+    /// Triangles a frame draws: the mesh's, or the DAG cut's.
+    pub triangles_drawn: usize,
+    /// A DAG's clusters drawn and in its cut (none for a mesh).
+    pub clusters_drawn: Option<(usize, usize)>,
 }
 
 /// Simplifies `model` to `ratio` on the GPU (1 = as is) and renders one `size` frame of the
@@ -58,6 +66,8 @@ pub fn screenshot_with(
             style,
             size,
             side_by_side: false,
+            frames: 0,
+            dag: None,
         },
     )
 }
@@ -66,12 +76,17 @@ pub fn screenshot_with(
 /// `size` pixels; with `side_by_side`, the original and the result in two labelled halves, as
 /// the window's `B` shows them.
 #[derive(Debug, Clone, Copy)]
-pub struct Shot {
+pub struct Shot<'a> {
     pub ratio: f64,
     pub method: crate::Method,
     pub style: Style,
     pub size: (u32, u32),
     pub side_by_side: bool,
+    /// Frames to draw and time after the picture (`view --frames`).
+    pub frames: usize,
+    /// Draw this DAG's cut at this many pixels of error instead of the mesh (the model is
+    /// then its first level, for the camera).
+    pub dag: Option<(&'a crate::dag::Dag, f64)>,
 }
 
 /// Renders the [`Shot`] of `model`; returns a PNG and what it drew.
@@ -82,6 +97,8 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
         mut style,
         size,
         side_by_side,
+        frames,
+        dag,
     } = shot;
     // Checked before the GPU work: a texture or colour mode with nothing to show fails at once.
     if style.mode == Mode::Color && model.mesh.colors.is_none() {
@@ -161,6 +178,45 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
         pane.0 as f32 / pane.1 as f32,
     );
     let cam = eye.camera;
+    if let Some((dag, pixels)) = dag {
+        let mut d = dag::DagScene::new(ctx, dag, model)?;
+        let p = d.cut_params(&cam, size, pixels);
+        let target = render::Target::new(&ctx.device, size)?;
+        let items = [(&d.scene, cam.model)];
+        let cut = &mut d.cut;
+        // Each frame cuts and draws; the first, which also makes what a first use makes, is
+        // the picture and is not timed.
+        let mut seconds = dag::time_frames(
+            ctx,
+            &mut renderer,
+            &target,
+            &cam,
+            &style,
+            &items,
+            frames + 1,
+            &mut |enc| cut.record(enc, &p),
+        )?;
+        seconds.remove(0);
+        let rgba = target.read_rgba(&ctx.device, &ctx.queue)?;
+        let counts = crate::compute::context::read_back(
+            &ctx.device,
+            &ctx.queue,
+            &d.cut.counts,
+            16,
+            "reading the cut's counts",
+        )?;
+        let counts: [u32; 4] = bytemuck::pod_read_unaligned(&counts);
+        scope.check("rendering the frame")?;
+        return Ok(Frame {
+            adapter: ctx.adapter_name.clone(),
+            faces: dag.mesh.triangles.len(),
+            max_error: 0.0,
+            png: encode_png(&rgba, size)?,
+            frame_seconds: seconds,
+            triangles_drawn: counts[2] as usize,
+            clusters_drawn: Some((counts[1] as usize, counts[0] as usize)),
+        });
+    }
     let mut draw = |mesh: &render::SceneMesh, size| {
         let items = [(mesh, cam.model)];
         render::render_rgba(
@@ -185,12 +241,33 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
     } else {
         (draw(scene, size)?, size)
     };
+    // The frames timed after the picture, as a DAG's are (side by side draws two panes: not
+    // one frame of the window's).
+    let frame_seconds = if frames > 0 && !side_by_side {
+        let target = render::Target::new(&ctx.device, size)?;
+        let items = [(scene, cam.model)];
+        dag::time_frames(
+            ctx,
+            &mut renderer,
+            &target,
+            &cam,
+            &style,
+            &items,
+            frames,
+            &mut |_| {},
+        )?
+    } else {
+        Vec::new()
+    };
     scope.check("rendering the frame")?;
     Ok(Frame {
         adapter: ctx.adapter_name.clone(),
         faces,
         max_error: scene.max_error as f64,
         png: encode_png(&rgba, size)?,
+        frame_seconds,
+        triangles_drawn: faces,
+        clusters_drawn: None,
     })
 }
 

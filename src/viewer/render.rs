@@ -94,6 +94,10 @@ pub struct SceneMesh {
     pub max_error: f32,
     /// The buffers the vertex shader reads, bound once, on first draw.
     group: std::sync::OnceLock<wgpu::BindGroup>,
+    /// A DAG's clusters: per cluster its draw, written by the cut on the device
+    /// ([`crate::dag::gpu::GpuCut::draws`]), and how many; the mesh is drawn from these
+    /// instead of its own arguments.
+    pub cluster_draws: Option<(wgpu::Buffer, u32)>,
 }
 
 /// Extras made on the host: per vertex, except the UVs and colours (per corner).
@@ -174,6 +178,7 @@ impl SceneMesh {
             faces,
             max_error,
             group: std::sync::OnceLock::new(),
+            cluster_draws: None,
         })
     }
 }
@@ -696,7 +701,11 @@ impl Renderer {
                 // per corner. The simplifier's indexed arguments serve as they are: their first
                 // four words (index count, instances, first index 0, base vertex 0) read as
                 // (vertex count, instances, first vertex, first instance).
-                pass.draw_indirect(&mesh.gpu.draw_args, 0);
+                match &mesh.cluster_draws {
+                    // A DAG: one draw per cluster, those out of the cut with no instance.
+                    Some((draws, n)) => pass.multi_draw_indirect(draws, 0, *n),
+                    None => pass.draw_indirect(&mesh.gpu.draw_args, 0),
+                }
             }
         }
     }

@@ -1,0 +1,155 @@
+//! A cluster DAG on screen: every level's triangles uploaded once, and per frame the cut
+//! ([`crate::dag::gpu::GpuCut`]) chosen on the device for the camera, which the renderer draws
+//! from with no read-back — the clusters whose error projects under the threshold, in view
+//! (Karis et al. 2021). The frame-timing loop `view --frames` runs is here too, for a DAG and
+//! a plain mesh alike.
+
+use super::camera::{Camera, Eye};
+use super::render::{Extras, Renderer, SceneMesh, Style, Target, vertex_normals};
+use super::scene::Model;
+use crate::compute::types::CutParams;
+use crate::dag::gpu::GpuCut;
+use crate::dag::{CameraCut, Dag};
+use crate::error::Result;
+use crate::rounds::gpu::GpuMesh;
+use glam::{Mat4, Vec3};
+use std::time::Instant;
+
+/// A DAG ready to draw: its triangles as one mesh, in the normalized frame of its input
+/// (`center`, `scale`), and its cut on the same device.
+pub struct DagScene {
+    pub scene: SceneMesh,
+    pub cut: GpuCut,
+    center: [f64; 3],
+    scale: f64,
+}
+
+impl DagScene {
+    /// `dag` uploaded on `ctx`'s device, in the frame of `model` (its input: the leaves).
+    pub fn new(
+        ctx: &crate::compute::context::GpuContext,
+        dag: &Dag,
+        model: &Model,
+    ) -> Result<DagScene> {
+        let (center, scale) = (model.up.center, model.up.scale);
+        let positions: Vec<[f32; 4]> = dag
+            .mesh
+            .positions
+            .iter()
+            .map(|&p| {
+                let n = crate::mesh::prepare::normalize(p, center, scale);
+                [n[0] as f32, n[1] as f32, n[2] as f32, 1.0]
+            })
+            .collect();
+        let indices: &[u32] = dag.mesh.triangles.as_flattened();
+        let gpu = GpuMesh::from_arrays(&ctx.device, &positions, indices, center, scale)?;
+        let extras = Extras {
+            error: Vec::new(),
+            // Every level's faces around a vertex: they approximate one surface.
+            normals: vertex_normals(&positions, indices),
+            uvs: None,
+            colors: None,
+        };
+        let mut scene = SceneMesh::new(
+            &ctx.device,
+            gpu,
+            positions.len(),
+            dag.mesh.triangles.len(),
+            &extras,
+        )?;
+        let cut = GpuCut::new(&ctx.pipelines, &ctx.queue, &dag.cut_clusters())?;
+        scene.cluster_draws = Some((cut.draws.clone(), cut.clusters()));
+        Ok(DagScene {
+            scene,
+            cut,
+            center,
+            scale,
+        })
+    }
+
+    /// The cut of `cam` at `pixels` on a `size` view, as `dag cut --camera` takes it: the eye
+    /// in the DAG's own units, the vertical field of view and the view's height.
+    pub fn camera_cut(&self, cam: &Camera, size: (u32, u32), pixels: f64) -> CameraCut {
+        let eye = cam.model.inverse().transform_point3(cam.eye());
+        CameraCut {
+            eye: [0, 1, 2].map(|i| eye[i] as f64 / self.scale + self.center[i]),
+            pixels,
+            fov_deg: (cam.fov_y as f64).to_degrees(),
+            height: size.1 as f64,
+        }
+    }
+
+    /// The cut's uniform for `cam` on a `size` view at `pixels`: the error test, and the
+    /// frustum of the view.
+    pub fn cut_params(&self, cam: &Camera, size: (u32, u32), pixels: f64) -> CutParams {
+        let mut p = self
+            .camera_cut(cam, size, pixels)
+            .params(self.cut.clusters() as usize);
+        // The DAG's units into the normalized frame the camera sees, then the view.
+        let c = Vec3::from_array(self.center.map(|x| x as f32));
+        let to_frame =
+            Mat4::from_scale(Vec3::splat(self.scale as f32)) * Mat4::from_translation(-c);
+        let aspect = size.0 as f32 / size.1 as f32;
+        p.planes = crate::dag::cut::frustum_planes(cam.proj_view(aspect) * cam.model * to_frame);
+        p.cull = 1;
+        p
+    }
+}
+
+/// The window's first view of `model` on a view of `size`, as a screenshot takes it.
+pub fn home_camera(model: &Model, size: (u32, u32)) -> Camera {
+    let mut eye = Eye::default();
+    eye.home(
+        model.up_axis,
+        model.stood,
+        model.extent(),
+        size.0 as f32 / size.1 as f32,
+    );
+    eye.camera
+}
+
+/// The input a DAG was built from, as a model: its first level's triangles and the vertices
+/// they use, standing as a mesh file opened in the window would.
+pub fn leaves(dag: &Dag, name: String) -> Result<Model> {
+    let mut leaf = dag.mesh.clone();
+    leaf.triangles = dag
+        .clusters
+        .iter()
+        .filter(|c| c.depth == 0)
+        .flat_map(|c| dag.triangles(c).iter().copied())
+        .collect();
+    leaf.remove_unused_vertices();
+    let mut m = Model::from_mesh(name, leaf)?;
+    let convention = super::camera::Up::Y;
+    m.stood = super::camera::stands(&m.mesh.positions, &m.mesh.triangles, convention);
+    m.up_axis = m.stood.map_or(convention, |(up, _)| up);
+    Ok(m)
+}
+
+/// Draws `frames` frames of `items` from `cam` into `target`, each submitted and waited for
+/// (`before` records what a frame needs first: a DAG's cut); the seconds of each.
+#[allow(clippy::too_many_arguments)]
+pub fn time_frames(
+    ctx: &crate::compute::context::GpuContext,
+    renderer: &mut Renderer,
+    target: &Target,
+    cam: &Camera,
+    style: &Style,
+    items: &[(&SceneMesh, Mat4)],
+    frames: usize,
+    before: &mut dyn FnMut(&mut wgpu::CommandEncoder),
+) -> Result<Vec<f64>> {
+    let mut seconds = Vec::with_capacity(frames);
+    for _ in 0..frames {
+        let t = Instant::now();
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        before(&mut enc);
+        renderer.draw(&ctx.device, &ctx.queue, &mut enc, target, cam, style, items);
+        ctx.queue.submit([enc.finish()]);
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| crate::error::Error::Gpu(format!("drawing a frame: {e}")))?;
+        seconds.push(t.elapsed().as_secs_f64());
+    }
+    Ok(seconds)
+}
