@@ -132,7 +132,7 @@ fn a_cut_drawn_from_the_device_has_no_cracks_on_screen() {
         let (d, _) = dag::build(&m, &DagOptions::default()).unwrap();
         let model = leaves(&d, name.into()).unwrap();
         let full = model.original(&ctx.device).unwrap();
-        let mut scene = DagScene::new(ctx, &d, &model).unwrap();
+        let mut scene = DagScene::new(&ctx.pipelines, &ctx.queue, &d, &model).unwrap();
         let mut renderer = Renderer::new(&ctx.device, &ctx.queue);
         let style = Style::default();
         let home = home_camera(&model, size);

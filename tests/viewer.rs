@@ -361,7 +361,7 @@ fn a_dag_screenshot_draws_its_cut_and_times_its_frames() {
         ],
         &["view", "s.mslod", "--screenshot", "x.png", "--pixels", "0"],
         &["view", "builtin:torus", "--frames", "2"],
-        &["view", "s.mslod"],
+        &["view", "s.mslod", "--pixels", "2"],
     ] {
         let o = meshslim(bad, dir.path());
         assert_ne!(o.status.code(), Some(0), "{bad:?}");

@@ -115,6 +115,58 @@ fn a_mode_key_the_mesh_cannot_show_says_why() {
     assert_eq!(status, "vertex colour: the mesh has no vertex colours");
 }
 
+/// A cluster DAG opens in the window as its cut: the 3D view draws from the cut the device
+/// chooses, the panel says what it draws, a larger threshold draws fewer triangles and a new
+/// picture, and O shows the whole first level instead.
+#[test]
+fn a_dag_opens_as_its_cut_and_its_threshold_moves_it() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sphere.mslod");
+    let m = meshslim::mesh::noisy_sphere(5, 0.01, 7);
+    let (d, _) = meshslim::dag::build(&m, &Default::default()).unwrap();
+    meshslim::dag::file::write(&path, &d).unwrap();
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(900.0, 600.0))
+        .wgpu_setup(meshslim::viewer::app::wgpu_setup())
+        .build_eframe(|cc| ViewerApp::new(cc, Start::Open(path.clone())).expect("starts"));
+    h.step();
+    finish_job(&mut h);
+    h.step();
+    h.step();
+    assert!(h.state().scene.dag.is_some(), "{}", h.state().status);
+    let counts = |h: &Harness<'static, ViewerApp>| {
+        let s = h.state();
+        let d = s.scene.dag.as_ref().unwrap().lock().unwrap();
+        d.counts(&s.eye.camera, s.view.pane_size(), s.view.pixels)
+    };
+    let fine = counts(&h);
+    assert!(
+        fine[2] > 0 && (fine[2] as usize) <= m.triangles.len(),
+        "{fine:?}"
+    );
+    let label = format!("{} triangles drawn", fine[2]);
+    assert!(
+        h.query_by_label_contains(&label).is_some(),
+        "the panel says {label}"
+    );
+    let picture = h.state().pane_rgba(0).unwrap().0;
+    h.state_mut().view.pixels = 16.0;
+    h.step();
+    h.step();
+    let coarse = counts(&h);
+    assert!(coarse[2] < fine[2], "{coarse:?} against {fine:?}");
+    let coarse_picture = h.state().pane_rgba(0).unwrap().0;
+    assert!(coarse_picture != picture, "the cut moved");
+    h.key_press(egui::Key::O);
+    h.step();
+    h.step();
+    let first_level = h.state().pane_rgba(0).unwrap().0;
+    assert!(first_level != coarse_picture, "O shows the first level");
+}
+
 /// On a software adapter (lavapipe here) the window starts on cpu-parallel, as the library's
 /// `auto` would, and its panel says why; gpu stays one click away.
 #[test]

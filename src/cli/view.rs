@@ -29,9 +29,9 @@ calls for (L toggles LOD; the panel shows the frame time with and without). X.pa
 side by side with the original), Ctrl+click to choose members for the LOD scene. The panel's
 Search runs the same NSGA-II on the open mesh.
 
-A cluster DAG (X.mslod, from 'meshslim dag build') is drawn with --screenshot as a renderer
-draws it: per frame the device picks each cluster's coarsest version whose error projects under
---pixels (default 1) and that is in view, and draws from those draws with no read-back.
+A cluster DAG (X.mslod, from 'meshslim dag build') is drawn as a renderer draws it: per frame
+the device picks each cluster's coarsest version whose error projects under --pixels (default 1;
+in the window, a slider) and that is in view, and draws from those draws with no read-back.
 --frames N draws and times N more frames from the same camera, and --json prints the median
 frame time and the triangles a frame drew, for a DAG and a plain mesh alike.
 
@@ -171,18 +171,13 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     if args.pixels.is_some() {
         dag_only("--pixels")?;
     }
-    if args.screenshot.is_none() {
-        if args.frames > 0 || args.json {
-            return Err(UsageError("--frames and --json go with --screenshot".into()).into());
-        }
-        if let Some(i) = args.input.as_ref().filter(|i| is_dag(i)) {
-            return Err(UsageError(format!(
-                "{}: a DAG is drawn with --screenshot for now; the window opens meshes and \
-                 manifests",
-                i.display()
-            ))
-            .into());
-        }
+    if args.screenshot.is_none() && (args.frames > 0 || args.json || args.pixels.is_some()) {
+        return Err(UsageError(
+            "--frames, --json and --pixels go with --screenshot (the window has a slider for \
+             the pixels)"
+                .into(),
+        )
+        .into());
     }
     if args.frames > 0 && args.side_by_side {
         return Err(UsageError("--frames times one view: not with --side-by-side".into()).into());

@@ -63,11 +63,13 @@ impl ViewerApp {
 
     /// As [`ViewerApp::open`], with the manifest's mesh already made.
     pub fn open_with(&mut self, path: PathBuf, model: Option<Model>) {
-        let device = self.gpu.device.clone();
+        let (pipelines, queue) = (self.gpu.pipelines.clone(), self.gpu.queue.clone());
         let label = format!("reading {}", path.display());
         self.spawn(
             label,
-            move |_, progress, _| scene::open(&device, &path, model, progress).map(Box::new),
+            move |_, progress, _| {
+                scene::open((&pipelines, &queue), &path, model, progress).map(Box::new)
+            },
             Done::Loaded,
         );
     }
@@ -273,8 +275,10 @@ impl ViewerApp {
                     original,
                     levels,
                     front,
+                    dag,
                 } = *loaded;
                 self.set_model(model, original);
+                self.scene.dag = dag.map(std::sync::Mutex::new);
                 if let Some(levels) = levels {
                     self.scene.lod_source =
                         format!("the {} levels of a meshslim lods run", levels.len() - 1);

@@ -7,6 +7,7 @@
 use super::camera::{Camera, Eye};
 use super::render::{Extras, Renderer, SceneMesh, Style, Target, vertex_normals};
 use super::scene::Model;
+use crate::compute::gpu::Pipelines;
 use crate::compute::types::CutParams;
 use crate::dag::gpu::GpuCut;
 use crate::dag::{CameraCut, Dag};
@@ -20,17 +21,22 @@ use std::time::Instant;
 pub struct DagScene {
     pub scene: SceneMesh,
     pub cut: GpuCut,
+    /// The clusters as the cut reads them, kept for the host's counts.
+    clusters: Vec<crate::compute::types::CutCluster>,
     center: [f64; 3],
     scale: f64,
 }
 
 impl DagScene {
-    /// `dag` uploaded on `ctx`'s device, in the frame of `model` (its input: the leaves).
+    /// `dag` uploaded on the device of `pipelines`, in the frame of `model` (its input: the
+    /// leaves).
     pub fn new(
-        ctx: &crate::compute::context::GpuContext,
+        pipelines: &Pipelines,
+        queue: &wgpu::Queue,
         dag: &Dag,
         model: &Model,
     ) -> Result<DagScene> {
+        let device = pipelines.device();
         let (center, scale) = (model.up.center, model.up.scale);
         let positions: Vec<[f32; 4]> = dag
             .mesh
@@ -42,7 +48,7 @@ impl DagScene {
             })
             .collect();
         let indices: &[u32] = dag.mesh.triangles.as_flattened();
-        let gpu = GpuMesh::from_arrays(&ctx.device, &positions, indices, center, scale)?;
+        let gpu = GpuMesh::from_arrays(device, &positions, indices, center, scale)?;
         let extras = Extras {
             error: Vec::new(),
             // Every level's faces around a vertex: they approximate one surface.
@@ -51,20 +57,33 @@ impl DagScene {
             colors: None,
         };
         let mut scene = SceneMesh::new(
-            &ctx.device,
+            device,
             gpu,
             positions.len(),
             dag.mesh.triangles.len(),
             &extras,
         )?;
-        let cut = GpuCut::new(&ctx.pipelines, &ctx.queue, &dag.cut_clusters())?;
+        let clusters = dag.cut_clusters();
+        let cut = GpuCut::new(pipelines, queue, &clusters)?;
         scene.cluster_draws = Some((cut.draws.clone(), cut.clusters()));
         Ok(DagScene {
             scene,
             cut,
+            clusters,
             center,
             scale,
         })
+    }
+
+    /// What the cut for `cam` at `pixels` draws, by the twin of the device's stage on the host
+    /// (the panel's counts; the device's own are never read back while drawing): clusters in
+    /// the cut, clusters drawn, triangles drawn.
+    pub fn counts(&self, cam: &Camera, size: (u32, u32), pixels: f64) -> [u32; 4] {
+        let p = self.cut_params(cam, size, pixels);
+        let mut draws = vec![crate::compute::types::CornerDraw::default(); self.clusters.len()];
+        let mut counts = [0; 4];
+        crate::dag::cut::dag_cut(&p, &self.clusters, &mut draws, &mut counts);
+        counts
     }
 
     /// The cut of `cam` at `pixels` on a `size` view, as `dag cut --camera` takes it: the eye

@@ -16,6 +16,8 @@ pub struct Device {
     /// `--method cluster`'s pipelines on the same device, so its result is drawn from the
     /// buffers the build wrote.
     pub(super) clusterer: Option<Arc<GpuClusterer>>,
+    /// The device's pipelines, for the stages made after the window starts (a DAG's cut).
+    pub(super) pipelines: Arc<crate::compute::gpu::Pipelines>,
     pub(super) adapter: String,
 }
 
@@ -53,6 +55,7 @@ impl Device {
             adapter: info.name,
             sim,
             clusterer,
+            pipelines: cache,
         };
         (device, start, status)
     }

@@ -18,7 +18,8 @@ pub(super) enum BrowserResult {
     Stay,
 }
 
-const MESH_EXTENSIONS: [&str; 5] = ["obj", "ply", "stl", "gltf", "glb"];
+/// Meshes, and cluster DAGs (`meshslim dag build`), which open as their cut.
+const MESH_EXTENSIONS: [&str; 6] = ["obj", "ply", "stl", "gltf", "glb", "mslod"];
 
 impl Browser {
     pub(super) fn new(current: Option<PathBuf>) -> Browser {
@@ -99,7 +100,7 @@ impl Browser {
                     ui.colored_label(egui::Color32::LIGHT_RED, e);
                 }
                 ui.label(format!(
-                    "{} (.obj .ply .stl .gltf .glb)",
+                    "{} (.obj .ply .stl .gltf .glb .mslod)",
                     self.dir.display()
                 ));
                 egui::ScrollArea::vertical()

@@ -289,6 +289,10 @@ impl Panel {
                     .text("speed"),
             );
         }
+        if scene.dag.is_some() {
+            ui.separator();
+            dag_ui(ui, view, eye, scene);
+        }
         ui.separator();
         self.lod_ui(ui, view, seen, &mut act);
         ui.separator();
@@ -567,18 +571,36 @@ const METHODS: [(Method, &str); 5] = [
     ),
 ];
 
+/// A DAG's threshold and what its cut draws from the current view (counted by the cut's twin
+/// on the host: the device's counts are not read back while drawing).
+fn dag_ui(ui: &mut egui::Ui, view: &mut View3d, eye: &Eye, scene: &Scene) {
+    let Some(dag) = &scene.dag else { return };
+    ui.label("Cluster DAG");
+    ui.add(
+        egui::Slider::new(&mut view.pixels, 0.25..=16.0)
+            .logarithmic(true)
+            .text("error (pixels)"),
+    )
+    .on_hover_text("each cluster is drawn at the coarsest level whose error projects under this");
+    let d = dag.lock().unwrap_or_else(|p| p.into_inner());
+    let [in_cut, drawn, triangles, _] = d.counts(&eye.camera, view.pane_size(), view.pixels);
+    ui.label(format!(
+        "cut: {in_cut} clusters, {drawn} in view, {triangles} triangles drawn"
+    ));
+}
+
 /// The device, the frame time, the counts before and after, and the result's run.
 fn stats_ui(ui: &mut egui::Ui, view: &View3d, seen: &Seen, animating: bool) {
     ui.label(format!("device: {}", seen.gpu.adapter));
     // The time between the pictures the user sees, while the window draws on its own (a few
-    // times a second during a job, continuously in the LOD scene and fly mode) or a picture is
-    // still being drawn (a drag on a large mesh). Otherwise it draws on input alone, and the
+    // times a second during a job, continuously in the LOD scene and fly mode) or a picture has
+    // been drawing for long (a drag on a large mesh). Otherwise it draws on input alone, and the
     // gap between frames is the user's, not the renderer's.
     // A poll that does not wait runs the callbacks of the renders the device has finished.
     let _ = seen.gpu.device.poll(wgpu::PollType::Poll);
-    let shown = view.clock.shown_gap(std::time::Instant::now());
-    ui.label(match shown {
-        Some(dt) if animating || view.clock.pending() => {
+    let now = std::time::Instant::now();
+    ui.label(match view.clock.shown_gap(now) {
+        Some(dt) if animating || view.clock.stalled(now) => {
             format!(
                 "frames shown: {:.1} ms apart ({:.1} FPS)",
                 dt * 1e3,

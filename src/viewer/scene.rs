@@ -55,6 +55,8 @@ pub struct Loaded {
     pub original: SceneMesh,
     pub levels: Option<Vec<SceneMesh>>,
     pub front: Option<Front>,
+    /// A cluster DAG (X.mslod), drawn as its cut; the model is its first level.
+    pub dag: Option<super::dag::DagScene>,
 }
 
 /// What the window shows — the model and its original drawn, its simplification, the LOD
@@ -75,6 +77,9 @@ pub struct Scene {
     pub texture_note: Option<String>,
     /// Bumped whenever a mesh or texture to show changes.
     pub(super) generation: u64,
+    /// The model's cluster DAG when a .mslod was opened: drawn as its cut (locked to record
+    /// the cut into a frame).
+    pub dag: Option<std::sync::Mutex<super::dag::DagScene>>,
 }
 
 impl Scene {
@@ -87,6 +92,7 @@ impl Scene {
         self.simplified = None;
         self.lod = None;
         self.front = None;
+        self.dag = None;
     }
 
     pub(super) fn set_simplified(&mut self, s: Simplified) {
@@ -121,11 +127,29 @@ impl Scene {
 /// made from, read from where it names it — or `given`, when the command line has made it
 /// (a `builtin:` input). `progress` gets the fraction of the level files read.
 pub fn open(
-    device: &wgpu::Device,
+    (pipelines, queue): (&crate::compute::gpu::Pipelines, &wgpu::Queue),
     path: &Path,
     given: Option<Model>,
     progress: &mut dyn FnMut(f32),
 ) -> Result<Loaded> {
+    let device = pipelines.device();
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mslod"))
+    {
+        let dag = crate::dag::file::read(path)?;
+        let mut model = super::dag::leaves(&dag, path.display().to_string())?;
+        model.path = Some(path.to_path_buf());
+        let original = model.original(device)?;
+        let d = super::dag::DagScene::new(pipelines, queue, &dag, &model)?;
+        return Ok(Loaded {
+            model,
+            original,
+            levels: None,
+            front: None,
+            dag: Some(d),
+        });
+    }
     let model_of = |input: &str, relative: Option<&str>, given: Option<Model>| -> Result<Model> {
         if let Some(m) = given {
             return Ok(m);
@@ -147,6 +171,7 @@ pub fn open(
             original,
             levels: None,
             front: None,
+            dag: None,
         });
     };
     match kind {
@@ -182,6 +207,7 @@ pub fn open(
                 original,
                 levels: Some(levels),
                 front: None,
+                dag: None,
             })
         }
         ManifestKind::Pareto => {
@@ -194,6 +220,7 @@ pub fn open(
                 original,
                 levels: None,
                 front: Some(front),
+                dag: None,
             })
         }
     }

@@ -22,6 +22,7 @@ struct DrawKey {
     lod_on: bool,
     sizes: Vec<(u32, u32)>,
     generation: u64,
+    pixels: f64,
 }
 
 /// A texture the 3D view draws into and egui shows.
@@ -43,7 +44,13 @@ pub struct FrameClock {
     submitted: u64,
     /// ...and finished, written by the device's callback.
     shown: std::sync::Arc<std::sync::Mutex<Shown>>,
+    /// When the oldest render still on the device was submitted.
+    waiting_since: Option<Instant>,
 }
+
+/// A render on the device this long has the user looking at an old picture; a shorter one is
+/// the ordinary latency of any frame.
+const STALLED: f64 = 0.2;
 
 /// The renders the device has finished: when the last was, and the smoothed gap between them.
 #[derive(Debug, Default, Clone, Copy)]
@@ -83,6 +90,9 @@ impl FrameClock {
 
     /// A render of the 3D view was submitted: its end is timed when the device has done it.
     fn submitted(&mut self, queue: &wgpu::Queue) {
+        if !self.pending() {
+            self.waiting_since = Some(Instant::now());
+        }
         self.submitted += 1;
         let shown = self.shown.clone();
         queue.on_submitted_work_done(move || {
@@ -94,6 +104,15 @@ impl FrameClock {
     /// Whether a render is still on the device: the screen shows an older picture.
     pub fn pending(&self) -> bool {
         self.shown.lock().map_or(0, |s| s.done) < self.submitted
+    }
+
+    /// Whether a render has been on the device for longer than a frame's usual latency, at
+    /// `now` (a drag on a large mesh on a slow device).
+    pub fn stalled(&self, now: Instant) -> bool {
+        self.pending()
+            && self
+                .waiting_since
+                .is_some_and(|t| (now - t).as_secs_f64() > STALLED)
     }
 
     /// Seconds between the pictures the user sees, at `now`: the smoothed gap between finished
@@ -124,6 +143,8 @@ pub struct View3d {
     pub clock: FrameClock,
     /// Smoothed frame seconds of the LOD scene with LOD on and off, as last measured.
     pub lod_frame: [Option<f64>; 2],
+    /// A DAG's threshold: the projected error a drawn cluster may show, in pixels.
+    pub pixels: f64,
     /// Frames drawn since the start (the tests count them while a job runs).
     pub frames: u64,
     /// Times the 3D view was rendered (only when what it shows changed).
@@ -143,6 +164,7 @@ impl View3d {
             lod_on: true,
             clock: FrameClock::default(),
             lod_frame: [None, None],
+            pixels: 1.0,
             frames: 0,
             renders: 0,
         }
@@ -167,6 +189,11 @@ impl View3d {
     pub(super) fn reframe(&mut self) {
         self.drawn = None;
         self.lod_frame = [None, None];
+    }
+
+    /// The first pane's size in pixels (640x480 before the first frame).
+    pub fn pane_size(&self) -> (u32, u32) {
+        self.panes.first().map_or((640, 480), |v| v.target.size)
     }
 
     /// The first pane's width over its height (4:3 before the first frame).
@@ -327,6 +354,7 @@ impl View3d {
             lod_on: self.lod_on,
             sizes: self.panes.iter().map(|v| v.target.size).collect(),
             generation: scene.generation,
+            pixels: self.pixels,
         };
         let drawn = if lod || self.drawn.as_ref() != Some(&key) {
             let r = self.draw(gpu, scene, &eye.camera, split, lod);
@@ -357,8 +385,22 @@ impl View3d {
         // A refused draw becomes the status line, not a panic in wgpu's default handler.
         let scope = crate::compute::gpu::ErrorScope::push(&gpu.device);
         for (k, mesh) in shown.iter().enumerate() {
-            let items: Vec<(&SceneMesh, Mat4)> = match (&scene.lod, lod) {
-                (Some(levels), true) => self.lod_items(levels, camera),
+            // A DAG's pane draws its cut, chosen on the device in this frame's encoder, where
+            // the original would be (O shows the whole first level instead).
+            let mut dag = scene
+                .dag
+                .as_ref()
+                .filter(|_| !lod && !self.show_original && scene.simplified.is_none())
+                .filter(|_| !split || k == 1)
+                .map(|d| d.lock().unwrap_or_else(|p| p.into_inner()));
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            if let Some(d) = dag.as_mut() {
+                let p = d.cut_params(camera, self.panes[k].target.size, self.pixels);
+                d.cut.record(&mut enc, &p);
+            }
+            let items: Vec<(&SceneMesh, Mat4)> = match (&scene.lod, lod, &dag) {
+                (Some(levels), true, _) => self.lod_items(levels, camera),
+                (_, _, Some(d)) => vec![(&d.scene, camera.model)],
                 _ => mesh.map(|m| vec![(m, camera.model)]).unwrap_or_default(),
             };
             let mut style = self.style;
@@ -369,7 +411,6 @@ impl View3d {
             }
             // One submission per pane: the renderer's uniforms are written through the queue,
             // and a second pane's writes would land before the first pane's draw otherwise.
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
             self.renderer.draw(
                 &gpu.device,
                 &gpu.queue,
@@ -611,7 +652,10 @@ mod tests {
         assert!(!clock.pending());
         // A third render on the device for 1.8 s: the screen has shown one picture that long.
         clock.submitted = 3;
+        clock.waiting_since = Some(at(0.1));
         assert!(clock.pending());
+        assert!(!clock.stalled(at(0.2)), "a frame's usual latency");
+        assert!(clock.stalled(at(1.9)));
         let gap = clock.shown_gap(at(1.9)).unwrap();
         assert!((gap - 1.8).abs() < 1e-9, "{gap}");
     }
