@@ -120,8 +120,9 @@ fn the_device_cut_is_its_twins_draw_for_draw() {
 /// view.
 #[test]
 fn a_cut_drawn_from_the_device_has_no_cracks_on_screen() {
+    use meshslim::viewer::Model;
     use meshslim::viewer::camera::Camera;
-    use meshslim::viewer::dag::{DagScene, home_camera, leaves};
+    use meshslim::viewer::dag::DagScene;
     use meshslim::viewer::render::{Renderer, Style, Target};
     let Some(ctx) = gpu_context() else { return };
     let size = (320u32, 240u32);
@@ -130,12 +131,13 @@ fn a_cut_drawn_from_the_device_has_no_cracks_on_screen() {
         ("double_torus", mesh::double_torus(14)),
     ] {
         let (d, _) = dag::build(&m, &DagOptions::default()).unwrap();
-        let model = leaves(&d, name.into()).unwrap();
+        let model = Model::leaves_of(&d, name.into()).unwrap();
         let full = model.original(&ctx.device).unwrap();
-        let mut scene = DagScene::new(&ctx.pipelines, &ctx.queue, &d, &model).unwrap();
+        let frame = (model.up.center, model.up.scale);
+        let mut scene = DagScene::new(&ctx.pipelines, &ctx.queue, &d, frame).unwrap();
         let mut renderer = Renderer::new(&ctx.device, &ctx.queue);
         let style = Style::default();
-        let home = home_camera(&model, size);
+        let home = model.home_camera(size);
         // A frame of `items` from `cam`, after what `first` records (a cut).
         let render = |renderer: &mut Renderer,
                       first: &mut dyn FnMut(&mut wgpu::CommandEncoder),

@@ -274,7 +274,7 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     };
     let model = match &dag {
         Some(d) => {
-            let mut m = crate::viewer::dag::leaves(d, input.display()).map_err(lib)?;
+            let mut m = crate::viewer::Model::leaves_of(d, input.display()).map_err(lib)?;
             m.up_axis = args.up.unwrap_or(m.up_axis);
             m
         }

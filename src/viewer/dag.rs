@@ -4,9 +4,8 @@
 //! (Karis et al. 2021). The frame-timing loop `view --frames` runs is here too, for a DAG and
 //! a plain mesh alike.
 
-use super::camera::{Camera, Eye};
+use super::camera::Camera;
 use super::render::{Extras, Renderer, SceneMesh, Style, Target, vertex_normals};
-use super::scene::Model;
 use crate::compute::gpu::Pipelines;
 use crate::compute::types::CutParams;
 use crate::dag::gpu::GpuCut;
@@ -28,16 +27,16 @@ pub struct DagScene {
 }
 
 impl DagScene {
-    /// `dag` uploaded on the device of `pipelines`, in the frame of `model` (its input: the
-    /// leaves).
+    /// `dag` uploaded on the device of `pipelines`, in the normalized frame (`center`,
+    /// `scale`) of its input, the first level, as its model draws it
+    /// ([`super::scene::Model::leaves_of`]).
     pub fn new(
         pipelines: &Pipelines,
         queue: &wgpu::Queue,
         dag: &Dag,
-        model: &Model,
+        (center, scale): ([f64; 3], f64),
     ) -> Result<DagScene> {
         let device = pipelines.device();
-        let (center, scale) = (model.up.center, model.up.scale);
         let positions: Vec<[f32; 4]> = dag
             .mesh
             .positions
@@ -113,36 +112,6 @@ impl DagScene {
         p.cull = 1;
         p
     }
-}
-
-/// The window's first view of `model` on a view of `size`, as a screenshot takes it.
-pub fn home_camera(model: &Model, size: (u32, u32)) -> Camera {
-    let mut eye = Eye::default();
-    eye.home(
-        model.up_axis,
-        model.stood,
-        model.extent(),
-        size.0 as f32 / size.1 as f32,
-    );
-    eye.camera
-}
-
-/// The input a DAG was built from, as a model: its first level's triangles and the vertices
-/// they use, standing as a mesh file opened in the window would.
-pub fn leaves(dag: &Dag, name: String) -> Result<Model> {
-    let mut leaf = dag.mesh.clone();
-    leaf.triangles = dag
-        .clusters
-        .iter()
-        .filter(|c| c.depth == 0)
-        .flat_map(|c| dag.triangles(c).iter().copied())
-        .collect();
-    leaf.remove_unused_vertices();
-    let mut m = Model::from_mesh(name, leaf)?;
-    let convention = super::camera::Up::Y;
-    m.stood = super::camera::stands(&m.mesh.positions, &m.mesh.triangles, convention);
-    m.up_axis = m.stood.map_or(convention, |(up, _)| up);
-    Ok(m)
 }
 
 /// Draws `frames` frames of `items` from `cam` into `target`, each submitted and waited for

@@ -179,7 +179,8 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
     );
     let cam = eye.camera;
     if let Some((dag, pixels)) = dag {
-        let mut d = dag::DagScene::new(&ctx.pipelines, &ctx.queue, dag, model)?;
+        let frame = (model.up.center, model.up.scale);
+        let mut d = dag::DagScene::new(&ctx.pipelines, &ctx.queue, dag, frame)?;
         let p = d.cut_params(&cam, size, pixels);
         let target = render::Target::new(&ctx.device, size)?;
         let items = [(&d.scene, cam.model)];

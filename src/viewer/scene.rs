@@ -138,10 +138,11 @@ pub fn open(
         .is_some_and(|e| e.eq_ignore_ascii_case("mslod"))
     {
         let dag = crate::dag::file::read(path)?;
-        let mut model = super::dag::leaves(&dag, path.display().to_string())?;
+        let mut model = Model::leaves_of(&dag, path.display().to_string())?;
         model.path = Some(path.to_path_buf());
         let original = model.original(device)?;
-        let d = super::dag::DagScene::new(pipelines, queue, &dag, &model)?;
+        let d =
+            super::dag::DagScene::new(pipelines, queue, &dag, (model.up.center, model.up.scale))?;
         return Ok(Loaded {
             model,
             original,
@@ -281,6 +282,36 @@ impl Model {
             up_axis: Up::Y,
             stood: None,
         })
+    }
+
+    /// The input a DAG was built from, as a model: its first level's triangles and the
+    /// vertices they use, standing as a mesh file opened in the window would.
+    pub fn leaves_of(dag: &crate::dag::Dag, name: String) -> Result<Model> {
+        let mut leaf = dag.mesh.clone();
+        leaf.triangles = dag
+            .clusters
+            .iter()
+            .filter(|c| c.depth == 0)
+            .flat_map(|c| dag.triangles(c).iter().copied())
+            .collect();
+        leaf.remove_unused_vertices();
+        let mut m = Model::from_mesh(name, leaf)?;
+        let convention = Up::Y;
+        m.stood = super::camera::stands(&m.mesh.positions, &m.mesh.triangles, convention);
+        m.up_axis = m.stood.map_or(convention, |(up, _)| up);
+        Ok(m)
+    }
+
+    /// The window's first view of the model on a view of `size`, as a screenshot takes it.
+    pub fn home_camera(&self, size: (u32, u32)) -> super::camera::Camera {
+        let mut eye = super::camera::Eye::default();
+        eye.home(
+            self.up_axis,
+            self.stood,
+            self.extent(),
+            size.0 as f32 / size.1 as f32,
+        );
+        eye.camera
     }
 
     pub fn faces(&self) -> usize {
