@@ -167,6 +167,39 @@ fn a_dag_opens_as_its_cut_and_its_threshold_moves_it() {
     assert!(first_level != coarse_picture, "O shows the first level");
 }
 
+/// A mesh opened in the window becomes a DAG from the panel: a job on the panel's backend,
+/// drawn as its cut when done, and saved as a .mslod that reads back as built.
+#[test]
+fn a_mesh_becomes_a_dag_from_the_panel_and_saves() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let m = meshslim::mesh::noisy_sphere(4, 0.01, 3);
+    let mut h = harness(Model::from_mesh("sphere".into(), m.clone()).unwrap());
+    h.step();
+    assert!(h.query_by_label("Make DAG").is_some());
+    h.get_by_label("Make DAG").click();
+    h.step();
+    assert!(h.state().jobs.busy(), "{}", h.state().status);
+    finish_job(&mut h);
+    h.step();
+    let s = h.state();
+    assert!(s.scene.dag.is_some(), "{}", s.status);
+    assert!(s.status.contains("clusters"), "{}", s.status);
+    let built = s.scene.dag_built.clone().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sphere.mslod");
+    h.state_mut().save_dag(Some(path.clone()));
+    assert!(
+        h.state().status.starts_with("saved the DAG"),
+        "{}",
+        h.state().status
+    );
+    let read = meshslim::dag::file::read(&path).unwrap();
+    assert_eq!(read, *built, "the file holds the DAG as built");
+    assert_eq!(read.mesh.triangles.len(), built.mesh.triangles.len());
+}
+
 /// On a software adapter (lavapipe here) the window starts on cpu-parallel, as the library's
 /// `auto` would, and its panel says why; gpu stays one click away.
 #[test]

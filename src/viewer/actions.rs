@@ -39,6 +39,8 @@ impl ViewerApp {
             Action::ResetView => self.reset_view(),
             Action::SetUp(up) => self.set_up(up),
             Action::Say(line) => self.status = line,
+            Action::MakeDag => self.make_dag(),
+            Action::SaveDag => self.save_dag(None),
         }
     }
 
@@ -243,6 +245,48 @@ impl ViewerApp {
         );
     }
 
+    /// Builds the model's cluster DAG on a worker thread, on the panel's backend (`gpu` runs
+    /// the grouped rounds on the process's device), and uploads it to draw as its cut.
+    pub fn make_dag(&mut self) {
+        let Some(model) = self.scene.model.clone() else {
+            self.status = "nothing to build: open a mesh first".into();
+            return;
+        };
+        let (pipelines, queue) = (self.gpu.pipelines.clone(), self.gpu.queue.clone());
+        let backend = self.panel.backend;
+        self.spawn(
+            format!("building the cluster DAG ({})", backend.name()),
+            move |cancel, progress, _| {
+                let opts = crate::dag::DagOptions {
+                    backend,
+                    cancel,
+                    ..Default::default()
+                };
+                let (dag, _) = crate::dag::build_with_progress(&model.mesh, &opts, progress)?;
+                let frame = (model.up.center, model.up.scale);
+                let d = super::dag::DagScene::new(&pipelines, &queue, &dag, frame)?;
+                Ok(Box::new((d, Arc::new(dag))))
+            },
+            Done::Dag,
+        );
+    }
+
+    /// Writes the DAG built in the window to `path`, or beside the model as X.mslod.
+    pub fn save_dag(&mut self, path: Option<PathBuf>) {
+        let (Some(dag), Some(model)) = (&self.scene.dag_built, &self.scene.model) else {
+            self.status = "nothing to save: make the DAG first".into();
+            return;
+        };
+        let path = path.unwrap_or_else(|| {
+            let from = model.path.clone().unwrap_or_else(|| PathBuf::from("mesh"));
+            from.with_extension("mslod")
+        });
+        self.status = match crate::dag::file::write(&path, dag) {
+            Ok(()) => format!("saved the DAG to {}", path.display()),
+            Err(e) => format!("cannot save the DAG: {e}"),
+        };
+    }
+
     /// Stops the running job; it ends at its next check (a round, a few thousand collapses).
     pub fn cancel(&mut self) {
         if let Some(label) = self.jobs.cancel() {
@@ -293,6 +337,19 @@ impl ViewerApp {
                     self.scene.front = Some(f);
                 }
             }
+            Done::Dag(Ok(built)) => {
+                let (d, dag) = *built;
+                self.status = format!(
+                    "{label}: {} clusters, {} levels in {secs:.1} s",
+                    dag.clusters.len(),
+                    dag.levels()
+                );
+                // The cut is what the window shows now, in place of a simplified result.
+                self.scene.simplified = None;
+                self.scene.dag = Some(std::sync::Mutex::new(d));
+                self.scene.dag_built = Some(dag);
+                self.scene.generation += 1;
+            }
             Done::Front(Ok(f)) => {
                 self.status = format!("Pareto front of {} members in {secs:.1} s", f.members.len());
                 self.scene.front = Some(*f);
@@ -333,7 +390,8 @@ impl ViewerApp {
             | Done::Simplified(Err(e))
             | Done::Lod(Err(e))
             | Done::Front(Err(e))
-            | Done::Member(Err(e)) => self.status = failed(e),
+            | Done::Member(Err(e))
+            | Done::Dag(Err(e)) => self.status = failed(e),
         }
     }
 

@@ -22,6 +22,8 @@ pub(super) enum Done {
     Front(Result<Box<Front>>),
     /// Member `k` of the front, ready to show.
     Member(Result<Box<(usize, Simplified)>>),
+    /// A cluster DAG of the model, on the device and as built (for saving).
+    Dag(Result<Box<(super::dag::DagScene, std::sync::Arc<crate::dag::Dag>)>>),
 }
 
 /// Work on a worker thread.

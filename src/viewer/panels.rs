@@ -37,6 +37,10 @@ pub enum Action {
     ResetView,
     /// Draw the model with this axis up (None: its file's).
     SetUp(Option<Up>),
+    /// Build the model's cluster DAG (a job) and draw it as its cut.
+    MakeDag,
+    /// Write the DAG beside the model as X.mslod.
+    SaveDag,
     /// Put this in the status line (a key that could not do what it names says why).
     Say(String),
 }
@@ -289,10 +293,8 @@ impl Panel {
                     .text("speed"),
             );
         }
-        if scene.dag.is_some() {
-            ui.separator();
-            dag_ui(ui, view, eye, scene);
-        }
+        ui.separator();
+        dag_ui(ui, view, eye, seen, &mut act);
         ui.separator();
         self.lod_ui(ui, view, seen, &mut act);
         ui.separator();
@@ -573,9 +575,27 @@ const METHODS: [(Method, &str); 5] = [
 
 /// A DAG's threshold and what its cut draws from the current view (counted by the cut's twin
 /// on the host: the device's counts are not read back while drawing).
-fn dag_ui(ui: &mut egui::Ui, view: &mut View3d, eye: &Eye, scene: &Scene) {
-    let Some(dag) = &scene.dag else { return };
+fn dag_ui(ui: &mut egui::Ui, view: &mut View3d, eye: &Eye, seen: &Seen, act: &mut Vec<Action>) {
+    let scene = seen.scene;
     ui.label("Cluster DAG");
+    ui.horizontal(|ui| {
+        let can = !seen.jobs.busy() && scene.model.is_some();
+        let make = ui
+            .add_enabled(can, egui::Button::new("Make DAG"))
+            .on_hover_text(
+                "meshlets of 128 triangles, each group simplified to half, on the panel's backend",
+            );
+        if make.clicked() {
+            act.push(Action::MakeDag);
+        }
+        let save = ui
+            .add_enabled(scene.dag_built.is_some(), egui::Button::new("Save DAG"))
+            .on_hover_text("as X.mslod beside the mesh");
+        if save.clicked() {
+            act.push(Action::SaveDag);
+        }
+    });
+    let Some(dag) = &scene.dag else { return };
     ui.add(
         egui::Slider::new(&mut view.pixels, 0.25..=16.0)
             .logarithmic(true)

@@ -80,6 +80,8 @@ pub struct Scene {
     /// The model's cluster DAG when a .mslod was opened: drawn as its cut (locked to record
     /// the cut into a frame).
     pub dag: Option<std::sync::Mutex<super::dag::DagScene>>,
+    /// The DAG as built in the window, until saved.
+    pub dag_built: Option<Arc<crate::dag::Dag>>,
 }
 
 impl Scene {
@@ -93,6 +95,7 @@ impl Scene {
         self.lod = None;
         self.front = None;
         self.dag = None;
+        self.dag_built = None;
     }
 
     pub(super) fn set_simplified(&mut self, s: Simplified) {
