@@ -89,6 +89,8 @@ fn the_device_cut_is_its_twins_draw_for_draw() {
             let mut p = p;
             p.planes = frustum_planes(proj * view);
             p.cull = 1;
+            // And each draw numbered by its cluster and level, as the window's colours read it.
+            p.number = 1;
             let mut culled = (vec![CornerDraw::default(); clusters.len()], [0; 4]);
             dag_cut(&p, &clusters, &mut culled.0, &mut culled.1);
             compare(&format!("{at}, culled"), &gpu.run(&p).unwrap(), &culled);
@@ -99,6 +101,13 @@ fn the_device_cut_is_its_twins_draw_for_draw() {
             assert!(culled.1[1] <= cpu.1[1], "{at}");
             for (c, (a, b)) in culled.0.iter().zip(&cpu.0).enumerate() {
                 assert!(a.instance_count <= b.instance_count, "{at}: cluster {c}");
+                let depth = d.clusters[c].depth.min(255);
+                assert_eq!(
+                    a.first_instance,
+                    (depth << 24) | c as u32,
+                    "{at}: cluster {c}"
+                );
+                assert_eq!(b.first_instance, 0, "{at}: unnumbered");
                 if a.instance_count < b.instance_count {
                     any_culled = true;
                     let s = d.clusters[c].bounds;

@@ -113,6 +113,14 @@ fn a_mode_key_the_mesh_cannot_show_says_why() {
     assert_eq!(h.state().view.style.mode, Mode::Shaded);
     let status = h.state().status.clone();
     assert_eq!(status, "vertex colour: the mesh has no vertex colours");
+    h.key_press(egui::Key::Num8);
+    h.step();
+    assert_eq!(h.state().view.style.mode, Mode::Shaded);
+    assert!(
+        h.state().status.starts_with("levels: only a cluster DAG"),
+        "{}",
+        h.state().status
+    );
 }
 
 /// A cluster DAG opens in the window as its cut: the 3D view draws from the cut the device
@@ -165,6 +173,32 @@ fn a_dag_opens_as_its_cut_and_its_threshold_moves_it() {
     h.step();
     let first_level = h.state().pane_rgba(0).unwrap().0;
     assert!(first_level != coarse_picture, "O shows the first level");
+    // Back to the cut, coloured by cluster (7) where the device numbers indirect draws.
+    h.key_press(egui::Key::O);
+    h.key_press(egui::Key::Num7);
+    h.step();
+    h.step();
+    let numbered = h
+        .state()
+        .scene
+        .dag
+        .as_ref()
+        .unwrap()
+        .lock()
+        .unwrap()
+        .numbered;
+    if numbered {
+        assert_eq!(h.state().view.style.mode, Mode::Clusters);
+        let clusters = h.state().pane_rgba(0).unwrap().0;
+        assert!(clusters != coarse_picture, "the clusters in colours");
+    } else {
+        assert_eq!(h.state().view.style.mode, Mode::Shaded);
+        assert!(
+            h.state().status.contains("INDIRECT_FIRST_INSTANCE"),
+            "{}",
+            h.state().status
+        );
+    }
 }
 
 /// A mesh opened in the window becomes a DAG from the panel: a job on the panel's backend,

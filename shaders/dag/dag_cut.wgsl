@@ -1,7 +1,8 @@
 // Per cluster of a DAG: whether it is in the cut for the camera (its own error projects to at
 // most the threshold, its group's to more: Karis et al. 2021), whether its bounds meet the view
 // frustum, and its indirect draw over its triangles' corners (the viewer pulls its vertices:
-// one instance when drawn, none otherwise). Twin of src/dag/cut.rs::dag_cut; the
+// one instance when drawn, none otherwise; the instance numbers the cluster where the device
+// reads indirect first instances, for the cluster and level colours). Twin of src/dag/cut.rs::dag_cut; the
 // command line's `dag cut --camera` runs the same test (`passes`), so the two agree.
 
 // Twin of crate::compute::types::CutParams.
@@ -15,7 +16,9 @@ struct CutParams {
     clusters: u32,
     // 1: clusters outside the frustum are not drawn.
     cull: u32,
-    _pad: u32,
+    // 1: each draw's first instance is its cluster, level in the top 8 bits (the device
+    // reads indirect first instances); 0 otherwise.
+    number: u32,
 }
 
 // Twin of crate::compute::types::CornerDraw: a non-indexed indirect draw, the corners of
@@ -39,7 +42,7 @@ struct CutCluster {
     triangle_count: u32,
     // 1 for a root: no group, always coarse enough.
     root: u32,
-    _pad0: u32,
+    depth: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -90,7 +93,7 @@ fn dag_cut(
     d.vertex_count = 3u * k.triangle_count;
     d.instance_count = select(0u, 1u, drawn);
     d.first_vertex = 3u * k.first_triangle;
-    d.first_instance = 0u;
+    d.first_instance = select(0u, (min(k.depth, 255u) << 24u) | c, cut.number != 0u);
     draws[c] = d;
     if (in_cut) {
         atomicAdd(&cut_counts[0], 1u);

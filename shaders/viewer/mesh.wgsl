@@ -16,8 +16,9 @@ struct View {
     view_proj: mat4x4<f32>,
     // The camera in the mesh's frame, for the headlight.
     eye: vec4<f32>,
-    // x: mode (0 shaded, 1 normals, 2 heatmap, 3 texture, 4 quality, 5 vertex colour), y: error at the top of the colour
-    // ramp, z: 1 for smooth shading, w: unused.
+    // x: mode (0 shaded, 1 normals, 2 heatmap, 3 texture, 4 quality, 5 vertex colour, 6 DAG
+    // clusters, 7 DAG levels), y: error at the top of the colour ramp, z: 1 for smooth shading,
+    // w: the DAG's deepest level (for 7).
     mode: vec4<f32>,
 }
 
@@ -40,6 +41,9 @@ struct VOut {
     // The face's smallest angle in degrees, the same at its three corners.
     @location(4) @interpolate(flat) min_angle: f32,
     @location(5) color: vec4<f32>,
+    // A DAG's cluster as the cut numbered its draw's instance: its level in the top 8 bits,
+    // its number below (0 for a mesh).
+    @location(6) @interpolate(flat) cluster: u32,
 }
 
 // The smallest angle (degrees) of the triangle (a, b, c); 0 for a degenerate one. The frame
@@ -62,7 +66,7 @@ fn smallest_angle(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
 }
 
 @vertex
-fn vs_main(@builtin(vertex_index) corner: u32) -> VOut {
+fn vs_main(@builtin(vertex_index) corner: u32, @builtin(instance_index) cluster: u32) -> VOut {
     let v = indices[corner];
     let position = positions[v];
     var o: VOut;
@@ -72,6 +76,7 @@ fn vs_main(@builtin(vertex_index) corner: u32) -> VOut {
     o.normal = vec3<f32>(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);
     o.uv = uvs[corner];
     o.color = unpack4x8unorm(colors[corner]);
+    o.cluster = cluster;
     let first = corner - corner % 3u;
     o.min_angle = smallest_angle(
         positions[indices[first]].xyz,
@@ -114,6 +119,19 @@ fn fs_main(v: VOut) -> @location(0) vec4<f32> {
     }
     if (mode == 5u) {
         return vec4<f32>(v.color.rgb * light, 1.0);
+    }
+    if (mode == 6u) {
+        // A hash of the cluster's number as a hue: neighbours get unrelated colours.
+        var h = v.cluster & 0xffffffu;
+        h = (h ^ (h >> 16u)) * 0x7feb352du;
+        h = (h ^ (h >> 15u)) * 0x846ca68bu;
+        h = h ^ (h >> 16u);
+        let c = vec3<f32>(f32(h & 255u), f32((h >> 8u) & 255u), f32((h >> 16u) & 255u)) / 255.0;
+        return vec4<f32>((0.3 + 0.7 * c) * light, 1.0);
+    }
+    if (mode == 7u) {
+        let level = f32(v.cluster >> 24u);
+        return vec4<f32>(ramp(level / max(view.mode.w, 1.0)) * light, 1.0);
     }
     return vec4<f32>(vec3<f32>(0.82, 0.78, 0.70) * light, 1.0);
 }

@@ -16,8 +16,8 @@ use crate::lod::manifest::{self, ManifestKind};
 
 pub(super) const VIEW_AFTER_HELP: &str = "\
 In the window: left drag orbits, right or middle drag pans, the wheel zooms, G flies (W A S D),
-F frames the mesh, 1-6 switch shaded / normals / heatmap / texture / quality / colour, X wireframe,
-B side by side,
+F frames the mesh, 1-8 switch shaded / normals / heatmap / texture / quality / colour / a DAG's
+clusters / its levels, X wireframe, B side by side,
 Enter simplifies to the target, Esc cancels, Ctrl+O opens, Ctrl+S saves, P takes a screenshot;
 F1 lists them all. Simplification runs beside the drawing: the window keeps drawing (frame time
 in the side panel) and the run can be cancelled.

@@ -173,8 +173,8 @@ pub fn checked_buffer_init(
 /// viewer's window, the viewer's tests): the adapter's own limits, so that million-triangle
 /// meshes fit; timestamp queries for the per-stage table (inside passes too, so that the
 /// rounds time each dispatch of a pass), line polygons for the viewer's
-/// wireframe, and f64 in shaders for the preparation on the device, each only when the adapter
-/// has it.
+/// wireframe, f64 in shaders for the preparation on the device, and indirect first instances
+/// for a DAG's cluster colours, each only when the adapter has it.
 pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
     wgpu::DeviceDescriptor {
         label: Some("meshslim"),
@@ -183,7 +183,8 @@ pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'sta
                 | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES
                 | wgpu::Features::POLYGON_MODE_LINE
                 | wgpu::Features::PIPELINE_CACHE
-                | wgpu::Features::SHADER_F64),
+                | wgpu::Features::SHADER_F64
+                | wgpu::Features::INDIRECT_FIRST_INSTANCE),
         required_limits: adapter.limits(),
         ..Default::default()
     }

@@ -386,7 +386,9 @@ pub struct CutParams {
     pub clusters: u32,
     /// 1: clusters outside the frustum are not drawn.
     pub cull: u32,
-    pub _pad: u32,
+    /// 1: each draw's first instance is its cluster, its level in the top 8 bits (when the
+    /// device reads indirect first instances); 0 otherwise.
+    pub number: u32,
 }
 
 /// A DAG's cluster as the cut reads it: its spheres and errors, its group's, its triangles.
@@ -404,7 +406,8 @@ pub struct CutCluster {
     pub triangle_count: u32,
     /// 1 for a root.
     pub root: u32,
-    pub _pad: [u32; 3],
+    pub depth: u32,
+    pub _pad: [u32; 2],
 }
 
 /// A non-indexed indirect draw over the corners of `vertex_count / 3` triangles from corner

@@ -50,7 +50,7 @@ impl CameraCut {
             scale: (per_unit / self.pixels) as f32,
             clusters: clusters as u32,
             cull: 0,
-            _pad: 0,
+            number: 0,
         }
     }
 }
@@ -88,7 +88,8 @@ impl Dag {
                     first_triangle: c.first_triangle,
                     triangle_count: c.triangle_count,
                     root: g.is_none() as u32,
-                    _pad: [0; 3],
+                    depth: c.depth,
+                    _pad: [0; 2],
                 }
             })
             .collect()
@@ -202,14 +203,18 @@ pub fn dag_cut(
     counts: &mut [u32; 4],
 ) {
     *counts = [0; 4];
-    for (k, d) in clusters.iter().zip(draws.iter_mut()) {
+    for (c, (k, d)) in clusters.iter().zip(draws.iter_mut()).enumerate() {
         let cut = in_cut(p, k);
         let drawn = cut && (p.cull == 0 || in_view(p, k.bounds));
         *d = CornerDraw {
             vertex_count: 3 * k.triangle_count,
             instance_count: drawn as u32,
             first_vertex: 3 * k.first_triangle,
-            first_instance: 0,
+            first_instance: if p.number != 0 {
+                (k.depth.min(255) << 24) | c as u32
+            } else {
+                0
+            },
         };
         counts[0] += cut as u32;
         counts[1] += drawn as u32;

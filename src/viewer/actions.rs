@@ -427,6 +427,8 @@ impl ViewerApp {
             (true, _, Mode::Shaded) => self.view.style.mode = Mode::Texture,
             (false, true, Mode::Shaded) => self.view.style.mode = Mode::Color,
             (_, false, Mode::Color) => self.view.style.mode = Mode::Shaded,
+            // A new model has no DAG (yet): nothing has clusters to colour.
+            (_, _, Mode::Clusters | Mode::Levels) => self.view.style.mode = Mode::Shaded,
             _ => {}
         }
         let m = self.scene.model.clone().expect("set just above");

@@ -22,6 +22,8 @@ pub struct DagScene {
     pub cut: GpuCut,
     /// The clusters as the cut reads them, kept for the host's counts.
     clusters: Vec<crate::compute::types::CutCluster>,
+    /// The device reads indirect first instances: the cut numbers each cluster's draw.
+    pub numbered: bool,
     center: [f64; 3],
     scale: f64,
 }
@@ -65,10 +67,14 @@ impl DagScene {
         let clusters = dag.cut_clusters();
         let cut = GpuCut::new(pipelines, queue, &clusters)?;
         scene.cluster_draws = Some((cut.draws.clone(), cut.clusters()));
+        scene.levels = dag.levels() as u32;
         Ok(DagScene {
             scene,
             cut,
             clusters,
+            numbered: device
+                .features()
+                .contains(wgpu::Features::INDIRECT_FIRST_INSTANCE),
             center,
             scale,
         })
@@ -110,6 +116,7 @@ impl DagScene {
         let aspect = size.0 as f32 / size.1 as f32;
         p.planes = crate::dag::cut::frustum_planes(cam.proj_view(aspect) * cam.model * to_frame);
         p.cull = 1;
+        p.number = self.numbered as u32;
         p
     }
 }

@@ -197,6 +197,8 @@ impl Panel {
             Key::Num4,
             Key::Num5,
             Key::Num6,
+            Key::Num7,
+            Key::Num8,
         ];
         for (k, mode) in modes.into_iter().zip(Mode::ALL) {
             if pressed(k) {
@@ -687,6 +689,7 @@ pub const HELP: &[(&str, &str)] = &[
         "1 2 3 4 5 6",
         "shaded, normals, error heatmap, texture, triangle quality, vertex colour",
     ),
+    ("7 8", "a DAG's cut: by cluster, by level"),
     ("M", "smooth / flat shading"),
     ("X", "wireframe overlay"),
     ("B", "side by side: original | simplified"),

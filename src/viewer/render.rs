@@ -26,16 +26,22 @@ pub enum Mode {
     Quality,
     /// The mesh's vertex colours (a painted or photographed scan), lit like `shaded`.
     Color,
+    /// A DAG's cut: each cluster in a colour of its own.
+    Clusters,
+    /// A DAG's cut: each cluster by its level, blue (the input's) to red (the coarsest).
+    Levels,
 }
 
 impl Mode {
-    pub const ALL: [Mode; 6] = [
+    pub const ALL: [Mode; 8] = [
         Mode::Shaded,
         Mode::Normals,
         Mode::Heatmap,
         Mode::Texture,
         Mode::Quality,
         Mode::Color,
+        Mode::Clusters,
+        Mode::Levels,
     ];
     pub fn label(self) -> &'static str {
         match self {
@@ -45,6 +51,8 @@ impl Mode {
             Mode::Texture => "texture",
             Mode::Quality => "triangle quality",
             Mode::Color => "vertex colour",
+            Mode::Clusters => "clusters",
+            Mode::Levels => "levels",
         }
     }
 }
@@ -98,6 +106,8 @@ pub struct SceneMesh {
     /// ([`crate::dag::gpu::GpuCut::draws`]), and how many; the mesh is drawn from these
     /// instead of its own arguments.
     pub cluster_draws: Option<(wgpu::Buffer, u32)>,
+    /// A DAG's levels (0 for a mesh): the top of the levels mode's ramp.
+    pub levels: u32,
 }
 
 /// Extras made on the host: per vertex, except the UVs and colours (per corner).
@@ -179,6 +189,7 @@ impl SceneMesh {
             max_error,
             group: std::sync::OnceLock::new(),
             cluster_draws: None,
+            levels: 0,
         })
     }
 }
@@ -624,7 +635,7 @@ impl Renderer {
         let view_proj = camera.proj_view(aspect);
         let eye = camera.eye();
         let mut bytes = vec![0u8; (n * SLOT) as usize];
-        for (i, (_, model)) in items.iter().enumerate() {
+        for (i, (mesh, model)) in items.iter().enumerate() {
             let u = ViewUniform {
                 view_proj: (view_proj * *model).to_cols_array_2d(),
                 eye: model.inverse().transform_point3(eye).extend(1.0).to_array(),
@@ -632,7 +643,7 @@ impl Renderer {
                     style.mode as u32 as f32,
                     style.error_scale,
                     style.smooth as u32 as f32,
-                    0.0,
+                    mesh.levels.saturating_sub(1) as f32,
                 ],
             };
             let at = i * SLOT as usize;

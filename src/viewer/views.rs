@@ -210,6 +210,10 @@ impl View3d {
                 self.renderer.has_texture() && scene.original.as_ref().is_some_and(|o| o.has_uvs)
             }
             Mode::Color => scene.original.as_ref().is_some_and(|o| o.has_colors),
+            Mode::Clusters | Mode::Levels => scene
+                .dag
+                .as_ref()
+                .is_some_and(|d| d.lock().is_ok_and(|d| d.numbered)),
             _ => true,
         }
     }
@@ -226,6 +230,12 @@ impl View3d {
                 .clone()
                 .unwrap_or_else(|| "the mesh has no UVs or no texture".into()),
             Mode::Color => "the mesh has no vertex colours".into(),
+            Mode::Clusters | Mode::Levels if scene.dag.is_some() => {
+                "this device cannot number indirect draws (INDIRECT_FIRST_INSTANCE)".into()
+            }
+            Mode::Clusters | Mode::Levels => {
+                "only a cluster DAG has clusters: open a .mslod or Make DAG".into()
+            }
             _ => "nothing to draw".into(),
         })
     }
@@ -406,6 +416,7 @@ impl View3d {
             let mut style = self.style;
             if style.mode == Mode::Texture && !mesh.is_some_and(|m| m.has_uvs)
                 || style.mode == Mode::Color && !mesh.is_some_and(|m| m.has_colors)
+                || matches!(style.mode, Mode::Clusters | Mode::Levels) && dag.is_none()
             {
                 style.mode = Mode::Shaded;
             }
