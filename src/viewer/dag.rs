@@ -54,8 +54,9 @@ impl DagScene {
             error: Vec::new(),
             // Every level's faces around a vertex: they approximate one surface.
             normals: vertex_normals(&positions, indices),
-            uvs: None,
-            colors: None,
+            // Per corner, as a mesh's: the DAG's vertices carry the input's UVs and colours.
+            uvs: super::corners::corner_uvs(&dag.mesh, indices),
+            colors: super::corners::corner_colors(&dag.mesh, indices.iter().copied()),
         };
         let mut scene = SceneMesh::new(
             device,

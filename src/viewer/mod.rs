@@ -7,6 +7,7 @@
 mod actions;
 pub mod app;
 pub mod camera;
+mod corners;
 pub mod dag;
 pub mod device;
 mod file_browser;

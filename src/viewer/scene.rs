@@ -3,8 +3,9 @@
 //! detail. Nothing here touches egui; the window (`app.rs`) and the tests drive it alike.
 
 use super::camera::Up;
+use super::corners::{corner_colors, corner_uvs};
 use super::front::Front;
-use super::render::{Extras, SceneMesh, pack_color, vertex_normals};
+use super::render::{Extras, SceneMesh, vertex_normals};
 use crate::error::{Error, Result};
 use crate::lod::manifest::{self, ManifestKind};
 use crate::mesh::{Mesh, UvOrigin};
@@ -373,21 +374,6 @@ impl Model {
             })
             .collect()
     }
-}
-
-/// Each corner's UV: that of its attribute vertex (see [`corner_attributes`]), so a seam
-/// vertex shows each side's own. Counted from the image's bottom-left corner, as the shader
-/// samples them (glTF's are flipped here).
-fn corner_uvs(welded: &Mesh, corner_attr: &[u32]) -> Option<Vec<[f32; 2]>> {
-    let uv = welded.uvs_from(UvOrigin::BottomLeft)?;
-    Some(corner_attr.iter().map(|&a| uv[a as usize]).collect())
-}
-
-/// Each corner's vertex colour, packed for the renderer: that of the vertex of `mesh` each
-/// corner names.
-fn corner_colors(mesh: &Mesh, corners: impl Iterator<Item = u32>) -> Option<Vec<u32>> {
-    let c = mesh.colors.as_ref()?;
-    Some(corners.map(|v| pack_color(c[v as usize])).collect())
 }
 
 /// A glTF material's base colour texture, else the first material library's first `map_Kd`;
