@@ -143,7 +143,15 @@ fn a_cut_drawn_from_the_device_has_no_cracks_on_screen() {
         let model = Model::leaves_of(&d, name.into()).unwrap();
         let full = model.original(&ctx.device).unwrap();
         let frame = (model.up.center, model.up.scale);
-        let mut scene = DagScene::new(&ctx.pipelines, &ctx.queue, &d, frame).unwrap();
+        let mut scene =
+            DagScene::new(&ctx.pipelines, &ctx.queue, &d, frame, model.dag_errors(&d)).unwrap();
+        // The cut's heatmap: every vertex of the DAG near the first level.
+        let top = scene.scene.max_error;
+        assert!(top < 0.05, "{name}: {top}");
+        assert!(
+            top > 0.0 || name == "double_torus",
+            "{name}: the coarse levels moved off it"
+        );
         let mut renderer = Renderer::new(&ctx.device, &ctx.queue);
         let style = Style::default();
         let home = model.home_camera(size);

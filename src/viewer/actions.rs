@@ -264,7 +264,8 @@ impl ViewerApp {
                 };
                 let (dag, _) = crate::dag::build_with_progress(&model.mesh, &opts, progress)?;
                 let frame = (model.up.center, model.up.scale);
-                let d = super::dag::DagScene::new(&pipelines, &queue, &dag, frame)?;
+                let error = model.dag_errors(&dag);
+                let d = super::dag::DagScene::new(&pipelines, &queue, &dag, frame, error)?;
                 Ok(Box::new((d, Arc::new(dag))))
             },
             Done::Dag,

@@ -24,6 +24,8 @@ pub struct DagScene {
     clusters: Vec<crate::compute::types::CutCluster>,
     /// The device reads indirect first instances: the cut numbers each cluster's draw.
     pub numbered: bool,
+    /// Per cluster, the largest heatmap distance of its vertices (empty without distances).
+    cluster_error: Vec<f32>,
     center: [f64; 3],
     scale: f64,
 }
@@ -31,12 +33,14 @@ pub struct DagScene {
 impl DagScene {
     /// `dag` uploaded on the device of `pipelines`, in the normalized frame (`center`,
     /// `scale`) of its input, the first level, as its model draws it
-    /// ([`super::scene::Model::leaves_of`]).
+    /// ([`super::scene::Model::leaves_of`]); `error` is each vertex's distance to that level
+    /// for the heatmap ([`super::scene::Model::dag_errors`]; empty draws it all blue).
     pub fn new(
         pipelines: &Pipelines,
         queue: &wgpu::Queue,
         dag: &Dag,
         (center, scale): ([f64; 3], f64),
+        error: Vec<f32>,
     ) -> Result<DagScene> {
         let device = pipelines.device();
         let positions: Vec<[f32; 4]> = dag
@@ -50,8 +54,19 @@ impl DagScene {
             .collect();
         let indices: &[u32] = dag.mesh.triangles.as_flattened();
         let gpu = GpuMesh::from_arrays(device, &positions, indices, center, scale)?;
+        let cluster_error: Vec<f32> = match error.is_empty() {
+            true => Vec::new(),
+            false => dag
+                .clusters
+                .iter()
+                .map(|c| {
+                    let tris = dag.triangles(c).iter().flatten();
+                    tris.fold(0f32, |m, &v| m.max(error[v as usize]))
+                })
+                .collect(),
+        };
         let extras = Extras {
-            error: Vec::new(),
+            error,
             // Every level's faces around a vertex: they approximate one surface.
             normals: vertex_normals(&positions, indices),
             // Per corner, as a mesh's: the DAG's vertices carry the input's UVs and colours.
@@ -76,6 +91,7 @@ impl DagScene {
             numbered: device
                 .features()
                 .contains(wgpu::Features::INDIRECT_FIRST_INSTANCE),
+            cluster_error,
             center,
             scale,
         })
@@ -85,11 +101,33 @@ impl DagScene {
     /// (the panel's counts; the device's own are never read back while drawing): clusters in
     /// the cut, clusters drawn, triangles drawn.
     pub fn counts(&self, cam: &Camera, size: (u32, u32), pixels: f64) -> [u32; 4] {
+        self.host_cut(cam, size, pixels).1
+    }
+
+    /// The top of the heatmap for the cut of `cam`: the largest distance of a drawn cluster's
+    /// vertices, as a mesh's heatmap tops at its own largest (0 without distances).
+    pub fn heat_top(&self, cam: &Camera, size: (u32, u32), pixels: f64) -> f32 {
+        if self.cluster_error.is_empty() {
+            return 0.0;
+        }
+        let (draws, _) = self.host_cut(cam, size, pixels);
+        (draws.iter().zip(&self.cluster_error))
+            .filter(|(d, _)| d.instance_count > 0)
+            .fold(0f32, |m, (_, &e)| m.max(e))
+    }
+
+    /// The cut of `cam` by the stage's twin on the host: each cluster's draw, and the counts.
+    fn host_cut(
+        &self,
+        cam: &Camera,
+        size: (u32, u32),
+        pixels: f64,
+    ) -> (Vec<crate::compute::types::CornerDraw>, [u32; 4]) {
         let p = self.cut_params(cam, size, pixels);
         let mut draws = vec![crate::compute::types::CornerDraw::default(); self.clusters.len()];
         let mut counts = [0; 4];
         crate::dag::cut::dag_cut(&p, &self.clusters, &mut draws, &mut counts);
-        counts
+        (draws, counts)
     }
 
     /// The cut of `cam` at `pixels` on a `size` view, as `dag cut --camera` takes it: the eye

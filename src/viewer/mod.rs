@@ -181,7 +181,13 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
     let cam = eye.camera;
     if let Some((dag, pixels)) = dag {
         let frame = (model.up.center, model.up.scale);
-        let mut d = dag::DagScene::new(&ctx.pipelines, &ctx.queue, dag, frame)?;
+        // The heatmap's distances cost a query a vertex: made only for it.
+        let error = match style.mode {
+            Mode::Heatmap => model.dag_errors(dag),
+            _ => Vec::new(),
+        };
+        let mut d = dag::DagScene::new(&ctx.pipelines, &ctx.queue, dag, frame, error)?;
+        style.error_scale = d.heat_top(&cam, size, pixels);
         let p = d.cut_params(&cam, size, pixels);
         let target = render::Target::new(&ctx.device, size)?;
         let items = [(&d.scene, cam.model)];
@@ -212,7 +218,7 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
         return Ok(Frame {
             adapter: ctx.adapter_name.clone(),
             faces: dag.mesh.triangles.len(),
-            max_error: 0.0,
+            max_error: style.error_scale as f64,
             png: encode_png(&rgba, size)?,
             frame_seconds: seconds,
             triangles_drawn: counts[2] as usize,

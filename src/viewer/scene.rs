@@ -145,8 +145,8 @@ pub fn open(
         let mut model = Model::leaves_of(&dag, path.display().to_string())?;
         model.path = Some(path.to_path_buf());
         let original = model.original(device)?;
-        let d =
-            super::dag::DagScene::new(pipelines, queue, &dag, (model.up.center, model.up.scale))?;
+        let frame = (model.up.center, model.up.scale);
+        let d = super::dag::DagScene::new(pipelines, queue, &dag, frame, model.dag_errors(&dag))?;
         return Ok(Loaded {
             model,
             original,
@@ -350,6 +350,12 @@ impl Model {
 
     /// Each vertex's distance to the original surface, relative to the diagonal; `positions`
     /// are in the normalized frame.
+    /// Each vertex of `dag` (this model its first level), its distance to the model's surface
+    /// relative to the diagonal: the heatmap of a cut, as of a simplified mesh.
+    pub fn dag_errors(&self, dag: &crate::dag::Dag) -> Vec<f32> {
+        self.errors(&self.normalized(&dag.mesh))
+    }
+
     fn errors(&self, positions: &[[f32; 4]]) -> Vec<f32> {
         use rayon::prelude::*;
         let up = &self.up;

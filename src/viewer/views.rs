@@ -405,8 +405,13 @@ impl View3d {
                 .map(|d| d.lock().unwrap_or_else(|p| p.into_inner()));
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             if let Some(d) = dag.as_mut() {
-                let p = d.cut_params(camera, self.panes[k].target.size, self.pixels);
+                let size = self.panes[k].target.size;
+                let p = d.cut_params(camera, size, self.pixels);
                 d.cut.record(&mut enc, &p);
+                // The heatmap tops at the cut's own largest distance, as a result's at its own.
+                if self.style.mode == Mode::Heatmap {
+                    self.style.error_scale = d.heat_top(camera, size, self.pixels);
+                }
             }
             let items: Vec<(&SceneMesh, Mat4)> = match (&scene.lod, lod, &dag) {
                 (Some(levels), true, _) => self.lod_items(levels, camera),
