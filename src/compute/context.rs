@@ -210,6 +210,29 @@ pub fn check_buffer(limits: &wgpu::Limits, label: &str, size: u64) -> Result<()>
     Ok(())
 }
 
+/// Maps `buf` for reading and waits for the device until it is: the one round trip every
+/// read-back makes. Gives the outcome (what failed, in words) and the seconds spent blocked.
+pub fn map_and_wait(
+    device: &wgpu::Device,
+    buf: &wgpu::Buffer,
+) -> (std::result::Result<(), String>, f64) {
+    let t = std::time::Instant::now();
+    let (tx, rx) = std::sync::mpsc::channel();
+    buf.map_async(wgpu::MapMode::Read, .., move |r| {
+        let _ = tx.send(r);
+    });
+    let polled = device.poll(wgpu::PollType::wait_indefinitely());
+    let waited = t.elapsed().as_secs_f64();
+    let outcome = polled
+        .map_err(|e| format!("waiting for the device: {e}"))
+        .and_then(|_| {
+            rx.recv()
+                .map_err(|_| "the device dropped a read-back".to_string())?
+                .map_err(|e| format!("mapping a read-back buffer: {e}"))
+        });
+    (outcome, waited)
+}
+
 /// The first `bytes` of `buf` (a multiple of 4, `COPY_SRC`), copied to a staging buffer after
 /// the work already submitted and read with one wait; `doing` says what for in an error.
 pub fn read_back(
@@ -231,18 +254,9 @@ pub fn read_back(
         enc.copy_buffer_to_buffer(buf, 0, &staging, 0, bytes);
     }
     queue.submit([enc.finish()]);
-    let (tx, rx) = std::sync::mpsc::channel();
-    staging.map_async(wgpu::MapMode::Read, .., move |r| {
-        let _ = tx.send(r);
-    });
-    let read = device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| Error::Gpu(format!("{doing}: waiting for the device: {e}")))
-        .and_then(|_| {
-            rx.recv()
-                .map_err(|_| Error::Gpu(format!("{doing}: the device dropped a read-back")))?
-                .map_err(|e| Error::Gpu(format!("{doing}: mapping a read-back buffer: {e}")))
-        })
+    let read = map_and_wait(device, &staging)
+        .0
+        .map_err(|e| Error::Gpu(format!("{doing}: {e}")))
         .and_then(|()| {
             let view = staging
                 .get_mapped_range(..)

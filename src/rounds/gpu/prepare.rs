@@ -16,7 +16,6 @@ use crate::rounds::prepare::{
 };
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
-use std::time::Instant;
 
 /// What the preparation cost on the device's side, for the rounds' report (the counts of
 /// `rounds::gpu::Costs`).
@@ -314,19 +313,11 @@ pub fn prepare(
 /// Maps `buf` (submitted work copies into it) and reads its words: one round trip, counted
 /// with the time blocked and the bytes.
 fn read_mapped(device: &wgpu::Device, buf: &wgpu::Buffer, costs: &PrepCosts) -> Result<Vec<u32>> {
-    let t = Instant::now();
-    let (tx, rx) = std::sync::mpsc::channel();
-    buf.map_async(wgpu::MapMode::Read, .., move |r| {
-        let _ = tx.send(r);
-    });
-    let polled = device.poll(wgpu::PollType::wait_indefinitely());
+    let (outcome, waited) = crate::compute::context::map_and_wait(device, buf);
     add(&costs.waits, 1);
-    add(&costs.blocked_ns, t.elapsed().as_nanos() as u64);
+    add(&costs.blocked_ns, (waited * 1e9) as u64);
     add(&costs.read_back, buf.size());
-    polled.map_err(|e| Error::Gpu(format!("waiting for the device: {e}")))?;
-    rx.recv()
-        .map_err(|_| Error::Gpu("the device dropped a read-back".into()))?
-        .map_err(|e| Error::Gpu(format!("mapping a read-back buffer: {e}")))?;
+    outcome.map_err(Error::Gpu)?;
     let view = buf
         .get_mapped_range(..)
         .map_err(|e| Error::Gpu(format!("reading back: {e}")))?;

@@ -86,20 +86,10 @@ impl GpuRounds<'_> {
 
     /// Maps `buf` for reading and waits for it: one round trip, counted with its seconds.
     pub(super) fn map_wait(&self, buf: &wgpu::Buffer) -> Result<f64> {
-        let t = Instant::now();
-        let (tx, rx) = std::sync::mpsc::channel();
-        buf.map_async(wgpu::MapMode::Read, .., move |r| {
-            let _ = tx.send(r);
-        });
-        let dev = &self.sim.device;
-        let polled = dev.poll(wgpu::PollType::wait_indefinitely());
-        let waited = t.elapsed().as_secs_f64();
+        let (outcome, waited) = crate::compute::context::map_and_wait(&self.sim.device, buf);
         Costs::add(&self.costs.waits, 1);
         Costs::add(&self.costs.blocked_ns, (waited * 1e9) as u64);
-        polled.map_err(|e| Error::Gpu(format!("waiting for the device: {e}")))?;
-        rx.recv()
-            .map_err(|_| Error::Gpu("the device dropped a read-back".into()))?
-            .map_err(|e| Error::Gpu(format!("mapping a read-back buffer: {e}")))?;
+        outcome.map_err(Error::Gpu)?;
         Ok(waited)
     }
 
