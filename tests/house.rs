@@ -345,10 +345,11 @@ fn one_dispatch_and_one_owner_per_viewer_concern() {
 }
 
 /// A family is a folder: every stage in shaders/rounds/ and shaders/core/ has its CPU twin, a
-/// function of the stage's name, in src/rounds/cpu/ (the rounds' `cpu-parallel` backend, which
-/// also runs the core stages), every stage in shaders/cluster/ in tests/cluster_twins/ (the
-/// clustering's twins are test code), and every stage in shaders/dag/ in src/dag/; a family's runner (an `impl Runner` of the compute core)
-/// lives in its own folder.
+/// function of the stage's name, in the file of that name in src/rounds/cpu/ (the rounds'
+/// `cpu-parallel` backend, which also runs the core stages: one twin per file, as vello keeps
+/// one cpu/<stage>.rs per stage), every stage in shaders/cluster/ in tests/cluster_twins/ (the
+/// clustering's twins are test code), and every stage in shaders/dag/ in src/dag/; a family's
+/// runner (an `impl Runner` of the compute core) lives in its own folder.
 #[test]
 fn each_family_is_a_folder_with_a_twin_for_every_stage() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -376,11 +377,12 @@ fn each_family_is_a_folder_with_a_twin_for_every_stage() {
         })
     };
     let mut missing = Vec::new();
-    for (shaders, twins) in [
-        ("rounds", "src/rounds/cpu"),
-        ("core", "src/rounds/cpu"),
-        ("cluster", "tests/cluster_twins"),
-        ("dag", "src/dag"),
+    // (shaders, twins' folder, whether each twin has the file of its stage's name)
+    for (shaders, twins, own_file) in [
+        ("rounds", "src/rounds/cpu", true),
+        ("core", "src/rounds/cpu", true),
+        ("cluster", "tests/cluster_twins", false),
+        ("dag", "src/dag", false),
     ] {
         let twins_text = text_of(&root.join(twins));
         for entry in std::fs::read_dir(root.join("shaders").join(shaders)).unwrap() {
@@ -388,10 +390,36 @@ fn each_family_is_a_folder_with_a_twin_for_every_stage() {
             let Some(stage) = name.strip_suffix(".wgsl") else {
                 continue;
             };
-            if !stage.ends_with(".inc") && !defines(&twins_text, stage) {
+            if stage.ends_with(".inc") {
+                continue;
+            }
+            if own_file {
+                let file = root.join(twins).join(format!("{stage}.rs"));
+                let text = std::fs::read_to_string(&file).map(|t| code(&t));
+                if !text.is_ok_and(|t| defines(&t, stage)) {
+                    missing.push(format!(
+                        "shaders/{shaders}/{name}: no fn {stage} in {twins}/{stage}.rs"
+                    ));
+                }
+            } else if !defines(&twins_text, stage) {
                 missing.push(format!(
                     "shaders/{shaders}/{name}: no fn {stage} in {twins}/"
                 ));
+            }
+        }
+    }
+    // One twin per file: no file of src/rounds/cpu/ defines a second stage's function.
+    for entry in std::fs::read_dir(root.join("src/rounds/cpu")).unwrap() {
+        let path = entry.unwrap().path();
+        let own = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let text = code(&std::fs::read_to_string(&path).unwrap());
+        for shaders in ["rounds", "core"] {
+            for e in std::fs::read_dir(root.join("shaders").join(shaders)).unwrap() {
+                let name = e.unwrap().file_name().to_string_lossy().into_owned();
+                let stage = name.trim_end_matches(".wgsl");
+                if stage != own && !stage.ends_with(".inc") && defines(&text, stage) {
+                    missing.push(format!("src/rounds/cpu/{own}.rs defines {stage}'s twin"));
+                }
             }
         }
     }

@@ -281,7 +281,7 @@ mod tests {
     /// index out of step would not fail to compile, only make the backends disagree.
     #[test]
     fn wgsl_constants_match_their_rust_twins() {
-        use crate::rounds::cpu::edge_costs::CounterField as C;
+        use crate::rounds::cpu::counters::CounterField as C;
         let module = parse("draw_args", &stage_source("rounds/draw_args").unwrap());
         let value = |name: &str| u32_constant(&module, "common.wgsl", name);
         let pairs = [

@@ -1,12 +1,12 @@
-//! Twin of shaders/rounds/collapse.wgsl: each winner moves its survivor to the new position, gives it
-//! the sum of both quadrics (re-centred on the new position) and the removed vertex's border
+//! Twin of shaders/rounds/collapse.wgsl: each winner moves its survivor to the new position, gives
+//! it the sum of both quadrics (re-centred on the new position) and the removed vertex's border
 //! bit, and points the removed vertex at the survivor; when the survivor is a seam vertex, the
-//! removed vertex's corners take their attribute vertices by the seam rule `edge_errors`
-//! checked. With appearance channels, the removed vertex's sides' attribute sums join those of
-//! the survivor's sides they map to, and a survivor that moves takes the values best for the
-//! merged sums at its new place (Hoppe 1999), kept valid: colours in 0..1, UVs within the two
-//! ends' range. Winners share no face, hence no vertex (and each attribute vertex belongs to
-//! one vertex), so these writes never meet.
+//! removed vertex's corners take their attribute vertices by the seam rule `edge_errors` checked.
+//! With appearance channels, the removed vertex's sides' attribute sums join those of the
+//! survivor's sides they map to, and a survivor that moves takes the values best for the merged
+//! sums at its new place (Hoppe 1999), kept valid: colours in 0..1, UVs within the two ends' range.
+//! Winners share no face, hence no vertex (and each attribute vertex belongs to one vertex), so
+//! these writes never meet.
 
 use super::attributes::Channels;
 use super::{Scatter, corner_on, face_of, faces_of, par_for};

@@ -3,7 +3,7 @@
 //! `ceiling_wanted` candidates lie. Keeps each round's collapses among the cheapest edges, so
 //! the order stays close to the greedy one.
 
-use super::edge_costs::{CounterField, counter};
+use super::counters::{CounterField, counter};
 use crate::compute::types::{HIST_BINS, HIST_SHIFT, INVALID_COST, Params};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 

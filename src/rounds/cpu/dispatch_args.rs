@@ -1,9 +1,9 @@
-//! Twin of shaders/rounds/dispatch_args.wgsl: the indirect dispatch sizes of the per-edge stages, of
-//! `validate`, of the per-candidate stages and of the trim's per-edge stages (zero unless the
+//! Twin of shaders/rounds/dispatch_args.wgsl: the indirect dispatch sizes of the per-edge stages,
+//! of `validate`, of the per-candidate stages and of the trim's per-edge stages (zero unless the
 //! round trims). The CPU runs loops of the exact length; this twin exists so tests can diff the GPU
 //! stage.
 
-use super::edge_costs::{CounterField, counter};
+use super::counters::{CounterField, counter};
 use crate::compute::types::{Params, WG};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 

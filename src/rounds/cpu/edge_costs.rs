@@ -1,16 +1,17 @@
-//! Twin of shaders/rounds/edge_costs.wgsl: for the candidates whose error (`edge_errors`) is under the
-//! round's cost ceiling, the faces that move: no normal may turn past the angle limit (against
-//! the current and the input normal), no needle may appear, and the worst new quality scales
-//! the error up to the priority the selection ranks by (MeshLab-style). The ceiling picks the
-//! edges that compete by their error; the priority orders them. Edges over the ceiling dropped
-//! out unchecked (`live_list`): on the 1M scan at 1%, checking the moved faces of every edge was half the run.
-//! The topological checks (link condition, border pinch, lone triangle, tetrahedral fold) scan
-//! both endpoints' neighbourhoods and rarely fail on a manifold, so they run in `validate`,
+//! Twin of shaders/rounds/edge_costs.wgsl: for the candidates whose error (`edge_errors`) is under
+//! the round's cost ceiling, the faces that move: no normal may turn past the angle limit (against
+//! the current and the input normal), no needle may appear, and the worst new quality scales the
+//! error up to the priority the selection ranks by (MeshLab-style). The ceiling picks the edges
+//! that compete by their error; the priority orders them. Edges over the ceiling dropped out
+//! unchecked (`live_list`): on the 1M scan at 1%, checking the moved faces of every edge was half
+//! the run. The topological checks (link condition, border pinch, lone triangle, tetrahedral fold)
+//! scan both endpoints' neighbourhoods and rarely fail on a manifold, so they run in `validate`,
 //! only for the edges that win a selection pass.
 
+use super::counters::{CounterField, counter};
 use super::{Scatter, face_of, faces_of, par_for};
 use crate::compute::common::*;
-use crate::compute::types::{Counters, EdgeCandidate, Params, state};
+use crate::compute::types::{EdgeCandidate, Params, state};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// The priority of collapsing `c` (its error, as `edge_errors` wrote it, scaled by the worst
@@ -125,29 +126,4 @@ pub(crate) fn edge_costs(
             }
         }
     });
-}
-
-/// Fields of [`Counters`] by position, for the atomic view of the buffer.
-#[derive(Clone, Copy)]
-pub enum CounterField {
-    Candidates = 0,
-    OverMaxError = 1,
-    Ceiling = 2,
-    Winners = 3,
-    Removed = 4,
-    MaxErr2Bits = 5,
-    TrimBin = 6,
-    TrimBudget = 7,
-    VerticesOut = 8,
-    FacesOut = 9,
-    Tentative = 10,
-    Live = 11,
-    OpenGroups = 12,
-    OpenExcess = 13,
-    OpenFaces = 14,
-}
-
-pub fn counter(counters: &[AtomicU32], f: CounterField) -> &AtomicU32 {
-    const _: () = assert!(std::mem::size_of::<Counters>() == 16 * 4);
-    &counters[f as usize]
 }

@@ -8,7 +8,7 @@
 //! the same faces).
 
 use super::attributes::Channels;
-use super::edge_costs::{CounterField, counter};
+use super::counters::{CounterField, counter};
 use super::{corner_attr, face_of, faces_of};
 use crate::compute::common::*;
 use crate::compute::types::{

@@ -1,9 +1,9 @@
-//! Twin of shaders/rounds/live_list.wgsl: the candidates whose error is under the round's cost ceiling
-//! go on the live list, the others drop out; `edge_costs` and the selection passes then run
-//! over the list instead of every edge. The GPU lists in an order that depends on timing, the
-//! CPU in edge order; no stage's result depends on it (each writes its own edge's slots).
+//! Twin of shaders/rounds/live_list.wgsl: the candidates whose error is under the round's cost
+//! ceiling go on the live list, the others drop out; `edge_costs` and the selection passes then run
+//! over the list instead of every edge. The GPU lists in an order that depends on timing, the CPU
+//! in edge order; no stage's result depends on it (each writes its own edge's slots).
 
-use super::edge_costs::{CounterField, counter};
+use super::counters::{CounterField, counter};
 use crate::compute::types::{EdgeCandidate, Params, state};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};

@@ -1,34 +1,58 @@
 //! Backend `cpu-parallel`: the GPU's rounds, stage for stage, on the CPU with rayon.
 //!
-//! Each file here is the twin of the WGSL stage of the same name in `shaders/` (a family of
-//! stages shares a file: `adjacency_count`, `adjacency_fill` and `adjacency_sort` live in
-//! adjacency.rs). A stage takes the same buffers in the same order as the shader binds them, as
+//! Each stage's twin is the file of its name: shaders/rounds/X.wgsl and shaders/core/X.wgsl
+//! have theirs in X.rs, the first of a family's files telling the family whole (trim_histogram.rs
+//! the trim, compact_mark.rs the compaction); what several twins share is in select.rs,
+//! counters.rs and this file, the preparation's driver in prepare.rs. A stage takes the same buffers in the same order as the shader binds them, as
 //! slices, and is written as a loop over invocation ids so that it reads like the shader. It
 //! validates every GPU pass (tests diff the buffers) and is the fair CPU side of the CPU-vs-GPU
 //! comparison.
 
-pub mod adjacency;
+pub mod adjacency_count;
+pub mod adjacency_fill;
+pub mod adjacency_sort;
 pub mod attributes;
+pub mod class_rank;
 pub mod collapse;
-pub mod compact;
+pub mod compact_faces;
+pub mod compact_mark;
+pub mod compact_vertices;
 pub mod cost_ceiling;
+pub mod counters;
 pub mod dispatch_args;
+pub mod draw_args;
 pub mod edge_costs;
 pub mod edge_errors;
-pub mod edges;
+pub mod edges_count;
+pub mod edges_fill;
+pub mod face_keys;
 pub mod face_planes;
-pub mod groups;
+pub mod group_errors;
+pub mod group_faces;
+pub mod group_flags;
+pub mod group_open;
 pub mod live_list;
+pub mod morton_keys;
 pub mod plan_round;
 pub mod prefix_sum;
+pub mod prep_faces;
+pub mod prep_vertices;
 pub mod prepare;
 pub mod select;
-pub mod trim;
+pub mod select_cost;
+pub mod select_id;
+pub mod select_win;
+pub mod trim_apply;
+pub mod trim_ceiling;
+pub mod trim_histogram;
+pub mod trim_mark;
 mod twins;
 pub mod validate;
 pub mod vertex_attributes;
 pub mod vertex_flags;
 pub mod vertex_quadrics;
+pub mod weld_insert;
+pub mod weld_resolve;
 
 use crate::compute::schedule::Step as S;
 use crate::compute::types::*;
@@ -36,7 +60,7 @@ use crate::error::{Error, Result};
 use crate::options::{Blocked, SimplifyOptions};
 use crate::rounds::schedule::{self, Buf, RoundStep, Stage, Step, When};
 use crate::rounds::{Download, RoundRunner, Selection, StageTimes, Upload};
-use edge_costs::CounterField;
+use counters::CounterField;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 use std::sync::atomic::AtomicU32;

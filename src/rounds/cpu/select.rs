@@ -1,21 +1,21 @@
-//! Twins of shaders/rounds/select_cost.wgsl, select_id.wgsl and select_win.wgsl: one pass of the
-//! independent-set selection, one invocation per candidate on the live list. An edge wins when its key (cost bits, then edge id) is the
-//! smallest over every candidate touching any face around either endpoint: 32-bit atomicMax of
-//! inverted keys per face, first on the cost, then on a hash of the id among equal costs (64-bit atomics
-//! are not portable). Two winners then share no face, so the checks each passed in
-//! `validate` stay true when both collapse. The pass's winners are TENTATIVE until `validate`
-//! checks them; confirmed winners lock the vertices of their faces (`validate`); a candidate at a
-//! locked vertex touches a winner's face and drops out at the next pass, and the others compete
-//! again (Luby-style).
+//! The independent-set selection, shared by its three stages' twins (select_cost.rs, select_id.rs,
+//! select_win.rs), and the check its winners pass before they collapse ([`shared_face`]). One pass
+//! of the selection: one invocation per candidate on the live list. An edge wins when its key (cost
+//! bits, then edge id) is the smallest over every candidate touching any face around either
+//! endpoint: 32-bit atomicMax of inverted keys per face, first on the cost, then on a hash of the
+//! id among equal costs (64-bit atomics are not portable). Two winners then share no face, so the
+//! checks each passed in `validate` stay true when both collapse. The pass's winners are TENTATIVE
+//! until `validate` checks them; confirmed winners lock the vertices of their faces (`validate`); a
+//! candidate at a locked vertex touches a winner's face and drops out at the next pass, and the
+//! others compete again (Luby-style).
 
-use super::edge_costs::{CounterField, counter};
-use super::{Scatter, faces_of, par_for};
-use crate::compute::common::tie_rank;
-use crate::compute::types::{EdgeCandidate, state};
+use super::counters::{CounterField, counter};
+use super::{faces_of, par_for};
+use crate::compute::types::state;
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// Faces around either endpoint of edge `e` (those on the edge come twice, harmlessly).
-fn around<'a>(
+pub(super) fn around<'a>(
     offsets: &[u32],
     vertex_faces: &'a [u32],
     e: [u32; 2],
@@ -26,120 +26,13 @@ fn around<'a>(
 }
 
 /// Invocations of the passes: one per candidate on the live list.
-fn live_count(counters: &[AtomicU32]) -> u32 {
+pub(super) fn live_count(counters: &[AtomicU32]) -> u32 {
     counter(counters, CounterField::Live).load(Relaxed)
-}
-
-#[allow(clippy::too_many_arguments)]
-pub fn select_cost(
-    offsets: &[u32],
-    vertex_faces: &[u32],
-    edges: &[[u32; 2]],
-    live: &[u32], // per listed candidate
-    candidates: &[EdgeCandidate],
-    vertex_lock: &[AtomicU32], // per vertex
-    counters: &[AtomicU32],
-    edge_state: &[AtomicU32], // per edge
-    face_best: &[AtomicU32],  // per face, cleared
-) {
-    par_for(live_count(counters), |i| {
-        let e = live[i as usize] as usize;
-        if edge_state[e].load(Relaxed) != state::CANDIDATE {
-            return;
-        }
-        let c = &candidates[e];
-        // At a vertex of a face around an earlier winner: it touches that face.
-        if edges[e]
-            .iter()
-            .any(|&v| vertex_lock[v as usize].load(Relaxed) != 0)
-        {
-            edge_state[e].store(state::OUT, Relaxed);
-            return;
-        }
-        let inv = !c.cost_bits;
-        for f in around(offsets, vertex_faces, edges[e]) {
-            // The atomic read-modify-write only where it can raise the value: max is
-            // idempotent, and most faces already hold a key at least as good.
-            let slot = &face_best[f as usize];
-            if slot.load(Relaxed) < inv {
-                slot.fetch_max(inv, Relaxed);
-            }
-        }
-    });
-}
-
-#[allow(clippy::too_many_arguments)]
-pub fn select_id(
-    offsets: &[u32],
-    vertex_faces: &[u32],
-    edges: &[[u32; 2]],
-    live: &[u32], // per listed candidate
-    candidates: &[EdgeCandidate],
-    face_best: &[AtomicU32],
-    counters: &[AtomicU32],
-    edge_state: &[AtomicU32],
-    face_id: &[AtomicU32], // per face, cleared
-) {
-    par_for(live_count(counters), |i| {
-        let e = live[i as usize];
-        let eu = e as usize;
-        if edge_state[eu].load(Relaxed) != state::CANDIDATE {
-            return;
-        }
-        let inv = !candidates[eu].cost_bits;
-        // Only an edge with the best cost at every face around it can win; the others need not
-        // post their rank (a winner is still the only one best at each of its faces).
-        if !around(offsets, vertex_faces, edges[eu])
-            .all(|f| face_best[f as usize].load(Relaxed) == inv)
-        {
-            return;
-        }
-        let rank = !tie_rank(e);
-        for f in around(offsets, vertex_faces, edges[eu]) {
-            let slot = &face_id[f as usize];
-            if slot.load(Relaxed) < rank {
-                slot.fetch_max(rank, Relaxed);
-            }
-        }
-        edge_state[eu].store(state::POSTED, Relaxed);
-    });
-}
-
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn select_win(
-    offsets: &[u32],
-    vertex_faces: &[u32],
-    edges: &[[u32; 2]],
-    live: &[u32],          // per listed candidate
-    face_id: &[AtomicU32], // per face
-    edge_state: &[AtomicU32],
-    tentative: Scatter<u32>, // per winner of the pass
-    counters: &[AtomicU32],
-) {
-    par_for(live_count(counters), |i| {
-        let e = live[i as usize];
-        let eu = e as usize;
-        // Posters alone: every other candidate failed select_id's cost test already.
-        if edge_state[eu].load(Relaxed) != state::POSTED {
-            return;
-        }
-        let rank = !tie_rank(e);
-        let wins = around(offsets, vertex_faces, edges[eu])
-            .all(|f| face_id[f as usize].load(Relaxed) == rank);
-        if !wins {
-            edge_state[eu].store(state::CANDIDATE, Relaxed);
-            return;
-        }
-        edge_state[eu].store(state::TENTATIVE, Relaxed);
-        let slot = counter(counters, CounterField::Tentative).fetch_add(1, Relaxed);
-        // SAFETY: the atomic counter hands out each slot once.
-        unsafe { tentative.write(slot as usize, e) };
-    });
 }
 
 /// A face two of the round's winners (`state::WON`) both reach, with those two winners: the
 /// promise `collapse` rests on broken. `collapse` writes every winner's vertices and faces
-/// through a [`Scatter`] without synchronisation, which is sound only if each face is around
+/// through a [`Scatter`](super::Scatter) without synchronisation, which is sound only if each face is around
 /// at most one winner's endpoints; so every round checks it, in release builds too, before
 /// `collapse` runs (parallel, into `owner`, one word per face; the cost is measured in
 /// docs/PERFORMANCE.md). `None` when the winners share no face.

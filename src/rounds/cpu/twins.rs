@@ -16,12 +16,12 @@ fn counts(p: &Params) -> (usize, usize) {
 /// never by its entry point's name; `tests::every_stage_has_one_twin` checks the list.
 pub(super) static TWINS: &[(&Stage, Twin)] = &[
     (&schedule::ADJACENCY_COUNT, |s, p| {
-        adjacency::adjacency_count(p, &s.indices, atomics(&mut s.offsets))
+        adjacency_count::adjacency_count(p, &s.indices, atomics(&mut s.offsets))
     }),
     (&schedule::ADJACENCY_FILL, |s, p| {
         let nf = counts(p).1;
         s.vertex_faces.resize(3 * nf, 0);
-        adjacency::adjacency_fill(
+        adjacency_fill::adjacency_fill(
             p,
             &s.indices,
             &s.offsets,
@@ -30,7 +30,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         )
     }),
     (&schedule::ADJACENCY_SORT, |s, p| {
-        adjacency::adjacency_sort(p, &s.offsets, Scatter::new(&mut s.vertex_faces))
+        adjacency_sort::adjacency_sort(p, &s.offsets, Scatter::new(&mut s.vertex_faces))
     }),
     (&schedule::FACE_PLANES, |s, p| {
         face_planes::face_planes(p, &s.positions, &s.indices, &mut s.face_normals)
@@ -69,7 +69,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         reset(&mut s.edge_offsets, nv + 1);
         s.remap.resize(nv, 0);
         s.neighbours.resize(2 * s.vertex_faces.len(), 0);
-        edges::edges_count(
+        edges_count::edges_count(
             p,
             &s.indices,
             &s.offsets,
@@ -82,7 +82,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
     (&schedule::EDGES_FILL, |s, p| {
         let nv = counts(p).0;
         s.edges.resize(s.edge_offsets[nv] as usize, [0; 2]);
-        edges::edges_fill(
+        edges_fill::edges_fill(
             p,
             &s.offsets,
             &s.neighbours,
@@ -152,7 +152,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         )
     }),
     (&schedule::SELECT_COST, |s, _| {
-        select::select_cost(
+        select_cost::select_cost(
             &s.offsets,
             &s.vertex_faces,
             &s.edges,
@@ -165,7 +165,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         )
     }),
     (&schedule::SELECT_ID, |s, _| {
-        select::select_id(
+        select_id::select_id(
             &s.offsets,
             &s.vertex_faces,
             &s.edges,
@@ -178,7 +178,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         )
     }),
     (&schedule::SELECT_WIN, |s, _| {
-        select::select_win(
+        select_win::select_win(
             &s.offsets,
             &s.vertex_faces,
             &s.edges,
@@ -205,7 +205,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         )
     }),
     (&schedule::TRIM_HISTOGRAM, |s, p| {
-        trim::trim_histogram(
+        trim_histogram::trim_histogram(
             p,
             &s.candidates,
             &s.edge_state,
@@ -214,11 +214,11 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         )
     }),
     (&schedule::TRIM_CEILING, |s, p| {
-        trim::trim_ceiling(p, &s.trim_histogram, atomics(&mut s.counters))
+        trim_ceiling::trim_ceiling(p, &s.trim_histogram, atomics(&mut s.counters))
     }),
     (&schedule::TRIM_MARK, |s, p| {
         reset(&mut s.marks, p.edge_capacity as usize + 1);
-        trim::trim_mark(
+        trim_mark::trim_mark(
             p,
             &s.candidates,
             &s.edge_state,
@@ -228,7 +228,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         )
     }),
     (&schedule::TRIM_APPLY, |s, p| {
-        trim::trim_apply(
+        trim_apply::trim_apply(
             p,
             &s.candidates,
             &s.marks,
@@ -260,7 +260,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         let (nv, nf) = counts(p);
         reset(&mut s.vertex_keep, nv + 1);
         reset(&mut s.face_keep, nf + 1);
-        compact::compact_mark(
+        compact_mark::compact_mark(
             p,
             &s.indices,
             &s.remap,
@@ -275,7 +275,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         s.out_quadrics.resize(nv2, Quadric::default());
         s.out_flags.resize(nv2, 0);
         s.out_vertex_attr.resize(nv2, 0);
-        compact::compact_vertices(
+        compact_vertices::compact_vertices(
             p,
             &s.vertex_keep,
             &s.positions,
@@ -294,7 +294,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         s.out_indices.resize(3 * nf2, 0);
         s.out_face_normals.resize(nf2, [0.0; 4]);
         s.out_face_extra.resize(nf2, FaceExtra::default());
-        compact::compact_faces(
+        compact_faces::compact_faces(
             p,
             &s.indices,
             &s.face_normals,
@@ -309,7 +309,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
     }),
     (&schedule::DRAW_ARGS, |s, p| {
         let mut draw = DrawArgs::default();
-        compact::draw_args(
+        draw_args::draw_args(
             p,
             &s.vertex_keep,
             &s.face_keep,
@@ -323,7 +323,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         plan_round::plan_round(p, &c, &mut s.plan, &mut s.planned, &mut s.dispatch)
     }),
     (&schedule::GROUP_FLAGS, |s, p| {
-        groups::group_flags(
+        group_flags::group_flags(
             p,
             &s.offsets,
             &s.vertex_faces,
@@ -334,7 +334,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         )
     }),
     (&schedule::GROUP_ERRORS, |s, p| {
-        groups::group_errors(
+        group_errors::group_errors(
             p,
             &s.candidates,
             &s.edge_state,
@@ -347,7 +347,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         )
     }),
     (&schedule::GROUP_FACES, |s, p| {
-        groups::group_faces(
+        group_faces::group_faces(
             p,
             &s.face_keep,
             &s.out_face_extra,
@@ -356,7 +356,7 @@ pub(super) static TWINS: &[(&Stage, Twin)] = &[
         )
     }),
     (&schedule::GROUP_OPEN, |s, p| {
-        groups::group_open(
+        group_open::group_open(
             p,
             &s.group_target,
             &mut s.group_count,

@@ -1,10 +1,11 @@
 //! Twin of shaders/rounds/validate.wgsl: the edges a selection pass picked (TENTATIVE) get the
-//! topological checks of the greedy reference — link condition, no border pinch, no lone
-//! triangle, no tetrahedral fold. Those that fail drop out; the rest win and lock every vertex of
-//! the faces around them (see `select`). Tentative winners share no face, so their checks cannot interfere. Checking only
-//! the winners instead of every edge every round saves the costliest scans of `edge_costs`.
+//! topological checks of the greedy reference — link condition, no border pinch, no lone triangle,
+//! no tetrahedral fold. Those that fail drop out; the rest win and lock every vertex of the faces
+//! around them (see `select`). Tentative winners share no face, so their checks cannot interfere.
+//! Checking only the winners instead of every edge every round saves the costliest scans of
+//! `edge_costs`.
 
-use super::edge_costs::{CounterField, counter};
+use super::counters::{CounterField, counter};
 use super::vertex_flags::count_containing;
 use super::{Scatter, face_of, faces_of, par_for};
 use crate::compute::types::{EdgeCandidate, Params, flag, state};

@@ -1,9 +1,9 @@
-//! Twin of shaders/rounds/vertex_quadrics.wgsl (first round): each vertex gathers the area-weighted plane
-//! quadrics of its faces and, for each border edge at it, Hoppe's constraint plane through the
-//! edge perpendicular to its face, weighted by the squared edge length; likewise for each
-//! attribute-seam edge (its two faces use different attribute vertices at an end), perpendicular
-//! to their mean normal, as the greedy reference does. A gather in the sorted face order, so the
-//! sums do not depend on thread timing. Quadrics are relative to the vertex.
+//! Twin of shaders/rounds/vertex_quadrics.wgsl (first round): each vertex gathers the area-weighted
+//! plane quadrics of its faces and, for each border edge at it, Hoppe's constraint plane through
+//! the edge perpendicular to its face, weighted by the squared edge length; likewise for each
+//! attribute-seam edge (its two faces use different attribute vertices at an end), perpendicular to
+//! their mean normal, as the greedy reference does. A gather in the sorted face order, so the sums
+//! do not depend on thread timing. Quadrics are relative to the vertex.
 
 use super::{corner_attr, face_of, faces_of, par_for_mut};
 use crate::compute::common::{

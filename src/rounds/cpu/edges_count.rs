@@ -1,9 +1,9 @@
-//! Twins of shaders/rounds/edges_count.wgsl and edges_fill.wgsl: the unique edges (a, b), a < b, of
-//! the current faces. Each vertex lists its higher-id neighbours in the order of its sorted face
-//! list (first occurrence), so edge ids are the same on every run and on CPU and GPU.
-//! `edges_count` enumerates them once into two slots per corner of the vertex's list (a face adds
-//! at most two neighbours), and `edges_fill` copies them to the scanned offsets: enumerating
-//! twice cost 1.8 s of lavapipe time on the 1M scan.
+//! Twin of shaders/rounds/edges_count.wgsl, the first of the edge list's two stages (then
+//! edges_fill.rs). The unique edges (a, b), a < b, of the current faces. Each vertex lists its
+//! higher-id neighbours in the order of its sorted face list (first occurrence), so edge ids are
+//! the same on every run and on CPU and GPU. `edges_count` enumerates them once into two slots per
+//! corner of the vertex's list (a face adds at most two neighbours), and `edges_fill` copies them
+//! to the scanned offsets: enumerating twice cost 1.8 s of lavapipe time on the 1M scan.
 
 use super::{Scatter, face_of, faces_of, par_for};
 use crate::compute::types::Params;
@@ -49,25 +49,6 @@ pub(crate) fn edges_count(
         unsafe {
             edge_counts.write(v as usize, n as u32);
             remap.write(v as usize, v);
-        }
-    });
-}
-
-/// Per vertex: copies its listed neighbours to its scanned edge offset.
-pub(crate) fn edges_fill(
-    params: &Params,
-    offsets: &[u32],          // per vertex + 1
-    neighbours: &[u32],       // 2 per corner
-    edge_offsets: &[u32],     // per vertex + 1 (scanned counts)
-    edges: Scatter<[u32; 2]>, // per edge
-) {
-    par_for(params.vertex_count, |v| {
-        let (lo, hi) = (edge_offsets[v as usize], edge_offsets[v as usize + 1]);
-        let base = 2 * offsets[v as usize];
-        for i in 0..hi - lo {
-            // SAFETY: vertex v owns slots [edge_offsets[v], edge_offsets[v+1]), disjoint from
-            // every other vertex's, and writes each once.
-            unsafe { edges.write((lo + i) as usize, [v, neighbours[(base + i) as usize]]) };
         }
     });
 }
