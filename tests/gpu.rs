@@ -9,7 +9,7 @@ use meshslim::compute::common::{length, sub, xyz};
 use meshslim::compute::types::*;
 use meshslim::options::AttributeWeights;
 use meshslim::rounds::cpu::CpuRounds;
-use meshslim::rounds::cpu::edge_costs::CounterField;
+use meshslim::rounds::cpu::counters::CounterField;
 use meshslim::rounds::gpu::{GpuRounds, GpuSimplifier};
 use meshslim::rounds::schedule::Buf;
 use meshslim::rounds::{RoundRunner, SELECTION_PASSES, Selection, Upload};

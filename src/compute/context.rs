@@ -3,6 +3,16 @@
 
 use crate::error::{Error, Result};
 
+/// The usage of a working buffer of the stages: read and written by shaders, filled and read
+/// back by copies.
+pub const STORAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
+    .union(wgpu::BufferUsages::COPY_DST)
+    .union(wgpu::BufferUsages::COPY_SRC);
+
+/// The usage of a stage's uniform parameters, written by the host.
+pub const UNIFORM: wgpu::BufferUsages =
+    wgpu::BufferUsages::UNIFORM.union(wgpu::BufferUsages::COPY_DST);
+
 /// A device and queue the simplifier (and a viewer) use.
 pub struct GpuContext {
     pub device: wgpu::Device,

@@ -1,7 +1,7 @@
 //! Grouped rounds ([`crate::compute::types::Params::groups`]): every group of faces
 //! simplified in one run, each to its own target — a level of the cluster DAG (`crate::dag`),
 //! the vertices groups share pinned. The stages are `group_flags`, `group_errors`,
-//! `group_faces` and `group_open` (`cpu::groups` holds their twins).
+//! `group_faces` and `group_open` (their twins are the files of those names in `cpu`).
 
 use super::{SELECTION_PASSES, Upload, cpu, drive, gpu};
 use crate::error::Result;
@@ -56,7 +56,7 @@ impl Upload {
         };
         let mut closed = vec![0u32; targets.len()];
         let mut counters = [0u32; 16];
-        cpu::groups::group_open(
+        cpu::group_open::group_open(
             &params,
             &targets,
             &mut count,

@@ -2,6 +2,7 @@
 //! shaders/rounds/ hold one file per stage; `rounds::cpu` holds their twins), on the process's
 //! device ([`shared`]) or a caller's.
 
+pub mod costs;
 pub mod prepare;
 pub mod simplifier;
 

@@ -3,6 +3,8 @@
 //! one read-back brings the counts the rounds' uniforms need. Recorded in one command buffer,
 //! the sorts' passes included (a uniform per pass, as the clustering's).
 
+use super::costs::Costs;
+use crate::compute::context::STORAGE;
 use crate::compute::context::{checked_buffer, checked_buffer_write};
 use crate::compute::gpu::{ErrorScope, Groups, Kernels};
 use crate::compute::types::{
@@ -15,28 +17,6 @@ use crate::rounds::prepare::{
     VERTEX_SORT_PASSES, WELD, face_sort_passes, sort_blocks,
 };
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
-
-/// What the preparation cost on the device's side, for the rounds' report (the counts of
-/// `rounds::gpu::Costs`).
-#[derive(Debug, Default)]
-pub struct PrepCosts {
-    pub waits: AtomicU64,
-    pub submits: AtomicU64,
-    pub dispatches: AtomicU64,
-    pub bind_groups: AtomicU64,
-    pub uploaded: AtomicU64,
-    pub read_back: AtomicU64,
-    pub blocked_ns: AtomicU64,
-}
-
-fn add(counter: &AtomicU64, n: u64) {
-    counter.fetch_add(n, Relaxed);
-}
-
-const SU: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
-    .union(wgpu::BufferUsages::COPY_DST)
-    .union(wgpu::BufferUsages::COPY_SRC);
 
 /// The rounds' first half as the preparation wrote it, and its counts.
 pub struct DevicePrepared {
@@ -55,7 +35,7 @@ pub struct DevicePrepared {
 struct GpuPrepare<'a> {
     device: &'a wgpu::Device,
     kernels: &'a Kernels,
-    costs: &'a PrepCosts,
+    costs: &'a Costs,
     bufs: HashMap<PBuf, wgpu::Buffer>,
     /// The sort's (keys, values) halves; `cur` is the one a pass reads.
     halves: [[wgpu::Buffer; 2]; 2],
@@ -142,7 +122,7 @@ impl crate::compute::gpu::Runner<PBuf, PGrid, PCount, std::convert::Infallible> 
             PGrid::ScanBlocks => scan.map_or(0, |s| self.count(s.0)).div_ceil(SCAN_BLOCK),
             PGrid::One => 1,
         };
-        add(&self.costs.dispatches, 1);
+        Costs::add(&self.costs.dispatches, 1);
         let bound = stage
             .bindings
             .iter()
@@ -150,7 +130,7 @@ impl crate::compute::gpu::Runner<PBuf, PGrid, PCount, std::convert::Infallible> 
             .collect();
         let key = (stage.entry, bound);
         if !self.bind_groups.contains_key(&key) {
-            add(&self.costs.bind_groups, 1);
+            Costs::add(&self.costs.bind_groups, 1);
             let bg = self
                 .kernels
                 .bind_group(self.device, stage, |b| self.buffer(b, scan));
@@ -179,7 +159,7 @@ pub fn prepare(
     kernels: &Kernels,
     mesh: &Mesh,
     p: &PrepParams,
-    costs: &PrepCosts,
+    costs: &Costs,
     mesh_usage: wgpu::BufferUsages,
 ) -> Result<DevicePrepared> {
     let scope = ErrorScope::push(dev);
@@ -189,7 +169,7 @@ pub fn prepare(
         checked_buffer(dev, &format!("meshslim.prep.{label}"), size, usage)
     };
     let init = |label: &str, data: &[u8], usage: wgpu::BufferUsages| {
-        add(&costs.uploaded, data.len() as u64);
+        Costs::add(&costs.uploaded, data.len() as u64);
         let label = format!("meshslim.prep.{label}");
         checked_buffer_write(dev, queue, &label, data, usage)
     };
@@ -217,17 +197,21 @@ pub fn prepare(
             m1 * std::mem::size_of::<FaceExtra>() as u64,
         ),
     ] {
-        bufs.insert(buf, mk(&format!("{buf:?}"), size, SU)?);
+        bufs.insert(buf, mk(&format!("{buf:?}"), size, STORAGE)?);
     }
     bufs.insert(PBuf::Positions, mk("positions", n1 * 16, mesh_usage)?);
     bufs.insert(PBuf::Indices, mk("indices", m1 * 12, mesh_usage)?);
     bufs.insert(
         PBuf::InPositions,
-        init("in_positions", bytemuck::cast_slice(&mesh.positions), SU)?,
+        init(
+            "in_positions",
+            bytemuck::cast_slice(&mesh.positions),
+            STORAGE,
+        )?,
     );
     bufs.insert(
         PBuf::InIndices,
-        init("in_indices", bytemuck::cast_slice(&mesh.triangles), SU)?,
+        init("in_indices", bytemuck::cast_slice(&mesh.triangles), STORAGE)?,
     );
     bufs.insert(PBuf::Prep, init("params", bytemuck::bytes_of(p), uniform)?);
     let face_passes = face_sort_passes(n);
@@ -254,8 +238,8 @@ pub fn prepare(
     let digit_counts = [scan(256 * sort_blocks(n)), scan(256 * sort_blocks(m))];
     let half = |label: &str| -> Result<[wgpu::Buffer; 2]> {
         Ok([
-            mk(&format!("sort_keys{label}"), sorted * 4, SU)?,
-            mk(&format!("sort_vals{label}"), sorted * 4, SU)?,
+            mk(&format!("sort_keys{label}"), sorted * 4, STORAGE)?,
+            mk(&format!("sort_vals{label}"), sorted * 4, STORAGE)?,
         ])
     };
     let mut run = GpuPrepare {
@@ -292,7 +276,7 @@ pub fn prepare(
     enc.copy_buffer_to_buffer(&run.bufs[&PBuf::WeldedId], at_n, &readback, 0, 4);
     enc.copy_buffer_to_buffer(&run.bufs[&PBuf::ClassUsed], at_n, &readback, 4, 4);
     enc.copy_buffer_to_buffer(&run.bufs[&PBuf::PrepCounts], 0, &readback, 8, 4);
-    add(&costs.submits, 1);
+    Costs::add(&costs.submits, 1);
     queue.submit([enc.finish()]);
     scope.check("preparing the mesh on the device")?;
     let words = read_mapped(dev, &readback, costs)?;
@@ -312,11 +296,11 @@ pub fn prepare(
 
 /// Maps `buf` (submitted work copies into it) and reads its words: one round trip, counted
 /// with the time blocked and the bytes.
-fn read_mapped(device: &wgpu::Device, buf: &wgpu::Buffer, costs: &PrepCosts) -> Result<Vec<u32>> {
+fn read_mapped(device: &wgpu::Device, buf: &wgpu::Buffer, costs: &Costs) -> Result<Vec<u32>> {
     let (outcome, waited) = crate::compute::context::map_and_wait(device, buf);
-    add(&costs.waits, 1);
-    add(&costs.blocked_ns, (waited * 1e9) as u64);
-    add(&costs.read_back, buf.size());
+    Costs::add(&costs.waits, 1);
+    Costs::add(&costs.blocked_ns, (waited * 1e9) as u64);
+    Costs::add(&costs.read_back, buf.size());
     outcome.map_err(Error::Gpu)?;
     let view = buf
         .get_mapped_range(..)

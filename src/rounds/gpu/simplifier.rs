@@ -5,6 +5,7 @@
 //! submissions and read-backs are in [`batch`].
 
 use super::BindKey;
+use crate::compute::context::{STORAGE, UNIFORM};
 use crate::compute::context::{checked_buffer, checked_buffer_init, checked_buffer_write};
 use crate::compute::gpu::{ErrorScope, Groups, Kernels, Pipelines, Runner};
 use crate::compute::types::*;
@@ -16,11 +17,7 @@ use std::time::Instant;
 
 mod batch;
 mod passes;
-pub use batch::Costs;
-
-const SU: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
-    .union(wgpu::BufferUsages::COPY_DST)
-    .union(wgpu::BufferUsages::COPY_SRC);
+pub use super::costs::Costs;
 
 /// Timestamp slots per submission (a round, or a batch of them): one per dispatch and one per
 /// compute pass (two per dispatch where stamps only bracket passes), up to the 4096 queries a
@@ -114,10 +111,10 @@ pub struct GpuMesh {
 
 /// Usages of a [`GpuMesh`]'s positions and indices: the rounds' storage, a renderer's vertex and
 /// index buffers, copies.
-pub(crate) const MESH_USAGE: wgpu::BufferUsages = SU
+pub(crate) const MESH_USAGE: wgpu::BufferUsages = STORAGE
     .union(wgpu::BufferUsages::VERTEX)
     .union(wgpu::BufferUsages::INDEX);
-pub(crate) const DRAW_ARGS_USAGE: wgpu::BufferUsages = SU.union(wgpu::BufferUsages::INDIRECT);
+pub(crate) const DRAW_ARGS_USAGE: wgpu::BufferUsages = STORAGE.union(wgpu::BufferUsages::INDIRECT);
 
 impl GpuMesh {
     /// A mesh made on the host — the input as loaded, or a CPU backend's result — with the
@@ -172,6 +169,116 @@ struct Half {
     indices: wgpu::Buffer,
     face_normals: wgpu::Buffer,
     face_extra: wgpu::Buffer,
+}
+
+/// Makes the rounds' buffers, counting the bytes uploaded.
+struct Alloc<'d> {
+    dev: &'d wgpu::Device,
+    queue: &'d wgpu::Queue,
+    uploaded: std::cell::Cell<u64>,
+}
+
+impl Alloc<'_> {
+    /// A buffer of `size` bytes, zeroed.
+    fn empty(&self, label: &str, size: u64, usage: wgpu::BufferUsages) -> Result<wgpu::Buffer> {
+        checked_buffer(self.dev, &format!("meshslim.{label}"), size, usage)
+    }
+
+    /// A buffer holding `data`.
+    fn init(&self, label: &str, data: &[u8], usage: wgpu::BufferUsages) -> Result<wgpu::Buffer> {
+        self.uploaded.set(self.uploaded.get() + data.len() as u64);
+        checked_buffer_write(
+            self.dev,
+            self.queue,
+            &format!("meshslim.{label}"),
+            data,
+            usage,
+        )
+    }
+
+    /// A storage buffer holding `data`, or of one word when there is none (a binding the
+    /// stages never read without it).
+    fn init_or(&self, label: &str, data: Option<&[u8]>) -> Result<wgpu::Buffer> {
+        match data {
+            Some(d) => self.init(label, d, STORAGE),
+            None => self.empty(label, 4, STORAGE),
+        }
+    }
+}
+
+impl Half {
+    /// The first round's input: the device's own preparation, or the host's arrays uploaded.
+    fn input(
+        a: &Alloc,
+        up: &Upload,
+        prepared: Option<super::prepare::DevicePrepared>,
+    ) -> Result<Half> {
+        let nv = up.vertex_count().max(1) as u64;
+        let nf = up.face_count().max(1) as u64;
+        let qsize = std::mem::size_of::<Quadric>() as u64;
+        Ok(match prepared {
+            Some(d) => Half {
+                positions: d.positions,
+                quadrics: a.empty("quadrics", nv * qsize, STORAGE)?,
+                flags: d.flags,
+                vertex_attr: d.vertex_attr,
+                indices: d.indices,
+                face_normals: a.empty("face_normals", nf * 16, STORAGE)?,
+                face_extra: d.face_extra,
+            },
+            None => Half {
+                positions: a.init("positions", bytemuck::cast_slice(&up.positions), MESH_USAGE)?,
+                // Quadrics carried in (`hybrid`'s clusters) are the first round's; otherwise the
+                // first round's `vertex_quadrics` writes them.
+                quadrics: match &up.quadrics {
+                    Some(q) => a.init("quadrics", bytemuck::cast_slice(q), STORAGE)?,
+                    None => a.empty("quadrics", nv * qsize, STORAGE)?,
+                },
+                flags: a.init("flags", bytemuck::cast_slice(&up.flags), STORAGE)?,
+                vertex_attr: a.init(
+                    "vertex_attr",
+                    bytemuck::cast_slice(&up.vertex_attr),
+                    STORAGE,
+                )?,
+                indices: a.init("indices", bytemuck::cast_slice(&up.indices), MESH_USAGE)?,
+                face_normals: match &up.face_planes {
+                    Some(p) => a.init("face_normals", bytemuck::cast_slice(p), STORAGE)?,
+                    None => a.empty("face_normals", nf * 16, STORAGE)?,
+                },
+                face_extra: a.init("face_extra", bytemuck::cast_slice(&up.face_extra), STORAGE)?,
+            },
+        })
+    }
+
+    /// The other half the rounds ping-pong into, sized for `nv` vertices and `nf` faces.
+    fn output(a: &Alloc, nv: u64, nf: u64) -> Result<Half> {
+        let qsize = std::mem::size_of::<Quadric>() as u64;
+        Ok(Half {
+            positions: a.empty("positions_out", nv * 16, MESH_USAGE)?,
+            quadrics: a.empty("quadrics_out", nv * qsize, STORAGE)?,
+            flags: a.empty("flags_out", nv * 4, STORAGE)?,
+            vertex_attr: a.empty("vertex_attr_out", nv * 4, STORAGE)?,
+            indices: a.empty("indices_out", nf * 12, MESH_USAGE)?,
+            face_normals: a.empty("face_normals_out", nf * 16, STORAGE)?,
+            face_extra: a.empty("face_extra_out", nf * 16, STORAGE)?,
+        })
+    }
+}
+
+/// The query set the stages' timestamps are written to, and the buffer it resolves into.
+fn timestamp_queries(dev: &wgpu::Device) -> (wgpu::QuerySet, wgpu::Buffer) {
+    let set = dev.create_query_set(&wgpu::QuerySetDescriptor {
+        label: Some("meshslim.timestamps"),
+        ty: wgpu::QueryType::Timestamp,
+        count: QUERY_CAP,
+    });
+    let resolve = dev.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("meshslim.timestamps_resolve"),
+        size: QUERY_CAP as u64 * 8,
+        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    (set, resolve)
 }
 
 /// The working state of one simplification on the GPU.
@@ -290,10 +397,10 @@ impl<'a> GpuRounds<'a> {
         p: &PrepParams,
         selection_passes: u32,
     ) -> Result<(GpuRounds<'a>, Upload)> {
-        let prep_costs = super::prepare::PrepCosts::default();
+        // The costs begin with the preparation's on the device.
+        let costs = Costs::default();
         let device = (&sim.device, &sim.queue);
-        let d = super::prepare::prepare(device, kernels, mesh, p, &prep_costs, MESH_USAGE)?;
-        let costs = Costs::from_preparation(&prep_costs);
+        let d = super::prepare::prepare(device, kernels, mesh, p, &costs, MESH_USAGE)?;
         super::prepare::check_counts(&d, mesh)?;
         let frame = ([p.frame[0], p.frame[1], p.frame[2]], p.frame[3]);
         let up = Upload::on_device(mesh, d.vertices, d.faces, frame);
@@ -316,68 +423,11 @@ impl<'a> GpuRounds<'a> {
         let nv = up.vertex_count().max(1) as u64;
         let nf = up.face_count().max(1) as u64;
         let cap = 3 * nf;
-        let mk = |label: &str, size: u64, usage: wgpu::BufferUsages| {
-            checked_buffer(dev, &format!("meshslim.{label}"), size, usage)
+        let a = Alloc {
+            dev,
+            queue: &sim.queue,
+            uploaded: std::cell::Cell::new(0),
         };
-        let uploaded = std::cell::Cell::new(0u64);
-        let init = |label: &str, data: &[u8], usage: wgpu::BufferUsages| {
-            uploaded.set(uploaded.get() + data.len() as u64);
-            checked_buffer_write(dev, &sim.queue, &format!("meshslim.{label}"), data, usage)
-        };
-        let mesh_usage = MESH_USAGE;
-        let qsize = std::mem::size_of::<Quadric>() as u64;
-        let half0 = match prepared {
-            Some(d) => Half {
-                positions: d.positions,
-                quadrics: mk("quadrics", nv * qsize, SU)?,
-                flags: d.flags,
-                vertex_attr: d.vertex_attr,
-                indices: d.indices,
-                face_normals: mk("face_normals", nf * 16, SU)?,
-                face_extra: d.face_extra,
-            },
-            None => Half {
-                positions: init("positions", bytemuck::cast_slice(&up.positions), mesh_usage)?,
-                // Quadrics carried in (`hybrid`'s clusters) are the first round's; otherwise the
-                // first round's `vertex_quadrics` writes them.
-                quadrics: match &up.quadrics {
-                    Some(q) => init("quadrics", bytemuck::cast_slice(q), SU)?,
-                    None => mk("quadrics", nv * qsize, SU)?,
-                },
-                flags: init("flags", bytemuck::cast_slice(&up.flags), SU)?,
-                vertex_attr: init("vertex_attr", bytemuck::cast_slice(&up.vertex_attr), SU)?,
-                indices: init("indices", bytemuck::cast_slice(&up.indices), mesh_usage)?,
-                face_normals: match &up.face_planes {
-                    Some(p) => init("face_normals", bytemuck::cast_slice(p), SU)?,
-                    None => mk("face_normals", nf * 16, SU)?,
-                },
-                face_extra: init("face_extra", bytemuck::cast_slice(&up.face_extra), SU)?,
-            },
-        };
-        let half1 = Half {
-            positions: mk("positions_out", nv * 16, mesh_usage)?,
-            quadrics: mk("quadrics_out", nv * qsize, SU)?,
-            flags: mk("flags_out", nv * 4, SU)?,
-            vertex_attr: mk("vertex_attr_out", nv * 4, SU)?,
-            indices: mk("indices_out", nf * 12, mesh_usage)?,
-            face_normals: mk("face_normals_out", nf * 16, SU)?,
-            face_extra: mk("face_extra_out", nf * 16, SU)?,
-        };
-        let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
-        let queries = sim.timestamps.then(|| {
-            let set = dev.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("meshslim.timestamps"),
-                ty: wgpu::QueryType::Timestamp,
-                count: QUERY_CAP,
-            });
-            let resolve = dev.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("meshslim.timestamps_resolve"),
-                size: QUERY_CAP as u64 * 8,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            (set, resolve)
-        });
         let groups = up.groups.as_ref().map_or(0, |g| g.targets.len() as u64);
         let blocks = (cap + 1)
             .div_ceil(SCAN_BLOCK as u64)
@@ -385,90 +435,92 @@ impl<'a> GpuRounds<'a> {
             + 1;
         let r = GpuRounds {
             sim,
-            half: [half0, half1],
+            half: [Half::input(&a, up, prepared)?, Half::output(&a, nv, nf)?],
             cur: 0,
             live_counts: (up.vertex_count() as u32, up.face_count() as u32),
-            draw_args: mk(
+            draw_args: a.empty(
                 "draw_args",
                 std::mem::size_of::<DrawArgs>() as u64,
                 DRAW_ARGS_USAGE,
             )?,
-            params: mk(
+            params: a.empty(
                 "params",
                 std::mem::size_of::<Params>() as u64,
-                uniform | wgpu::BufferUsages::COPY_SRC,
+                UNIFORM | wgpu::BufferUsages::COPY_SRC,
             )?,
-            scan_v: mk("scan_v", 16, uniform)?,
-            scan_f: mk("scan_f", 16, uniform)?,
-            scan_e: mk("scan_e", 16, uniform)?,
-            offsets: mk("offsets", (nv + 1) * 4, SU)?,
-            cursor: mk("cursor", nv * 4, SU)?,
-            vertex_faces: mk("vertex_faces", nf * 12, SU)?,
-            edge_offsets: mk("edge_offsets", (nv + 1) * 4, SU)?,
-            edges: mk("edges", cap * 8, SU)?,
-            candidates: mk(
+            scan_v: a.empty("scan_v", 16, UNIFORM)?,
+            scan_f: a.empty("scan_f", 16, UNIFORM)?,
+            scan_e: a.empty("scan_e", 16, UNIFORM)?,
+            offsets: a.empty("offsets", (nv + 1) * 4, STORAGE)?,
+            cursor: a.empty("cursor", nv * 4, STORAGE)?,
+            vertex_faces: a.empty("vertex_faces", nf * 12, STORAGE)?,
+            edge_offsets: a.empty("edge_offsets", (nv + 1) * 4, STORAGE)?,
+            edges: a.empty("edges", cap * 8, STORAGE)?,
+            candidates: a.empty(
                 "candidates",
                 cap * std::mem::size_of::<EdgeCandidate>() as u64,
-                SU,
+                STORAGE,
             )?,
-            edge_state: mk("edge_state", cap * 4, SU)?,
-            histogram: mk("histogram", HIST_BINS as u64 * 4, SU)?,
-            trim_histogram: mk("trim_histogram", HIST_BINS as u64 * 4, SU)?,
-            face_best: mk("face_best", nf * 4, SU)?,
-            face_id: mk("face_id", nf * 4, SU)?,
-            vertex_lock: mk("vertex_lock", nv * 4, SU)?,
-            remap: mk("remap", nv * 4, SU)?,
-            vertex_keep: mk("vertex_keep", (nv + 1) * 4, SU)?,
-            face_keep: mk("face_keep", (nf + 1) * 4, SU)?,
-            marks: mk("marks", (cap + 1) * 4, SU)?,
-            tentative: mk("tentative", cap * 4, SU)?,
-            dispatch: mk("dispatch", 64, SU | wgpu::BufferUsages::INDIRECT)?,
-            live: mk("live", cap * 4, SU)?,
-            neighbours: mk("neighbours", nf * 24, SU)?,
-            block_sums: mk("block_sums", blocks * 4, SU)?,
-            counters: mk("counters", COUNTERS_BYTES, SU)?,
-            plan: mk(
+            edge_state: a.empty("edge_state", cap * 4, STORAGE)?,
+            histogram: a.empty("histogram", HIST_BINS as u64 * 4, STORAGE)?,
+            trim_histogram: a.empty("trim_histogram", HIST_BINS as u64 * 4, STORAGE)?,
+            face_best: a.empty("face_best", nf * 4, STORAGE)?,
+            face_id: a.empty("face_id", nf * 4, STORAGE)?,
+            vertex_lock: a.empty("vertex_lock", nv * 4, STORAGE)?,
+            remap: a.empty("remap", nv * 4, STORAGE)?,
+            vertex_keep: a.empty("vertex_keep", (nv + 1) * 4, STORAGE)?,
+            face_keep: a.empty("face_keep", (nf + 1) * 4, STORAGE)?,
+            marks: a.empty("marks", (cap + 1) * 4, STORAGE)?,
+            tentative: a.empty("tentative", cap * 4, STORAGE)?,
+            dispatch: a.empty("dispatch", 64, STORAGE | wgpu::BufferUsages::INDIRECT)?,
+            live: a.empty("live", cap * 4, STORAGE)?,
+            neighbours: a.empty("neighbours", nf * 24, STORAGE)?,
+            block_sums: a.empty("block_sums", blocks * 4, STORAGE)?,
+            counters: a.empty("counters", COUNTERS_BYTES, STORAGE)?,
+            plan: a.empty(
                 "plan",
                 std::mem::size_of::<crate::compute::types::PlanState>() as u64,
-                SU,
+                STORAGE,
             )?,
-            planned: mk(
+            planned: a.empty(
                 "planned",
                 std::mem::size_of::<crate::compute::types::Planned>() as u64,
-                SU | wgpu::BufferUsages::INDIRECT,
+                STORAGE | wgpu::BufferUsages::INDIRECT,
             )?,
             planned_round: false,
             trimming: false,
             bind_groups: HashMap::new(),
             costs,
             face_extra_out: up.output_needs_face_extra(),
-            attr_values: match &up.attrs {
-                Some(a) => init("attr_values", bytemuck::cast_slice(&a.values), SU)?,
-                None => mk("attr_values", 4, SU)?,
-            },
-            attr_sums: mk("attr_sums", (up.attr_sums_len().max(1) * 4) as u64, SU)?,
+            attr_values: a.init_or(
+                "attr_values",
+                up.attrs.as_ref().map(|x| bytemuck::cast_slice(&x.values)),
+            )?,
+            attr_sums: a.empty("attr_sums", (up.attr_sums_len().max(1) * 4) as u64, STORAGE)?,
             attr_len: up.attrs.as_ref().map_or(0, |a| a.values.len() as u64),
-            face_group: match &up.groups {
-                Some(g) => init("face_group", bytemuck::cast_slice(&g.face_group), SU)?,
-                None => mk("face_group", 4, SU)?,
-            },
-            group_target: match &up.groups {
-                Some(g) => init("group_target", bytemuck::cast_slice(&g.targets), SU)?,
-                None => mk("group_target", 4, SU)?,
-            },
-            group_closed: match &up.groups {
-                Some(g) => init("group_closed", bytemuck::cast_slice(&g.closed), SU)?,
-                None => mk("group_closed", 4, SU)?,
-            },
-            group_count: mk("group_count", groups.max(1) * 4, SU)?,
-            group_err: mk("group_err", groups.max(1) * 4, SU)?,
+            face_group: a.init_or(
+                "face_group",
+                up.groups
+                    .as_ref()
+                    .map(|g| bytemuck::cast_slice(&g.face_group)),
+            )?,
+            group_target: a.init_or(
+                "group_target",
+                up.groups.as_ref().map(|g| bytemuck::cast_slice(&g.targets)),
+            )?,
+            group_closed: a.init_or(
+                "group_closed",
+                up.groups.as_ref().map(|g| bytemuck::cast_slice(&g.closed)),
+            )?,
+            group_count: a.empty("group_count", groups.max(1) * 4, STORAGE)?,
+            group_err: a.empty("group_err", groups.max(1) * 4, STORAGE)?,
             groups,
-            readback: mk(
+            readback: a.empty(
                 "readback",
                 batch::READBACK_BYTES,
                 wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             )?,
-            queries,
+            queries: sim.timestamps.then(|| timestamp_queries(dev)),
             query_stages: Vec::new(),
             next_slot: 0,
             pass: None,
@@ -486,7 +538,7 @@ impl<'a> GpuRounds<'a> {
             instance_count: 1,
             ..Default::default()
         };
-        Costs::add(&r.costs.uploaded, uploaded.get());
+        Costs::add(&r.costs.uploaded, a.uploaded.get());
         r.write(&r.draw_args, 0, bytemuck::bytes_of(&args));
         scope.check("uploading the mesh")?;
         let mut r = r;
@@ -498,89 +550,47 @@ impl<'a> GpuRounds<'a> {
     /// waiting for it: on lavapipe, whose device memory is the process's, unmapping the 1M
     /// scan's buffers took 0.03-0.04 s, more than the rest of the host's part of the call.
     pub fn retire(self) {
-        let GpuRounds {
-            half,
-            draw_args,
-            params,
-            scan_v,
-            scan_f,
-            scan_e,
-            offsets,
-            cursor,
-            vertex_faces,
-            edge_offsets,
-            edges,
-            candidates,
-            edge_state,
-            histogram,
-            trim_histogram,
-            live,
-            face_best,
-            face_id,
-            vertex_lock,
-            remap,
-            vertex_keep,
-            face_keep,
-            marks,
-            tentative,
-            dispatch,
-            neighbours,
-            block_sums,
-            counters,
-            plan,
-            planned,
-            attr_values,
-            attr_sums,
-            face_group,
-            group_target,
-            group_count,
-            group_closed,
-            group_err,
-            readback,
-            bind_groups,
-            queries,
-            ..
-        } = self;
+        // Moved out field by field (the rounds borrow their simplifier, which stays).
         let buffers = [
-            draw_args,
-            params,
-            scan_v,
-            scan_f,
-            scan_e,
-            offsets,
-            cursor,
-            vertex_faces,
-            edge_offsets,
-            edges,
-            candidates,
-            edge_state,
-            histogram,
-            trim_histogram,
-            live,
-            face_best,
-            face_id,
-            vertex_lock,
-            remap,
-            vertex_keep,
-            face_keep,
-            marks,
-            tentative,
-            dispatch,
-            neighbours,
-            block_sums,
-            counters,
-            plan,
-            planned,
-            attr_values,
-            attr_sums,
-            face_group,
-            group_target,
-            group_count,
-            group_closed,
-            group_err,
-            readback,
+            self.draw_args,
+            self.params,
+            self.scan_v,
+            self.scan_f,
+            self.scan_e,
+            self.offsets,
+            self.cursor,
+            self.vertex_faces,
+            self.edge_offsets,
+            self.edges,
+            self.candidates,
+            self.edge_state,
+            self.histogram,
+            self.trim_histogram,
+            self.live,
+            self.face_best,
+            self.face_id,
+            self.vertex_lock,
+            self.remap,
+            self.vertex_keep,
+            self.face_keep,
+            self.marks,
+            self.tentative,
+            self.dispatch,
+            self.neighbours,
+            self.block_sums,
+            self.counters,
+            self.plan,
+            self.planned,
+            self.attr_values,
+            self.attr_sums,
+            self.face_group,
+            self.group_target,
+            self.group_count,
+            self.group_closed,
+            self.group_err,
+            self.readback,
         ];
-        let resources = (half, buffers, bind_groups, queries);
+        let resources = (self.half, buffers, self.bind_groups, self.queries);
         // A thread that cannot start leaves the freeing to this one.
         let _ = std::thread::Builder::new()
             .name("meshslim-free".into())

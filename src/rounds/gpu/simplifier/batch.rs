@@ -4,7 +4,6 @@
 
 use super::*;
 use crate::compute::types::{PlanState, Planned, grid_slot};
-use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 
 /// Bytes of the planner's state, read back after a batch.
 const PLAN_BYTES: u64 = std::mem::size_of::<PlanState>() as u64;
@@ -18,58 +17,6 @@ const PLANNED_GRIDS: u64 = std::mem::offset_of!(Planned, grids) as u64;
 /// timestamps.
 pub(super) const READBACK_BYTES: u64 =
     PLAN_BYTES + crate::rounds::BATCH_ROUNDS as u64 * LOG_BYTES + QUERY_CAP as u64 * 8;
-
-/// What a simplification cost on the device's side, counted as it goes (the report's
-/// `device_waits`, `submits`, ...).
-#[derive(Default)]
-pub struct Costs {
-    pub waits: AtomicU64,
-    pub submits: AtomicU64,
-    pub dispatches: AtomicU64,
-    pub bind_groups: AtomicU64,
-    pub uploaded: AtomicU64,
-    pub read_back: AtomicU64,
-    /// Nanoseconds the host spent blocked on the device.
-    pub blocked_ns: AtomicU64,
-}
-
-impl Costs {
-    pub(super) fn add(counter: &AtomicU64, n: u64) {
-        counter.fetch_add(n, Relaxed);
-    }
-
-    /// Costs that begin with the preparation's on the device.
-    pub(crate) fn from_preparation(p: &crate::rounds::gpu::prepare::PrepCosts) -> Costs {
-        let c = Costs::default();
-        for (to, from) in [
-            (&c.waits, &p.waits),
-            (&c.submits, &p.submits),
-            (&c.dispatches, &p.dispatches),
-            (&c.bind_groups, &p.bind_groups),
-            (&c.uploaded, &p.uploaded),
-            (&c.read_back, &p.read_back),
-            (&c.blocked_ns, &p.blocked_ns),
-        ] {
-            Costs::add(to, Costs::get(from));
-        }
-        c
-    }
-
-    pub fn get(counter: &AtomicU64) -> u64 {
-        counter.load(Relaxed)
-    }
-
-    /// The counts into `r`, with the host's share of `call_seconds`.
-    pub fn report(&self, r: &mut crate::rounds::RoundsReport, call_seconds: f64) {
-        r.device_waits = Costs::get(&self.waits);
-        r.submits = Costs::get(&self.submits);
-        r.dispatches = Costs::get(&self.dispatches);
-        r.bind_groups_created = Costs::get(&self.bind_groups);
-        r.bytes_uploaded = Costs::get(&self.uploaded);
-        r.bytes_read_back = Costs::get(&self.read_back);
-        r.host_seconds = (call_seconds - Costs::get(&self.blocked_ns) as f64 * 1e-9).max(0.0);
-    }
-}
 
 impl GpuRounds<'_> {
     /// Submits `enc`, counted.
