@@ -10,7 +10,7 @@
 
 use meshslim::cluster::gpu::{GpuClusterMesh, Part, shared};
 use meshslim::cluster::gpu_schedule as sched;
-use meshslim::cluster::grid::Grid;
+use meshslim::cluster::grid::CellGrid;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -19,7 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let h: f32 = args.next().map_or(Ok(4.9e-3), |s| s.parse())?;
     let m = meshslim::io::read(std::path::Path::new(&path))?;
     let (pos, lo, hi) = meshslim::cluster::unit_frame_points(&m);
-    let grid = Grid::new(lo, hi, h);
+    let grid = CellGrid::new(lo, hi, h);
     let sim = shared()?;
     let locked = vec![false; pos.len()];
     let mut g = GpuClusterMesh::new(sim, &pos, &m.triangles, &locked)?;

@@ -48,7 +48,6 @@
 
 #[cfg(feature = "bench")]
 pub mod bench;
-mod cache;
 #[cfg(feature = "cli")]
 pub mod cli;
 // Vertex clustering; public (hidden) for the tests of its stages.
@@ -68,6 +67,7 @@ pub mod memory;
 pub mod mesh;
 pub mod metrics;
 pub mod options;
+mod prefetch;
 mod quadric;
 #[cfg(any(feature = "bench", feature = "viewer"))]
 pub mod raster;

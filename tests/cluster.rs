@@ -1,7 +1,7 @@
 //! The clustering methods (`cluster`, `hybrid`) and their stages, on generated meshes with
 //! known answers.
 
-use meshslim::cluster::grid::Grid;
+use meshslim::cluster::grid::CellGrid;
 use meshslim::cluster::{floating, stages};
 use meshslim::mesh::{grid, icosphere, topology, torus};
 use meshslim::{Backend, Error, Mesh, Method, SimplifyOptions, StopReason, simplify};
@@ -86,7 +86,7 @@ fn a_grid_of_countable_cells_keeps_the_faces_between_them() {
         .map(|p| [p[0], p[1], p[2], 1.0])
         .collect();
     // Shift the grid by half a vertex spacing so no vertex sits on a cell wall.
-    let g = Grid::new([-1.0 / 16.0, -1.0 / 16.0, 0.0], [1.0, 1.0, 0.0], 0.27);
+    let g = CellGrid::new([-1.0 / 16.0, -1.0 / 16.0, 0.0], [1.0, 1.0, 0.0], 0.27);
     let keys = stages::cell_keys(&g, &positions, &vec![false; positions.len()]);
     let (sorted, members) = stages::radix_sort(keys);
     let mut cells = stages::cell_ranges(&sorted, members);

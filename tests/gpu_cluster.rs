@@ -9,8 +9,8 @@ use cluster_twins as twins;
 use common::{gpu_context, pod, unit_close};
 use meshslim::Mesh;
 use meshslim::cluster::gpu::{GpuClusterMesh, GpuClusterer, Part};
-use meshslim::cluster::gpu_schedule::CBuf;
-use meshslim::cluster::grid::Grid;
+use meshslim::cluster::gpu_schedule::ClusterBuf;
+use meshslim::cluster::grid::CellGrid;
 use meshslim::cluster::stages::{self, Placement};
 use meshslim::compute::common::quadric_eval;
 use meshslim::compute::types::{ClusterPlaced, SORT_BLOCK};
@@ -51,24 +51,25 @@ fn each_cluster_stage_matches_its_cpu_twin() {
         let locked = locked_of(pos.len(), lock);
         let (nv, nf) = (pos.len(), m.triangles.len());
         let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
-        let rd =
-            |g: &GpuClusterMesh, b: CBuf, bytes: usize| g.read_buffer(b, bytes as u64).unwrap();
+        let rd = |g: &GpuClusterMesh, b: ClusterBuf, bytes: usize| {
+            g.read_buffer(b, bytes as u64).unwrap()
+        };
         for h in sizes {
-            let grid = Grid::new(lo, hi, h);
+            let grid = CellGrid::new(lo, hi, h);
             let label = format!("{name} at h = {h} ({:?} cells an axis)", grid.dims);
             let cpu = twins::run(&pos, &m.triangles, &locked, &grid);
             // adjacency_* and face_planes, from the upload.
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::Offsets, 4 * (nv + 1))),
+                pod::<u32>(rd(&gpu, ClusterBuf::Offsets, 4 * (nv + 1))),
                 cpu.offsets,
                 "{label}: offsets"
             );
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::VertexFaces, 12 * nf)),
+                pod::<u32>(rd(&gpu, ClusterBuf::VertexFaces, 12 * nf)),
                 cpu.vertex_faces,
                 "{label}: vertex_faces"
             );
-            let normals: Vec<[f32; 4]> = pod(rd(&gpu, CBuf::FaceNormals, 16 * nf));
+            let normals: Vec<[f32; 4]> = pod(rd(&gpu, ClusterBuf::FaceNormals, 16 * nf));
             for (f, (a, b)) in normals.iter().zip(&cpu.face_normals).enumerate() {
                 assert!(
                     unit_close(a, b, 1e-4),
@@ -78,12 +79,12 @@ fn each_cluster_stage_matches_its_cpu_twin() {
             gpu.set_grid(&grid);
             gpu.run_part(Part::Keys).unwrap();
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::SortKeys, 4 * nv)),
+                pod::<u32>(rd(&gpu, ClusterBuf::SortKeys, 4 * nv)),
                 cpu.keys.0,
                 "{label}: cell_keys' keys"
             );
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::SortVals, 4 * nv)),
+                pod::<u32>(rd(&gpu, ClusterBuf::SortVals, 4 * nv)),
                 cpu.keys.1,
                 "{label}: cell_keys' values"
             );
@@ -97,19 +98,19 @@ fn each_cluster_stage_matches_its_cpu_twin() {
                 gpu.run_part(Part::SortPass(p as u32)).unwrap();
                 let what = |s: &str| format!("{label}: radix pass {p}, {s}");
                 assert_eq!(
-                    &pod::<u32>(rd(&gpu, CBuf::DigitCounts, 4 * (256 * blocks + 1))),
+                    &pod::<u32>(rd(&gpu, ClusterBuf::DigitCounts, 4 * (256 * blocks + 1))),
                     counts,
                     "{}",
                     what("digit counts")
                 );
                 assert_eq!(
-                    &pod::<u32>(rd(&gpu, CBuf::SortKeys, 4 * nv)),
+                    &pod::<u32>(rd(&gpu, ClusterBuf::SortKeys, 4 * nv)),
                     keys,
                     "{}",
                     what("keys")
                 );
                 assert_eq!(
-                    &pod::<u32>(rd(&gpu, CBuf::SortVals, 4 * nv)),
+                    &pod::<u32>(rd(&gpu, ClusterBuf::SortVals, 4 * nv)),
                     vals,
                     "{}",
                     what("values")
@@ -129,22 +130,22 @@ fn each_cluster_stage_matches_its_cpu_twin() {
             gpu.run_part(Part::Cells).unwrap();
             let cells = cpu.cells.cell_key.len();
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::CellHead, 4 * (nv + 1))),
+                pod::<u32>(rd(&gpu, ClusterBuf::CellHead, 4 * (nv + 1))),
                 cpu.cells.cell_head,
                 "{label}: cell_head"
             );
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::CellStart, 4 * (cells + 1))),
+                pod::<u32>(rd(&gpu, ClusterBuf::CellStart, 4 * (cells + 1))),
                 cpu.cells.cell_start,
                 "{label}: cell_start"
             );
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::VertexCell, 4 * nv)),
+                pod::<u32>(rd(&gpu, ClusterBuf::VertexCell, 4 * nv)),
                 cpu.cells.vertex_cell,
                 "{label}: vertex_cell"
             );
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::CellKey, 4 * cells)),
+                pod::<u32>(rd(&gpu, ClusterBuf::CellKey, 4 * cells)),
                 cpu.cells.cell_key,
                 "{label}: cell_key"
             );
@@ -161,27 +162,27 @@ fn each_cluster_stage_matches_its_cpu_twin() {
             gpu.run_part(Part::Quadrics).unwrap();
             twins::check_placed(
                 &label,
-                &pod(rd(&gpu, CBuf::ClusterPlaced, 32 * cells)),
+                &pod(rd(&gpu, ClusterBuf::ClusterPlaced, 32 * cells)),
                 &cpu.cluster_placed,
-                &pod(rd(&gpu, CBuf::ClusterQuadric, 48 * cells)),
+                &pod(rd(&gpu, ClusterBuf::ClusterQuadric, 48 * cells)),
                 &cpu.cluster_quadric,
                 grid.h,
             );
             gpu.run_part(Part::Faces).unwrap();
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::FaceKey, 12 * nf)),
+                pod::<u32>(rd(&gpu, ClusterBuf::FaceKey, 12 * nf)),
                 cpu.faces.face_key,
                 "{label}: face_key"
             );
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::BucketOffsets, 4 * (nv + 1))),
+                pod::<u32>(rd(&gpu, ClusterBuf::BucketOffsets, 4 * (nv + 1))),
                 cpu.faces.bucket_offsets,
                 "{label}: bucket_offsets"
             );
             assert_eq!(
                 pod::<u32>(rd(
                     &gpu,
-                    CBuf::BucketFaces,
+                    ClusterBuf::BucketFaces,
                     4 * cpu.faces.bucket_faces.len()
                 )),
                 cpu.faces.bucket_faces,
@@ -190,18 +191,18 @@ fn each_cluster_stage_matches_its_cpu_twin() {
             let mut scanned = cpu.faces.face_keep.clone();
             meshslim::rounds::cpu::prefix_sum::prefix_sum(nf as u32, &mut scanned, &mut Vec::new());
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::FaceKeep, 4 * (nf + 1))),
+                pod::<u32>(rd(&gpu, ClusterBuf::FaceKeep, 4 * (nf + 1))),
                 scanned,
                 "{label}: face_keep (scanned)"
             );
             let kept = cpu.faces.face_origin.len();
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::ClusterFaces, 12 * kept)),
+                pod::<u32>(rd(&gpu, ClusterBuf::ClusterFaces, 12 * kept)),
                 cpu.faces.cluster_faces,
                 "{label}: cluster_faces"
             );
             assert_eq!(
-                pod::<u32>(rd(&gpu, CBuf::FaceOrigin, 4 * kept)),
+                pod::<u32>(rd(&gpu, ClusterBuf::FaceOrigin, 4 * kept)),
                 cpu.faces.face_origin,
                 "{label}: face_origin"
             );
@@ -224,7 +225,7 @@ fn driver_build(
     pos: &[[f32; 4]],
     faces: &[[u32; 3]],
     locked: &[bool],
-    grid: &Grid,
+    grid: &CellGrid,
 ) -> meshslim::cluster::gpu::ClusterBuild {
     let keys = stages::cell_keys(grid, pos, locked);
     let (sorted, members) = stages::radix_sort(keys);
@@ -275,7 +276,7 @@ fn the_gpu_build_equals_the_cpu_build() {
         let locked = locked_of(pos.len(), lock);
         let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
         for h in sizes {
-            let grid = Grid::new(lo, hi, h);
+            let grid = CellGrid::new(lo, hi, h);
             let label = format!("{name} at h = {h}");
             let g = gpu.build(&grid).unwrap();
             let again = gpu.build(&grid).unwrap();
@@ -292,10 +293,11 @@ fn the_gpu_build_equals_the_cpu_build() {
             // `cluster_mesh` (the drawable result) against its twin on the GPU's clusters.
             let drawn = gpu.drawable([0.0; 3], 1.0).unwrap();
             let n = g.clusters;
-            let placed: Vec<ClusterPlaced> =
-                pod(gpu.read_buffer(CBuf::ClusterPlaced, 32 * n as u64).unwrap());
+            let placed: Vec<ClusterPlaced> = pod(gpu
+                .read_buffer(ClusterBuf::ClusterPlaced, 32 * n as u64)
+                .unwrap());
             let heads: Vec<u32> = pod(gpu
-                .read_buffer(CBuf::CellHead, 4 * (pos.len() as u64 + 1))
+                .read_buffer(ClusterBuf::CellHead, 4 * (pos.len() as u64 + 1))
                 .unwrap());
             let mut want = vec![[0f32; 4]; n];
             let c = meshslim::cluster::gpu_schedule::cluster_params(
@@ -304,11 +306,12 @@ fn the_gpu_build_equals_the_cpu_build() {
                 m.triangles.len(),
             );
             twins::cluster_mesh(&c, &heads, &placed, &mut want);
-            let got: Vec<[f32; 4]> =
-                pod(gpu.read_buffer(CBuf::MeshPositions, 16 * n as u64).unwrap());
+            let got: Vec<[f32; 4]> = pod(gpu
+                .read_buffer(ClusterBuf::MeshPositions, 16 * n as u64)
+                .unwrap());
             assert_eq!(got, want, "{label}: cluster_mesh");
             let idx: Vec<u32> = pod(gpu
-                .read_buffer(CBuf::ClusterFaces, 12 * g.faces.len() as u64)
+                .read_buffer(ClusterBuf::ClusterFaces, 12 * g.faces.len() as u64)
                 .unwrap());
             let flat: Vec<u32> = g.faces.iter().flat_map(|(_, t)| *t).collect();
             assert_eq!(idx, flat, "{label}: the drawn indices are the kept faces");

@@ -14,7 +14,7 @@ use meshslim::Mesh;
 use meshslim::cluster::floating::{self, UNCLAIMED};
 use meshslim::cluster::floating_gpu::FcPart;
 use meshslim::cluster::gpu::{GpuClusterMesh, GpuClusterer, Part};
-use meshslim::cluster::gpu_schedule::CBuf;
+use meshslim::cluster::gpu_schedule::ClusterBuf;
 use meshslim::cluster::gpu_schedule::ROUND_SLOTS;
 use meshslim::cluster::stages;
 use meshslim::compute::types::{ClusterPlaced, Params, Quadric};
@@ -44,7 +44,7 @@ fn locked_of(n: usize, lock: bool) -> Vec<bool> {
     (0..n).map(|v| lock && v % 7 == 0).collect()
 }
 
-fn rd<T: bytemuck::Pod>(g: &GpuClusterMesh, b: CBuf, n: usize) -> Vec<T> {
+fn rd<T: bytemuck::Pod>(g: &GpuClusterMesh, b: ClusterBuf, n: usize) -> Vec<T> {
     let bytes = g
         .read_buffer(b, (n * std::mem::size_of::<T>()) as u64)
         .unwrap();
@@ -59,12 +59,15 @@ fn sort_on_both(
     passes: u32,
     nv: usize,
 ) -> (Vec<u32>, Vec<u32>) {
-    let keys: Vec<u32> = rd(gpu, CBuf::SortKeys, nv);
-    let vals: Vec<u32> = rd(gpu, CBuf::SortVals, nv);
+    let keys: Vec<u32> = rd(gpu, ClusterBuf::SortKeys, nv);
+    let vals: Vec<u32> = rd(gpu, ClusterBuf::SortVals, nv);
     for p in 0..passes {
         gpu.run_part(Part::SortPass(p)).unwrap();
     }
-    let (gk, gv): (Vec<u32>, Vec<u32>) = (rd(gpu, CBuf::SortKeys, nv), rd(gpu, CBuf::SortVals, nv));
+    let (gk, gv): (Vec<u32>, Vec<u32>) = (
+        rd(gpu, ClusterBuf::SortKeys, nv),
+        rd(gpu, ClusterBuf::SortVals, nv),
+    );
     let want = twins::sort(&keys, &vals, passes)
         .pop()
         .map_or((keys, vals), |p| (p.1, p.2));
@@ -79,21 +82,25 @@ fn cells_on_both(gpu: &mut GpuClusterMesh, label: &str, sorted: &(Vec<u32>, Vec<
     let c = twins::cells(&gpu.cluster_params(), &sorted.0, &sorted.1);
     let n = c.cell_key.len();
     assert_eq!(
-        rd::<u32>(gpu, CBuf::CellHead, nv + 1),
+        rd::<u32>(gpu, ClusterBuf::CellHead, nv + 1),
         c.cell_head,
         "{label}"
     );
     assert_eq!(
-        rd::<u32>(gpu, CBuf::CellStart, n + 1),
+        rd::<u32>(gpu, ClusterBuf::CellStart, n + 1),
         c.cell_start,
         "{label}"
     );
     assert_eq!(
-        rd::<u32>(gpu, CBuf::VertexCell, nv),
+        rd::<u32>(gpu, ClusterBuf::VertexCell, nv),
         c.vertex_cell,
         "{label}"
     );
-    assert_eq!(rd::<u32>(gpu, CBuf::CellKey, n), c.cell_key, "{label}");
+    assert_eq!(
+        rd::<u32>(gpu, ClusterBuf::CellKey, n),
+        c.cell_key,
+        "{label}"
+    );
     n
 }
 
@@ -108,9 +115,9 @@ fn each_floating_stage_matches_its_cpu_twin() {
         let (nv, nf) = (pos.len(), m.triangles.len());
         let indices: &[u32] = bytemuck::cast_slice(&m.triangles);
         let mut gpu = GpuClusterMesh::new(&sim, &pos, &m.triangles, &locked).unwrap();
-        let offsets: Vec<u32> = rd(&gpu, CBuf::Offsets, nv + 1);
-        let vertex_faces: Vec<u32> = rd(&gpu, CBuf::VertexFaces, 3 * nf);
-        let normals: Vec<[f32; 4]> = rd(&gpu, CBuf::FaceNormals, nf);
+        let offsets: Vec<u32> = rd(&gpu, ClusterBuf::Offsets, nv + 1);
+        let vertex_faces: Vec<u32> = rd(&gpu, ClusterBuf::VertexFaces, 3 * nf);
+        let normals: Vec<[f32; 4]> = rd(&gpu, ClusterBuf::FaceNormals, nf);
         let params = Params {
             vertex_count: nv as u32,
             face_count: nf as u32,
@@ -119,7 +126,7 @@ fn each_floating_stage_matches_its_cpu_twin() {
 
         // fc_grades: floats, within 1e-4 of the longest edge there.
         gpu.run_fc_part(FcPart::Ranks).unwrap();
-        let grades: Vec<f32> = rd(&gpu, CBuf::FcGrade, nv);
+        let grades: Vec<f32> = rd(&gpu, ClusterBuf::FcGrade, nv);
         let mut want = vec![0f32; nv];
         ft::fc_grades(&params, &pos, indices, &offsets, &vertex_faces, &mut want);
         let exact = grades.iter().zip(&want).filter(|(a, b)| a == b).count();
@@ -148,14 +155,18 @@ fn each_floating_stage_matches_its_cpu_twin() {
         // fc_ranks fed the GPU's grades: exact.
         let (mut ranks, mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv], vec![0u32; nv]);
         ft::fc_ranks(&params, &grades, &mut ranks, &mut keys, &mut vals);
-        assert_eq!(rd::<u32>(&gpu, CBuf::FcRank, nv), ranks, "{name}: fc_rank");
         assert_eq!(
-            rd::<u32>(&gpu, CBuf::SortKeys, nv),
+            rd::<u32>(&gpu, ClusterBuf::FcRank, nv),
+            ranks,
+            "{name}: fc_rank"
+        );
+        assert_eq!(
+            rd::<u32>(&gpu, ClusterBuf::SortKeys, nv),
             keys,
             "{name}: rank keys"
         );
         assert_eq!(
-            rd::<u32>(&gpu, CBuf::SortVals, nv),
+            rd::<u32>(&gpu, ClusterBuf::SortVals, nv),
             vals,
             "{name}: rank values"
         );
@@ -167,7 +178,7 @@ fn each_floating_stage_matches_its_cpu_twin() {
         );
         gpu.run_fc_part(FcPart::Order).unwrap();
         assert_eq!(
-            rd::<u32>(&gpu, CBuf::FcOrder, nv),
+            rd::<u32>(&gpu, ClusterBuf::FcOrder, nv),
             order,
             "{name}: fc_order"
         );
@@ -189,33 +200,33 @@ fn each_floating_stage_matches_its_cpu_twin() {
             let (mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv]);
             ft::fc_keys(&c, &pos, &order, &mut keys, &mut vals);
             assert_eq!(
-                rd::<u32>(&gpu, CBuf::SortKeys, nv),
+                rd::<u32>(&gpu, ClusterBuf::SortKeys, nv),
                 keys,
                 "{label}: fc_keys"
             );
             assert_eq!(
-                rd::<u32>(&gpu, CBuf::SortVals, nv),
+                rd::<u32>(&gpu, ClusterBuf::SortVals, nv),
                 vals,
                 "{label}: fc_keys"
             );
             let (mut centre, mut head) = (vec![0u32; nv], vec![0u32; nv + 1]);
             ft::fc_init(&c, &locked_u32, &mut centre, &mut head);
             assert_eq!(
-                rd::<u32>(&gpu, CBuf::FcCentre, nv),
+                rd::<u32>(&gpu, ClusterBuf::FcCentre, nv),
                 centre,
                 "{label}: fc_init"
             );
             assert_eq!(
-                rd::<u32>(&gpu, CBuf::FcHead, nv),
+                rd::<u32>(&gpu, ClusterBuf::FcHead, nv),
                 head[..nv],
                 "{label}: fc_init"
             );
             let passes = gpu.hash_passes();
             let sorted = sort_on_both(&mut gpu, &label, passes, nv);
             let cells = cells_on_both(&mut gpu, &label, &sorted);
-            let cell_head: Vec<u32> = rd(&gpu, CBuf::CellHead, nv + 1);
-            let cell_start: Vec<u32> = rd(&gpu, CBuf::CellStart, cells + 1);
-            let cell_key: Vec<u32> = rd(&gpu, CBuf::CellKey, cells);
+            let cell_head: Vec<u32> = rd(&gpu, ClusterBuf::CellHead, nv + 1);
+            let cell_start: Vec<u32> = rd(&gpu, ClusterBuf::CellStart, cells + 1);
+            let cell_key: Vec<u32> = rd(&gpu, ClusterBuf::CellKey, cells);
 
             // The rounds, each stage from the GPU's buffers before it.
             let mut rounds = 0;
@@ -225,9 +236,9 @@ fn each_floating_stage_matches_its_cpu_twin() {
                         gpu.run_fc_part(FcPart::Batch).unwrap();
                     }
                     let f = meshslim::cluster::gpu_schedule::float_params(r, slot);
-                    let centre: Vec<u32> = rd(&gpu, CBuf::FcCentre, nv);
-                    let mut decided: Vec<u32> = rd(&gpu, CBuf::FcDecided, nv);
-                    let mut head: Vec<u32> = rd(&gpu, CBuf::FcHead, nv + 1);
+                    let centre: Vec<u32> = rd(&gpu, ClusterBuf::FcCentre, nv);
+                    let mut decided: Vec<u32> = rd(&gpu, ClusterBuf::FcDecided, nv);
+                    let mut head: Vec<u32> = rd(&gpu, ClusterBuf::FcHead, nv + 1);
                     gpu.run_fc_part(FcPart::Round(slot)).unwrap();
                     let mut live = vec![0u32; ROUND_SLOTS];
                     ft::fc_decide(
@@ -244,12 +255,16 @@ fn each_floating_stage_matches_its_cpu_twin() {
                         &mut live,
                     );
                     let what = format!("{label}: round {rounds}");
-                    let live_gpu: Vec<u32> = rd(&gpu, CBuf::FcLive, ROUND_SLOTS);
+                    let live_gpu: Vec<u32> = rd(&gpu, ClusterBuf::FcLive, ROUND_SLOTS);
                     assert_eq!(
                         live_gpu[slot as usize], live[slot as usize],
                         "{what}: fc_live"
                     );
-                    assert_eq!(rd::<u32>(&gpu, CBuf::FcDecided, nv), decided, "{what}");
+                    assert_eq!(
+                        rd::<u32>(&gpu, ClusterBuf::FcDecided, nv),
+                        decided,
+                        "{what}"
+                    );
                     let mut after = centre.clone();
                     ft::fc_claim(
                         &c,
@@ -264,11 +279,15 @@ fn each_floating_stage_matches_its_cpu_twin() {
                         &mut head,
                     );
                     assert_eq!(
-                        rd::<u32>(&gpu, CBuf::FcCentre, nv),
+                        rd::<u32>(&gpu, ClusterBuf::FcCentre, nv),
                         after,
                         "{what}: centres"
                     );
-                    assert_eq!(rd::<u32>(&gpu, CBuf::FcHead, nv), head[..nv], "{what}");
+                    assert_eq!(
+                        rd::<u32>(&gpu, ClusterBuf::FcHead, nv),
+                        head[..nv],
+                        "{what}"
+                    );
                     if live[slot as usize] == 0 {
                         break 'rounds;
                     }
@@ -276,21 +295,25 @@ fn each_floating_stage_matches_its_cpu_twin() {
                     assert!(rounds <= nv, "{label}: rounds do not end");
                 }
             }
-            let centre: Vec<u32> = rd(&gpu, CBuf::FcCentre, nv);
+            let centre: Vec<u32> = rd(&gpu, ClusterBuf::FcCentre, nv);
             assert!(
                 !centre.contains(&UNCLAIMED),
                 "{label}: every vertex claimed"
             );
 
             // Centres numbered, vertices keyed by cluster.
-            let mut head: Vec<u32> = rd(&gpu, CBuf::FcHead, nv + 1);
+            let mut head: Vec<u32> = rd(&gpu, ClusterBuf::FcHead, nv + 1);
             gpu.run_fc_part(FcPart::Clusters).unwrap();
             meshslim::rounds::cpu::prefix_sum::prefix_sum(nv as u32, &mut head, &mut Vec::new());
-            assert_eq!(rd::<u32>(&gpu, CBuf::FcHead, nv + 1), head, "{label}: head");
+            assert_eq!(
+                rd::<u32>(&gpu, ClusterBuf::FcHead, nv + 1),
+                head,
+                "{label}: head"
+            );
             let (mut keys, mut vals) = (vec![0u32; nv], vec![0u32; nv]);
             ft::fc_cluster_keys(&c, &centre, &head, &mut keys, &mut vals);
-            assert_eq!(rd::<u32>(&gpu, CBuf::SortKeys, nv), keys, "{label}");
-            assert_eq!(rd::<u32>(&gpu, CBuf::SortVals, nv), vals, "{label}");
+            assert_eq!(rd::<u32>(&gpu, ClusterBuf::SortKeys, nv), keys, "{label}");
+            assert_eq!(rd::<u32>(&gpu, ClusterBuf::SortVals, nv), vals, "{label}");
             let by_cluster = sort_on_both(
                 &mut gpu,
                 &label,
@@ -299,7 +322,7 @@ fn each_floating_stage_matches_its_cpu_twin() {
             );
             let clusters = cells_on_both(&mut gpu, &label, &by_cluster);
             assert_eq!(clusters as u32, head[nv], "{label}: a cluster per centre");
-            let vertex_cluster: Vec<u32> = rd(&gpu, CBuf::VertexCell, nv);
+            let vertex_cluster: Vec<u32> = rd(&gpu, ClusterBuf::VertexCell, nv);
             assert_eq!(
                 floating::clusters_of(&centre),
                 (vertex_cluster.clone(), clusters),
@@ -320,16 +343,16 @@ fn each_floating_stage_matches_its_cpu_twin() {
                 &locked_u32,
                 &centre,
                 &by_cluster.1,
-                &rd::<u32>(&gpu, CBuf::CellHead, nv + 1),
-                &rd::<u32>(&gpu, CBuf::CellStart, clusters + 1),
+                &rd::<u32>(&gpu, ClusterBuf::CellHead, nv + 1),
+                &rd::<u32>(&gpu, ClusterBuf::CellStart, clusters + 1),
                 &mut placed,
                 &mut quadric,
             );
             twins::check_placed(
                 &label,
-                &rd(&gpu, CBuf::ClusterPlaced, clusters),
+                &rd(&gpu, ClusterBuf::ClusterPlaced, clusters),
                 &placed,
-                &rd(&gpu, CBuf::ClusterQuadric, clusters),
+                &rd(&gpu, ClusterBuf::ClusterQuadric, clusters),
                 &quadric,
                 r,
             );
@@ -339,10 +362,10 @@ fn each_floating_stage_matches_its_cpu_twin() {
             let kept = f.face_origin.len();
             assert!(kept > 0, "{label}: some faces survive");
             assert_eq!(
-                rd::<u32>(&gpu, CBuf::ClusterFaces, 3 * kept),
+                rd::<u32>(&gpu, ClusterBuf::ClusterFaces, 3 * kept),
                 f.cluster_faces
             );
-            assert_eq!(rd::<u32>(&gpu, CBuf::FaceOrigin, kept), f.face_origin);
+            assert_eq!(rd::<u32>(&gpu, ClusterBuf::FaceOrigin, kept), f.face_origin);
             eprintln!("{label}: {rounds} rounds, {clusters} clusters, {kept} faces");
         }
     }
@@ -406,7 +429,7 @@ fn ranks_differing(gpu: &mut GpuClusterMesh, pos: &[[f32; 4]], faces: &[[u32; 3]
     gpu.run_fc_part(FcPart::Ranks).unwrap();
     let csr = stages::Csr::new(pos.len(), faces);
     let cpu = floating::ranks(&floating::grades(pos, faces, &csr));
-    let got: Vec<u32> = rd(gpu, CBuf::FcRank, pos.len());
+    let got: Vec<u32> = rd(gpu, ClusterBuf::FcRank, pos.len());
     got.iter()
         .zip(&cpu)
         .filter(|(g, c)| **g != (**c >> 32) as u32)
@@ -430,7 +453,7 @@ fn the_gpu_floating_build_equals_the_twins_chain() {
         if differ > 0 {
             eprintln!("{name}: {differ} ranks differ from the CPU's on this device");
         }
-        let grades: Vec<f32> = rd(&gpu, CBuf::FcGrade, pos.len());
+        let grades: Vec<f32> = rd(&gpu, ClusterBuf::FcGrade, pos.len());
         for r in radii {
             let label = format!("{name} at r = {r}");
             let (g, rounds) = gpu.build_floating(lo, hi, r).unwrap();

@@ -10,7 +10,7 @@
 //! backend the same rounds run as WGSL stages (`floating_gpu.rs`; their twins are test code,
 //! tests/cluster_twins/floating.rs).
 
-use super::grid::Grid;
+use super::grid::CellGrid;
 use super::stages::{self, Csr, Placed};
 use super::{
     Built, ClusterReport, Points, Work, check_backend, clustered_report, device_for, land, output,
@@ -113,14 +113,19 @@ pub fn radius(r: f32, v: u32) -> f32 {
 
 /// The hash grid of the rounds at nominal radius `r`: cells twice the largest radius wide, so
 /// two vertices within the sum of their radii lie in neighbouring cells.
-pub fn hash_grid(lo: V3, hi: V3, r: f32) -> Grid {
+pub fn hash_grid(lo: V3, hi: V3, r: f32) -> CellGrid {
     let r_max = r * (1.0 + 0.5 * JITTER);
-    Grid::new(lo, hi, 2.0 * r_max)
+    CellGrid::new(lo, hi, 2.0 * r_max)
 }
 
 /// The cells around `p`'s (3×3×3) present in `keys` (sorted, each once), as ranges of members
 /// (`start[i]..start[i + 1]` for cell `i`), nearest first, and how many there are.
-pub fn cells_around(grid: &Grid, keys: &[u32], start: &[u32], p: V3) -> ([(u32, u32); 27], usize) {
+pub fn cells_around(
+    grid: &CellGrid,
+    keys: &[u32],
+    start: &[u32],
+    p: V3,
+) -> ([(u32, u32); 27], usize) {
     let c = grid.coords(p);
     let mut out = [(0u32, 0u32); 27];
     let mut k = 0;

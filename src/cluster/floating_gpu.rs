@@ -9,10 +9,11 @@
 use super::floating::hash_grid;
 use super::gpu::{ClusterBuild, GpuClusterMesh, Part};
 use super::gpu_schedule::{
-    self as sched, CBuf, RANK_PASSES, ROUND_SLOTS, cluster_passes, float_params,
+    self as sched, ClusterBuf, RANK_PASSES, ROUND_SLOTS, cluster_passes, float_params,
 };
 use crate::compute::common::V3;
 use crate::compute::context::checked_buffer;
+use crate::compute::context::{STORAGE, UNIFORM};
 use crate::compute::gpu::ErrorScope;
 use crate::error::{Error, Result};
 
@@ -36,11 +37,6 @@ pub enum FcPart {
     Quadrics,
 }
 
-const SU: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
-    .union(wgpu::BufferUsages::COPY_DST)
-    .union(wgpu::BufferUsages::COPY_SRC);
-const UNIFORM: wgpu::BufferUsages = wgpu::BufferUsages::UNIFORM.union(wgpu::BufferUsages::COPY_DST);
-
 impl GpuClusterMesh<'_> {
     /// The floating cells' buffers, made on the first floating build of this mesh (a `cluster`
     /// run never pays for them).
@@ -54,15 +50,15 @@ impl GpuClusterMesh<'_> {
             checked_buffer(dev, &format!("meshslim.{label}"), size, usage)
         };
         for (buf, label, size) in [
-            (CBuf::FcGrade, "fc_grade", 4 * v),
-            (CBuf::FcRank, "fc_rank", 4 * v),
-            (CBuf::FcOrder, "fc_order", 4 * v),
-            (CBuf::FcCentre, "fc_centre", 4 * v),
-            (CBuf::FcDecided, "fc_decided", 4 * v),
-            (CBuf::FcHead, "fc_head", 4 * (v + 1)),
-            (CBuf::FcLive, "fc_live", 4 * ROUND_SLOTS as u64),
+            (ClusterBuf::FcGrade, "fc_grade", 4 * v),
+            (ClusterBuf::FcRank, "fc_rank", 4 * v),
+            (ClusterBuf::FcOrder, "fc_order", 4 * v),
+            (ClusterBuf::FcCentre, "fc_centre", 4 * v),
+            (ClusterBuf::FcDecided, "fc_decided", 4 * v),
+            (ClusterBuf::FcHead, "fc_head", 4 * (v + 1)),
+            (ClusterBuf::FcLive, "fc_live", 4 * ROUND_SLOTS as u64),
         ] {
-            let b = mk(label, size, SU)?;
+            let b = mk(label, size, STORAGE)?;
             self.bufs.insert(buf, b);
         }
         self.floats = (0..ROUND_SLOTS)
@@ -157,7 +153,7 @@ impl GpuClusterMesh<'_> {
                 self.record_fc(&mut enc, FcPart::Round(slot));
             }
             self.sim.queue.submit([enc.finish()]);
-            let live = self.read_many(&[(CBuf::FcLive, 0, 4 * ROUND_SLOTS as u64)])?;
+            let live = self.read_many(&[(ClusterBuf::FcLive, 0, 4 * ROUND_SLOTS as u64)])?;
             let live: Vec<u32> = bytemuck::pod_collect_to_vec(&live[0]);
             let busy = live.iter().take_while(|&&n| n > 0).count();
             rounds += busy;

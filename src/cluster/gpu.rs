@@ -5,10 +5,13 @@
 //! vertex→face lists and face planes ([`GpuClusterMesh::new`]); each build then records every pass
 //! in one command buffer and reads back two counts, then the result.
 
-use crate::cluster::gpu_schedule::{self as sched, CBuf, CCount, CGrid, CStage, CStep};
-use crate::cluster::grid::Grid;
+use crate::cluster::gpu_schedule::{
+    self as sched, ClusterBuf, ClusterCount, ClusterGrid, ClusterStage, ClusterStep,
+};
+use crate::cluster::grid::CellGrid;
 use crate::cluster::stages::{Placed, Placement};
 use crate::compute::common::xyz;
+use crate::compute::context::{STORAGE, UNIFORM};
 use crate::compute::context::{checked_buffer, checked_buffer_init};
 use crate::compute::gpu::{ErrorScope, Groups, Kernels, Pipelines, Runner};
 use crate::compute::types::*;
@@ -17,11 +20,6 @@ use crate::rounds::gpu::GpuMesh;
 use crate::rounds::gpu::simplifier::{DRAW_ARGS_USAGE, MESH_USAGE};
 use std::collections::HashMap;
 use std::time::Instant;
-
-const SU: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
-    .union(wgpu::BufferUsages::COPY_DST)
-    .union(wgpu::BufferUsages::COPY_SRC);
-const UNIFORM: wgpu::BufferUsages = wgpu::BufferUsages::UNIFORM.union(wgpu::BufferUsages::COPY_DST);
 
 /// Radix passes at most: 32-bit keys, 8 bits a pass.
 const MAX_PASSES: usize = 4;
@@ -89,24 +87,24 @@ pub struct GpuClusterMesh<'a> {
     pub(super) cluster: ClusterParams,
     /// The half holding the sort's current keys and values.
     cur: usize,
-    /// The radix pass a [`CBuf::Radix`] binding takes.
+    /// The radix pass a [`ClusterBuf::Radix`] binding takes.
     pass: usize,
     halves: [[wgpu::Buffer; 2]; 2],
     radix: Vec<wgpu::Buffer>,
     scans: [wgpu::Buffer; 3],
     /// The build's buffers; the floating cells' are added on their first build
     /// (`floating_gpu.rs`).
-    pub(super) bufs: HashMap<CBuf, wgpu::Buffer>,
-    /// The floating cells' uniforms, one per round slot ([`CBuf::Floating`]), empty until their
+    pub(super) bufs: HashMap<ClusterBuf, wgpu::Buffer>,
+    /// The floating cells' uniforms, one per round slot ([`ClusterBuf::Floating`]), empty until their
     /// first build.
     pub(super) floats: Vec<wgpu::Buffer>,
-    /// The round slot a [`CBuf::Floating`] binding takes.
+    /// The round slot a [`ClusterBuf::Floating`] binding takes.
     pub(super) slot: usize,
     /// Whether the floating cells' rank order has been sorted (once per mesh).
     pub(super) ranked: bool,
     /// The last build's cells and kept faces, and its grid.
     built: Option<(u32, u32)>,
-    grid: Option<Grid>,
+    grid: Option<CellGrid>,
     /// Upload, vertex→face lists and face planes: seconds.
     pub setup_seconds: f64,
 }
@@ -131,65 +129,29 @@ impl<'a> GpuClusterMesh<'a> {
             checked_buffer(dev, &format!("meshslim.{label}"), size, usage)
         };
         let init = |label: &str, data: &[u8]| {
-            checked_buffer_init(dev, &format!("meshslim.{label}"), data, data.len(), SU)
+            checked_buffer_init(dev, &format!("meshslim.{label}"), data, data.len(), STORAGE)
         };
         let locked_u32: Vec<u32> = locked.iter().map(|&l| l as u32).collect();
-        let longest_scan = (256 * blocks + 1).max(v + 1).max(f + 1);
         let mut bufs = HashMap::new();
-        for (buf, label, size, usage) in [
-            (CBuf::Cluster, "cluster", 48, UNIFORM),
-            (
-                CBuf::Params,
-                "params",
-                std::mem::size_of::<Params>() as u64,
-                UNIFORM,
-            ),
-            (
-                CBuf::BlockSums,
-                "block_sums",
-                4 * (longest_scan.div_ceil(1024) + 1),
-                SU,
-            ),
-            (
-                CBuf::DigitCounts,
-                "digit_counts",
-                4 * (256 * blocks + 1),
-                SU,
-            ),
-            (CBuf::CellHead, "cell_head", 4 * (v + 1), SU),
-            (CBuf::CellStart, "cell_start", 4 * (v + 1), SU),
-            (CBuf::VertexCell, "vertex_cell", 4 * v, SU),
-            (CBuf::CellKey, "cell_key", 4 * v, SU),
-            (CBuf::Offsets, "offsets", 4 * (v + 1), SU),
-            (CBuf::Cursor, "cursor", 4 * v, SU),
-            (CBuf::VertexFaces, "vertex_faces", 12 * f, SU),
-            (CBuf::FaceNormals, "face_normals", 16 * f, SU),
-            (CBuf::ClusterPlaced, "cluster_placed", 32 * v, SU),
-            (CBuf::ClusterQuadric, "cluster_quadric", 48 * v, SU),
-            (CBuf::FaceKey, "face_key", 12 * f, SU),
-            (CBuf::FaceKeep, "face_keep", 4 * (f + 1), SU),
-            (CBuf::BucketOffsets, "bucket_offsets", 4 * (v + 1), SU),
-            (CBuf::BucketCursor, "bucket_cursor", 4 * v, SU),
-            (CBuf::BucketFaces, "bucket_faces", 4 * f, SU),
-            (CBuf::ClusterFaces, "cluster_faces", 12 * f, MESH_USAGE),
-            (CBuf::MeshPositions, "mesh_positions", 16 * v, MESH_USAGE),
-            (CBuf::FaceOrigin, "face_origin", 4 * f, SU),
-        ] {
+        for (buf, label, size, usage) in buffer_sizes(v, f, blocks) {
             bufs.insert(buf, mk(label, size, usage)?);
         }
         bufs.insert(
-            CBuf::Positions,
+            ClusterBuf::Positions,
             init("positions", bytemuck::cast_slice(positions))?,
         );
-        bufs.insert(CBuf::Indices, init("indices", bytemuck::cast_slice(faces))?);
         bufs.insert(
-            CBuf::Locked,
+            ClusterBuf::Indices,
+            init("indices", bytemuck::cast_slice(faces))?,
+        );
+        bufs.insert(
+            ClusterBuf::Locked,
             init("locked", bytemuck::cast_slice(&locked_u32))?,
         );
         let half = |s: &str| -> Result<[wgpu::Buffer; 2]> {
             Ok([
-                mk(&format!("sort_keys{s}"), 4 * v, SU)?,
-                mk(&format!("sort_vals{s}"), 4 * v, SU)?,
+                mk(&format!("sort_keys{s}"), 4 * v, STORAGE)?,
+                mk(&format!("sort_vals{s}"), 4 * v, STORAGE)?,
             ])
         };
         let halves = [half("")?, half("_out")?];
@@ -201,23 +163,13 @@ impl<'a> GpuClusterMesh<'a> {
             mk("scan_f", 16, UNIFORM)?,
             mk("scan_d", 16, UNIFORM)?,
         ];
-        let q = &sim.queue;
-        let sp = |n: u64| ScanParams {
-            n: n as u32,
-            _pad: [0; 3],
-        };
-        q.write_buffer(&scans[0], 0, bytemuck::bytes_of(&sp(v)));
-        q.write_buffer(&scans[1], 0, bytemuck::bytes_of(&sp(f)));
-        q.write_buffer(&scans[2], 0, bytemuck::bytes_of(&sp(256 * blocks)));
-        let params = Params {
-            vertex_count: nv as u32,
-            face_count: nf as u32,
-            ..Default::default()
-        };
-        q.write_buffer(&bufs[&CBuf::Params], 0, bytemuck::bytes_of(&params));
-        for (p, b) in radix.iter().enumerate() {
-            q.write_buffer(b, 0, bytemuck::bytes_of(&sched::radix_params(nv, p as u32)));
-        }
+        write_params(
+            &sim.queue,
+            &scans,
+            &bufs[&ClusterBuf::Params],
+            &radix,
+            (nv, nf),
+        );
         let mut m = GpuClusterMesh {
             sim,
             nv,
@@ -240,17 +192,17 @@ impl<'a> GpuClusterMesh<'a> {
         let mut enc = dev.create_command_encoder(&Default::default());
         m.record(&mut enc, sched::ADJACENCY);
         m.record(&mut enc, sched::PLANES);
-        q.submit([enc.finish()]);
+        sim.queue.submit([enc.finish()]);
         scope.check("uploading the mesh for clustering")?;
         m.setup_seconds = t.elapsed().as_secs_f64();
         Ok(m)
     }
 
     /// Sets the grid of the next build (and rewinds the sort to `cell_keys`' half).
-    pub fn set_grid(&mut self, grid: &Grid) {
+    pub fn set_grid(&mut self, grid: &CellGrid) {
         self.cluster = sched::cluster_params(grid, self.nv, self.nf);
         self.cur = 0;
-        let c = &self.bufs[&CBuf::Cluster];
+        let c = &self.bufs[&ClusterBuf::Cluster];
         self.sim
             .queue
             .write_buffer(c, 0, bytemuck::bytes_of(&self.cluster));
@@ -292,7 +244,7 @@ impl<'a> GpuClusterMesh<'a> {
 
     /// Runs `steps` alone and waits for them (after [`Self::set_grid`] and the parts they
     /// read): what examples/cluster_gpu_stages.rs times stage by stage.
-    pub fn run_steps(&mut self, steps: &[CStep]) -> Result<()> {
+    pub fn run_steps(&mut self, steps: &[ClusterStep]) -> Result<()> {
         let scope = ErrorScope::push(&self.sim.device);
         let mut enc = self.sim.device.create_command_encoder(&Default::default());
         self.record(&mut enc, steps);
@@ -309,7 +261,7 @@ impl<'a> GpuClusterMesh<'a> {
     }
 
     /// One clustering at `grid`: every pass in one command buffer, then the result read back.
-    pub fn build(&mut self, grid: &Grid) -> Result<ClusterBuild> {
+    pub fn build(&mut self, grid: &CellGrid) -> Result<ClusterBuild> {
         let scope = ErrorScope::push(&self.sim.device);
         self.set_grid(grid);
         let mut enc = self
@@ -335,7 +287,10 @@ impl<'a> GpuClusterMesh<'a> {
     /// each vertex's cluster.
     pub(super) fn read_build(&mut self) -> Result<ClusterBuild> {
         let (nv, nf) = (self.nv as u64, self.nf as u64);
-        let counts = self.read_many(&[(CBuf::CellHead, 4 * nv, 4), (CBuf::FaceKeep, 4 * nf, 4)])?;
+        let counts = self.read_many(&[
+            (ClusterBuf::CellHead, 4 * nv, 4),
+            (ClusterBuf::FaceKeep, 4 * nf, 4),
+        ])?;
         let cells = u32::from_le_bytes(counts[0][..4].try_into().unwrap_or_default()) as u64;
         let kept = u32::from_le_bytes(counts[1][..4].try_into().unwrap_or_default()) as u64;
         assert!(cells <= nv && kept <= nf, "counts within their buffers");
@@ -343,11 +298,11 @@ impl<'a> GpuClusterMesh<'a> {
         self.built = Some((cells as u32, kept as u32));
         self.grid = None;
         let data = self.read_many(&[
-            (CBuf::ClusterPlaced, 0, 32 * cells),
-            (CBuf::ClusterQuadric, 0, 48 * cells),
-            (CBuf::ClusterFaces, 0, 12 * kept),
-            (CBuf::FaceOrigin, 0, 4 * kept),
-            (CBuf::VertexCell, 0, 4 * nv),
+            (ClusterBuf::ClusterPlaced, 0, 32 * cells),
+            (ClusterBuf::ClusterQuadric, 0, 48 * cells),
+            (ClusterBuf::ClusterFaces, 0, 12 * kept),
+            (ClusterBuf::FaceOrigin, 0, 4 * kept),
+            (ClusterBuf::VertexCell, 0, 4 * nv),
         ])?;
         let pod = |i: usize| -> &[u8] { &data[i] };
         Ok(ClusterBuild::from_buffers(
@@ -360,7 +315,7 @@ impl<'a> GpuClusterMesh<'a> {
     }
 
     /// The grid of the last build.
-    pub fn last_grid(&self) -> Option<Grid> {
+    pub fn last_grid(&self) -> Option<CellGrid> {
         self.grid
     }
 
@@ -389,41 +344,41 @@ impl<'a> GpuClusterMesh<'a> {
         )?;
         scope.check("making the clustering drawable")?;
         Ok(GpuMesh {
-            positions: self.bufs[&CBuf::MeshPositions].clone(),
-            indices: self.bufs[&CBuf::ClusterFaces].clone(),
+            positions: self.bufs[&ClusterBuf::MeshPositions].clone(),
+            indices: self.bufs[&ClusterBuf::ClusterFaces].clone(),
             draw_args,
             center,
             scale,
         })
     }
 
-    pub(super) fn record(&mut self, enc: &mut wgpu::CommandEncoder, steps: &[CStep]) {
+    pub(super) fn record(&mut self, enc: &mut wgpu::CommandEncoder, steps: &[ClusterStep]) {
         crate::compute::gpu::record(self, enc, steps)
     }
 
-    fn count(&self, c: CCount) -> u32 {
+    fn count(&self, c: ClusterCount) -> u32 {
         match c {
-            CCount::Vertices => self.nv as u32,
-            CCount::Faces => self.nf as u32,
-            CCount::Digits => 256 * (self.nv as u32).div_ceil(SORT_BLOCK),
+            ClusterCount::Vertices => self.nv as u32,
+            ClusterCount::Faces => self.nf as u32,
+            ClusterCount::Digits => 256 * (self.nv as u32).div_ceil(SORT_BLOCK),
         }
     }
 
     /// The first `bytes` of a working buffer as the schedule names it (the sort's names as the
     /// halves stand now): what the tests diff against the twins.
-    pub fn read_buffer(&self, buf: CBuf, bytes: u64) -> Result<Vec<u8>> {
+    pub fn read_buffer(&self, buf: ClusterBuf, bytes: u64) -> Result<Vec<u8>> {
         Ok(self.read_many(&[(buf, 0, bytes)])?.remove(0))
     }
 
     /// `(buffer, byte offset, bytes)` ranges read back through one staging buffer, one wait.
-    pub(super) fn read_many(&self, ranges: &[(CBuf, u64, u64)]) -> Result<Vec<Vec<u8>>> {
+    pub(super) fn read_many(&self, ranges: &[(ClusterBuf, u64, u64)]) -> Result<Vec<Vec<u8>>> {
         let dev = &self.sim.device;
         let scope = ErrorScope::push(dev);
         let out = self.read_ranges(ranges);
         scope.check_with("reading back the clustering", out)
     }
 
-    fn read_ranges(&self, ranges: &[(CBuf, u64, u64)]) -> Result<Vec<Vec<u8>>> {
+    fn read_ranges(&self, ranges: &[(ClusterBuf, u64, u64)]) -> Result<Vec<Vec<u8>>> {
         let dev = &self.sim.device;
         let total: u64 = ranges.iter().map(|r| r.2.next_multiple_of(4)).sum();
         let staging = dev.create_buffer(&wgpu::BufferDescriptor {
@@ -465,25 +420,122 @@ impl<'a> GpuClusterMesh<'a> {
     }
 }
 
-impl crate::compute::gpu::Runner<CBuf, CGrid, CCount, std::convert::Infallible>
+/// The build's working buffers, each with its label, size in bytes and usage, for `v`
+/// vertices, `f` faces and `blocks` radix-sort blocks.
+fn buffer_sizes(
+    v: u64,
+    f: u64,
+    blocks: u64,
+) -> Vec<(ClusterBuf, &'static str, u64, wgpu::BufferUsages)> {
+    let longest_scan = (256 * blocks + 1).max(v + 1).max(f + 1);
+    vec![
+        (ClusterBuf::Cluster, "cluster", 48, UNIFORM),
+        (
+            ClusterBuf::Params,
+            "params",
+            std::mem::size_of::<Params>() as u64,
+            UNIFORM,
+        ),
+        (
+            ClusterBuf::BlockSums,
+            "block_sums",
+            4 * (longest_scan.div_ceil(1024) + 1),
+            STORAGE,
+        ),
+        (
+            ClusterBuf::DigitCounts,
+            "digit_counts",
+            4 * (256 * blocks + 1),
+            STORAGE,
+        ),
+        (ClusterBuf::CellHead, "cell_head", 4 * (v + 1), STORAGE),
+        (ClusterBuf::CellStart, "cell_start", 4 * (v + 1), STORAGE),
+        (ClusterBuf::VertexCell, "vertex_cell", 4 * v, STORAGE),
+        (ClusterBuf::CellKey, "cell_key", 4 * v, STORAGE),
+        (ClusterBuf::Offsets, "offsets", 4 * (v + 1), STORAGE),
+        (ClusterBuf::Cursor, "cursor", 4 * v, STORAGE),
+        (ClusterBuf::VertexFaces, "vertex_faces", 12 * f, STORAGE),
+        (ClusterBuf::FaceNormals, "face_normals", 16 * f, STORAGE),
+        (ClusterBuf::ClusterPlaced, "cluster_placed", 32 * v, STORAGE),
+        (
+            ClusterBuf::ClusterQuadric,
+            "cluster_quadric",
+            48 * v,
+            STORAGE,
+        ),
+        (ClusterBuf::FaceKey, "face_key", 12 * f, STORAGE),
+        (ClusterBuf::FaceKeep, "face_keep", 4 * (f + 1), STORAGE),
+        (
+            ClusterBuf::BucketOffsets,
+            "bucket_offsets",
+            4 * (v + 1),
+            STORAGE,
+        ),
+        (ClusterBuf::BucketCursor, "bucket_cursor", 4 * v, STORAGE),
+        (ClusterBuf::BucketFaces, "bucket_faces", 4 * f, STORAGE),
+        (
+            ClusterBuf::ClusterFaces,
+            "cluster_faces",
+            12 * f,
+            MESH_USAGE,
+        ),
+        (
+            ClusterBuf::MeshPositions,
+            "mesh_positions",
+            16 * v,
+            MESH_USAGE,
+        ),
+        (ClusterBuf::FaceOrigin, "face_origin", 4 * f, STORAGE),
+    ]
+}
+
+/// The prefix sums' counts, the mesh's counts and each radix pass's parameters, written once.
+fn write_params(
+    q: &wgpu::Queue,
+    scans: &[wgpu::Buffer; 3],
+    params_buf: &wgpu::Buffer,
+    radix: &[wgpu::Buffer],
+    (nv, nf): (usize, usize),
+) {
+    let (v, f) = (nv as u64, nf as u64);
+    let blocks = (nv as u32).div_ceil(SORT_BLOCK) as u64;
+    let sp = |n: u64| ScanParams {
+        n: n as u32,
+        _pad: [0; 3],
+    };
+    q.write_buffer(&scans[0], 0, bytemuck::bytes_of(&sp(v)));
+    q.write_buffer(&scans[1], 0, bytemuck::bytes_of(&sp(f)));
+    q.write_buffer(&scans[2], 0, bytemuck::bytes_of(&sp(256 * blocks)));
+    let params = Params {
+        vertex_count: nv as u32,
+        face_count: nf as u32,
+        ..Default::default()
+    };
+    q.write_buffer(params_buf, 0, bytemuck::bytes_of(&params));
+    for (p, b) in radix.iter().enumerate() {
+        q.write_buffer(b, 0, bytemuck::bytes_of(&sched::radix_params(nv, p as u32)));
+    }
+}
+
+impl crate::compute::gpu::Runner<ClusterBuf, ClusterGrid, ClusterCount, std::convert::Infallible>
     for GpuClusterMesh<'_>
 {
     /// The buffer bound for `buf`; `scan` is the prefix sum's (count, data) when one runs.
-    fn buffer(&self, buf: CBuf, scan: Option<(CCount, CBuf)>) -> &wgpu::Buffer {
+    fn buffer(&self, buf: ClusterBuf, scan: Option<(ClusterCount, ClusterBuf)>) -> &wgpu::Buffer {
         match buf {
-            CBuf::SortKeys => &self.halves[self.cur][0],
-            CBuf::SortVals => &self.halves[self.cur][1],
-            CBuf::SortKeysOut => &self.halves[1 - self.cur][0],
-            CBuf::SortValsOut => &self.halves[1 - self.cur][1],
-            CBuf::Radix => &self.radix[self.pass],
-            CBuf::Floating => &self.floats[self.slot],
-            CBuf::ScanCount => match scan.map(|s| s.0) {
-                Some(CCount::Faces) => &self.scans[1],
-                Some(CCount::Digits) => &self.scans[2],
+            ClusterBuf::SortKeys => &self.halves[self.cur][0],
+            ClusterBuf::SortVals => &self.halves[self.cur][1],
+            ClusterBuf::SortKeysOut => &self.halves[1 - self.cur][0],
+            ClusterBuf::SortValsOut => &self.halves[1 - self.cur][1],
+            ClusterBuf::Radix => &self.radix[self.pass],
+            ClusterBuf::Floating => &self.floats[self.slot],
+            ClusterBuf::ScanCount => match scan.map(|s| s.0) {
+                Some(ClusterCount::Faces) => &self.scans[1],
+                Some(ClusterCount::Digits) => &self.scans[2],
                 _ => &self.scans[0],
             },
-            CBuf::ScanData => {
-                let data = scan.map_or(CBuf::CellHead, |s| s.1);
+            ClusterBuf::ScanData => {
+                let data = scan.map_or(ClusterBuf::CellHead, |s| s.1);
                 &self.bufs[&data]
             }
             other => &self.bufs[&other],
@@ -494,14 +546,14 @@ impl crate::compute::gpu::Runner<CBuf, CGrid, CCount, std::convert::Infallible>
     fn run(
         &mut self,
         enc: &mut wgpu::CommandEncoder,
-        stage: &'static CStage,
-        scan: Option<(CCount, CBuf)>,
+        stage: &'static ClusterStage,
+        scan: Option<(ClusterCount, ClusterBuf)>,
     ) {
         let groups = match stage.grid {
-            CGrid::Each(c) => self.count(c).div_ceil(WG),
-            CGrid::SortBlocks => (self.nv as u32).div_ceil(SORT_BLOCK),
-            CGrid::ScanBlocks => scan.map_or(0, |s| self.count(s.0)).div_ceil(SCAN_BLOCK),
-            CGrid::One => 1,
+            ClusterGrid::Each(c) => self.count(c).div_ceil(WG),
+            ClusterGrid::SortBlocks => (self.nv as u32).div_ceil(SORT_BLOCK),
+            ClusterGrid::ScanBlocks => scan.map_or(0, |s| self.count(s.0)).div_ceil(SCAN_BLOCK),
+            ClusterGrid::One => 1,
         };
         self.sim.kernels.pass(
             &self.sim.device,
@@ -518,7 +570,7 @@ impl crate::compute::gpu::Runner<CBuf, CGrid, CCount, std::convert::Infallible>
         match step {}
     }
 
-    fn prefix_sum(&self) -> [&'static CStage; 3] {
+    fn prefix_sum(&self) -> [&'static ClusterStage; 3] {
         sched::PREFIX_SUM
     }
 }

@@ -15,14 +15,14 @@
 /// the half a pass reads (and, after the sort, the sorted result), the `*Out` ones the half it
 /// writes; the runner swaps them after each pass.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum CBuf {
+pub enum ClusterBuf {
     /// [`crate::compute::types::ClusterParams`] (uniform).
     Cluster,
     /// The rounds' `Params` (uniform) with the vertex and face counts, for the adjacency stages.
     Params,
     /// The pass's [`crate::compute::types::RadixParams`] (uniform, one buffer per pass).
     Radix,
-    /// A prefix sum's count (uniform `ScanParams`); which one is the [`CStep::PrefixSum`]'s.
+    /// A prefix sum's count (uniform `ScanParams`); which one is the [`ClusterStep::PrefixSum`]'s.
     ScanCount,
     /// The values a prefix sum scans in place.
     ScanData,
@@ -70,7 +70,7 @@ pub enum CBuf {
 
 /// A count a stage or a prefix sum runs over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CCount {
+pub enum ClusterCount {
     Vertices,
     Faces,
     /// 256 digit counts per sort block.
@@ -79,8 +79,8 @@ pub enum CCount {
 
 /// What a stage's invocations run over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CGrid {
-    Each(CCount),
+pub enum ClusterGrid {
+    Each(ClusterCount),
     /// One workgroup per block of `SORT_BLOCK` keys.
     SortBlocks,
     /// One workgroup per `SCAN_BLOCK` elements of the prefix sum's count.
@@ -89,81 +89,87 @@ pub enum CGrid {
 }
 
 /// A stage of the clustering build: entry point `entry` in `shaders/<shader>.wgsl`.
-pub type CStage = crate::compute::schedule::Stage<CBuf, CGrid>;
+pub type ClusterStage = crate::compute::schedule::Stage<ClusterBuf, ClusterGrid>;
 
-use crate::cluster::grid::{Grid, SINGLETON};
+use crate::cluster::grid::{CellGrid, SINGLETON};
 use crate::compute::types::{ClusterParams, FloatParams, RadixParams, SORT_BLOCK};
-use CCount::{Faces, Vertices};
-use CGrid::{Each, SortBlocks};
+use ClusterCount::{Faces, Vertices};
+use ClusterGrid::{Each, SortBlocks};
 
 // The prefix sum, the vertex→face lists and the face planes: the core's, on these buffers.
-crate::compute::schedule::shared_stages!(CStage, CStep, CBuf, CGrid, CCount);
+crate::compute::schedule::shared_stages!(
+    ClusterStage,
+    ClusterStep,
+    ClusterBuf,
+    ClusterGrid,
+    ClusterCount
+);
 
-pub static CELL_KEYS: CStage = crate::stage!(CBuf; cell_keys in "cluster/cell_keys" over Each(Vertices);
+pub static CELL_KEYS: ClusterStage = crate::stage!(ClusterBuf; cell_keys in "cluster/cell_keys" over Each(Vertices);
     cluster: Uniform Cluster, positions: Read Positions, locked: Read Locked,
     sort_keys: ReadWrite SortKeys, sort_vals: ReadWrite SortVals);
-pub static RADIX_COUNT: CStage = crate::stage!(CBuf; radix_count in "cluster/radix_count" over SortBlocks;
+pub static RADIX_COUNT: ClusterStage = crate::stage!(ClusterBuf; radix_count in "cluster/radix_count" over SortBlocks;
     radix: Uniform Radix, keys: Read SortKeys, digit_counts: ReadWrite DigitCounts);
-pub static RADIX_SCATTER: CStage = crate::stage!(CBuf; radix_scatter in "cluster/radix_scatter" over SortBlocks;
+pub static RADIX_SCATTER: ClusterStage = crate::stage!(ClusterBuf; radix_scatter in "cluster/radix_scatter" over SortBlocks;
     radix: Uniform Radix, keys: Read SortKeys, vals: Read SortVals,
     digit_counts: Read DigitCounts, keys_out: ReadWrite SortKeysOut,
     vals_out: ReadWrite SortValsOut);
-pub static CELL_HEADS: CStage = crate::stage!(CBuf; cell_heads in "cluster/cell_heads" over Each(Vertices);
+pub static CELL_HEADS: ClusterStage = crate::stage!(ClusterBuf; cell_heads in "cluster/cell_heads" over Each(Vertices);
     cluster: Uniform Cluster, sort_keys: Read SortKeys, cell_head: ReadWrite CellHead);
-pub static CELL_RANGES: CStage = crate::stage!(CBuf; cell_ranges in "cluster/cell_ranges" over Each(Vertices);
+pub static CELL_RANGES: ClusterStage = crate::stage!(ClusterBuf; cell_ranges in "cluster/cell_ranges" over Each(Vertices);
     cluster: Uniform Cluster, cell_head: Read CellHead, sort_keys: Read SortKeys,
     sort_vals: Read SortVals, cell_start: ReadWrite CellStart,
     vertex_cell: ReadWrite VertexCell, cell_key: ReadWrite CellKey);
-pub static CLUSTER_QUADRICS: CStage = crate::stage!(CBuf; cluster_quadrics in "cluster/cluster_quadrics" over Each(Vertices);
+pub static CLUSTER_QUADRICS: ClusterStage = crate::stage!(ClusterBuf; cluster_quadrics in "cluster/cluster_quadrics" over Each(Vertices);
     cluster: Uniform Cluster, positions: Read Positions, indices: Read Indices,
     offsets: Read Offsets, vertex_faces: Read VertexFaces, face_normals: Read FaceNormals,
     sort_vals: Read SortVals, cell_head: Read CellHead, cell_start: Read CellStart,
     cell_key: Read CellKey, cluster_placed: ReadWrite ClusterPlaced,
     cluster_quadric: ReadWrite ClusterQuadric);
-pub static CLUSTER_FACES_MARK: CStage = crate::stage!(CBuf; cluster_faces_mark in "cluster/cluster_faces_mark" over Each(Faces);
+pub static CLUSTER_FACES_MARK: ClusterStage = crate::stage!(ClusterBuf; cluster_faces_mark in "cluster/cluster_faces_mark" over Each(Faces);
     cluster: Uniform Cluster, indices: Read Indices, vertex_cell: Read VertexCell,
     face_key: ReadWrite FaceKey, face_keep: ReadWrite FaceKeep,
     bucket_counts: ReadWrite BucketOffsets);
-pub static CLUSTER_FACES_FILL: CStage = crate::stage!(CBuf; cluster_faces_fill in "cluster/cluster_faces_fill" over Each(Faces);
+pub static CLUSTER_FACES_FILL: ClusterStage = crate::stage!(ClusterBuf; cluster_faces_fill in "cluster/cluster_faces_fill" over Each(Faces);
     cluster: Uniform Cluster, face_key: Read FaceKey, face_keep: Read FaceKeep,
     bucket_offsets: Read BucketOffsets, bucket_cursor: ReadWrite BucketCursor,
     bucket_faces: ReadWrite BucketFaces);
-pub static CLUSTER_FACES_DEDUPE: CStage = crate::stage!(CBuf; cluster_faces_dedupe in "cluster/cluster_faces_dedupe" over Each(Vertices);
+pub static CLUSTER_FACES_DEDUPE: ClusterStage = crate::stage!(ClusterBuf; cluster_faces_dedupe in "cluster/cluster_faces_dedupe" over Each(Vertices);
     cluster: Uniform Cluster, face_key: Read FaceKey, bucket_offsets: Read BucketOffsets,
     bucket_faces: ReadWrite BucketFaces, face_keep: ReadWrite FaceKeep);
-pub static CLUSTER_FACES_COMPACT: CStage = crate::stage!(CBuf; cluster_faces_compact in "cluster/cluster_faces_compact" over Each(Faces);
+pub static CLUSTER_FACES_COMPACT: ClusterStage = crate::stage!(ClusterBuf; cluster_faces_compact in "cluster/cluster_faces_compact" over Each(Faces);
     cluster: Uniform Cluster, face_key: Read FaceKey, face_keep: Read FaceKeep,
     cluster_faces: ReadWrite ClusterFaces, face_origin: ReadWrite FaceOrigin);
 
-pub static CLUSTER_MESH: CStage = crate::stage!(CBuf; cluster_mesh in "cluster/cluster_mesh" over Each(Vertices);
+pub static CLUSTER_MESH: ClusterStage = crate::stage!(ClusterBuf; cluster_mesh in "cluster/cluster_mesh" over Each(Vertices);
     cluster: Uniform Cluster, cell_head: Read CellHead, cluster_placed: Read ClusterPlaced,
     mesh_positions: ReadWrite MeshPositions);
-pub static FC_GRADES: CStage = crate::stage!(CBuf; fc_grades in "cluster/fc_grades" over Each(Vertices);
+pub static FC_GRADES: ClusterStage = crate::stage!(ClusterBuf; fc_grades in "cluster/fc_grades" over Each(Vertices);
     params: Uniform Params, positions: Read Positions, indices: Read Indices,
     offsets: Read Offsets, vertex_faces: Read VertexFaces, fc_grade: ReadWrite FcGrade);
-pub static FC_RANKS: CStage = crate::stage!(CBuf; fc_ranks in "cluster/fc_ranks" over Each(Vertices);
+pub static FC_RANKS: ClusterStage = crate::stage!(ClusterBuf; fc_ranks in "cluster/fc_ranks" over Each(Vertices);
     params: Uniform Params, fc_grade: Read FcGrade, fc_rank: ReadWrite FcRank,
     sort_keys: ReadWrite SortKeys, sort_vals: ReadWrite SortVals);
-pub static FC_KEYS: CStage = crate::stage!(CBuf; fc_keys in "cluster/fc_keys" over Each(Vertices);
+pub static FC_KEYS: ClusterStage = crate::stage!(ClusterBuf; fc_keys in "cluster/fc_keys" over Each(Vertices);
     cluster: Uniform Cluster, positions: Read Positions, fc_order: Read FcOrder,
     sort_keys: ReadWrite SortKeys, sort_vals: ReadWrite SortVals);
-pub static FC_INIT: CStage = crate::stage!(CBuf; fc_init in "cluster/fc_init" over Each(Vertices);
+pub static FC_INIT: ClusterStage = crate::stage!(ClusterBuf; fc_init in "cluster/fc_init" over Each(Vertices);
     cluster: Uniform Cluster, locked: Read Locked, fc_centre: ReadWrite FcCentre,
     fc_head: ReadWrite FcHead);
-pub static FC_DECIDE: CStage = crate::stage!(CBuf; fc_decide in "cluster/fc_decide" over Each(Vertices);
+pub static FC_DECIDE: ClusterStage = crate::stage!(ClusterBuf; fc_decide in "cluster/fc_decide" over Each(Vertices);
     cluster: Uniform Cluster, floating: Uniform Floating, positions: Read Positions,
     fc_rank: Read FcRank, sort_vals: Read SortVals, cell_head: Read CellHead,
     cell_start: Read CellStart, cell_key: Read CellKey, fc_centre: Read FcCentre,
     fc_decided: ReadWrite FcDecided, fc_live: ReadWrite FcLive);
-pub static FC_CLAIM: CStage = crate::stage!(CBuf; fc_claim in "cluster/fc_claim" over Each(Vertices);
+pub static FC_CLAIM: ClusterStage = crate::stage!(ClusterBuf; fc_claim in "cluster/fc_claim" over Each(Vertices);
     cluster: Uniform Cluster, floating: Uniform Floating, positions: Read Positions,
     sort_vals: Read SortVals, cell_head: Read CellHead, cell_start: Read CellStart,
     cell_key: Read CellKey, fc_decided: Read FcDecided, fc_centre: ReadWrite FcCentre,
     fc_head: ReadWrite FcHead);
-pub static FC_CLUSTER_KEYS: CStage = crate::stage!(CBuf; fc_cluster_keys in "cluster/fc_cluster_keys" over Each(Vertices);
+pub static FC_CLUSTER_KEYS: ClusterStage = crate::stage!(ClusterBuf; fc_cluster_keys in "cluster/fc_cluster_keys" over Each(Vertices);
     cluster: Uniform Cluster, fc_centre: Read FcCentre, fc_head: Read FcHead,
     sort_keys: ReadWrite SortKeys, sort_vals: ReadWrite SortVals);
-pub static FC_QUADRICS: CStage = crate::stage!(CBuf; fc_quadrics in "cluster/fc_quadrics" over Each(Vertices);
+pub static FC_QUADRICS: ClusterStage = crate::stage!(ClusterBuf; fc_quadrics in "cluster/fc_quadrics" over Each(Vertices);
     cluster: Uniform Cluster, floating: Uniform Floating, positions: Read Positions,
     indices: Read Indices, offsets: Read Offsets, vertex_faces: Read VertexFaces,
     face_normals: Read FaceNormals, locked: Read Locked, fc_centre: Read FcCentre,
@@ -171,9 +177,9 @@ pub static FC_QUADRICS: CStage = crate::stage!(CBuf; fc_quadrics in "cluster/fc_
     cluster_placed: ReadWrite ClusterPlaced, cluster_quadric: ReadWrite ClusterQuadric);
 
 /// Every stage, each once: the runner makes one pipeline per entry.
-pub const STAGES: &[&[&CStage]] = &[SHARED_STAGES, OWN_STAGES];
+pub const STAGES: &[&[&ClusterStage]] = &[SHARED_STAGES, OWN_STAGES];
 /// The family's own stages.
-const OWN_STAGES: &[&CStage] = &[
+const OWN_STAGES: &[&ClusterStage] = &[
     &CELL_KEYS,
     &RADIX_COUNT,
     &RADIX_SCATTER,
@@ -196,82 +202,83 @@ const OWN_STAGES: &[&CStage] = &[
 ];
 
 /// One step of a build; the clustering has no steps of its own.
-pub type CStep = crate::compute::schedule::Step<CBuf, CGrid, CCount, std::convert::Infallible>;
+pub type ClusterStep =
+    crate::compute::schedule::Step<ClusterBuf, ClusterGrid, ClusterCount, std::convert::Infallible>;
 
 use crate::compute::schedule::Step::{Clear, CopyBuffer, PrefixSum, Run};
 
 /// The face planes, once per mesh after [`ADJACENCY`] (the grid changes neither).
-pub const PLANES: &[CStep] = &[Run(&FACE_PLANES)];
+pub const PLANES: &[ClusterStep] = &[Run(&FACE_PLANES)];
 /// Per build: each vertex's cell key.
-pub const KEYS: &[CStep] = &[Run(&CELL_KEYS)];
+pub const KEYS: &[ClusterStep] = &[Run(&CELL_KEYS)];
 /// One radix pass (as many as the largest key needs); the halves swap after it.
-pub const SORT_PASS: &[CStep] = &[
+pub const SORT_PASS: &[ClusterStep] = &[
     Run(&RADIX_COUNT),
     PrefixSum {
-        count: CCount::Digits,
-        data: CBuf::DigitCounts,
+        count: ClusterCount::Digits,
+        data: ClusterBuf::DigitCounts,
     },
     Run(&RADIX_SCATTER),
 ];
 /// The cells of the sorted keys.
-pub const CELLS: &[CStep] = &[
+pub const CELLS: &[ClusterStep] = &[
     Run(&CELL_HEADS),
     PrefixSum {
         count: Vertices,
-        data: CBuf::CellHead,
+        data: ClusterBuf::CellHead,
     },
     Run(&CELL_RANGES),
 ];
 /// One cluster per cell: its quadric and vertex.
-pub const QUADRICS: &[CStep] = &[Run(&CLUSTER_QUADRICS)];
+pub const QUADRICS: &[ClusterStep] = &[Run(&CLUSTER_QUADRICS)];
 /// The faces between three clusters, repeats dropped, compacted in face order.
-pub const FACES: &[CStep] = &[
-    Clear(CBuf::BucketOffsets),
-    Clear(CBuf::BucketCursor),
+pub const FACES: &[ClusterStep] = &[
+    Clear(ClusterBuf::BucketOffsets),
+    Clear(ClusterBuf::BucketCursor),
     Run(&CLUSTER_FACES_MARK),
     PrefixSum {
         count: Vertices,
-        data: CBuf::BucketOffsets,
+        data: ClusterBuf::BucketOffsets,
     },
     Run(&CLUSTER_FACES_FILL),
     Run(&CLUSTER_FACES_DEDUPE),
     PrefixSum {
         count: Faces,
-        data: CBuf::FaceKeep,
+        data: ClusterBuf::FaceKeep,
     },
     Run(&CLUSTER_FACES_COMPACT),
 ];
 /// After a build, for a renderer: the clusters' vertices beside the compacted faces.
-pub const DRAWABLE: &[CStep] = &[Run(&CLUSTER_MESH)];
+pub const DRAWABLE: &[ClusterStep] = &[Run(&CLUSTER_MESH)];
 
 /// Floating cells, once per mesh: each vertex's grade and rank, and the rank sort's keys; then
 /// four [`SORT_PASS`]es (32-bit keys) and [`FLOATING_ORDER`].
-pub const FLOATING_RANKS: &[CStep] = &[Run(&FC_GRADES), Run(&FC_RANKS)];
+pub const FLOATING_RANKS: &[ClusterStep] = &[Run(&FC_GRADES), Run(&FC_RANKS)];
 /// The vertices by rank, kept from the rank sort (the halves are the builds' again after it).
-pub const FLOATING_ORDER: &[CStep] = &[CopyBuffer(CBuf::SortVals, CBuf::FcOrder)];
+pub const FLOATING_ORDER: &[ClusterStep] = &[CopyBuffer(ClusterBuf::SortVals, ClusterBuf::FcOrder)];
 /// Per build: the hash grid's keys in rank order and every vertex unclaimed (a locked one its
 /// own centre); then the [`SORT_PASS`]es and [`CELLS`].
-pub const FLOATING_KEYS: &[CStep] = &[Run(&FC_KEYS), Run(&FC_INIT)];
+pub const FLOATING_KEYS: &[ClusterStep] = &[Run(&FC_KEYS), Run(&FC_INIT)];
 /// The start of a batch of rounds: the slots' counters cleared.
-pub const FLOATING_BATCH: &[CStep] = &[Clear(CBuf::FcLive)];
+pub const FLOATING_BATCH: &[ClusterStep] = &[Clear(ClusterBuf::FcLive)];
 /// One round: the new centres, then their claims.
-pub const FLOATING_ROUND: &[CStep] = &[Run(&FC_DECIDE), Run(&FC_CLAIM)];
+pub const FLOATING_ROUND: &[ClusterStep] = &[Run(&FC_DECIDE), Run(&FC_CLAIM)];
 /// After the rounds: centres numbered in vertex order, every vertex keyed by its cluster; then
 /// the [`SORT_PASS`]es, [`CELLS`] (a cell per cluster, its members in vertex order),
 /// [`FLOATING_QUADRICS`] and [`FACES`].
-pub const FLOATING_CLUSTERS: &[CStep] = &[
+pub const FLOATING_CLUSTERS: &[ClusterStep] = &[
     PrefixSum {
         count: Vertices,
-        data: CBuf::FcHead,
+        data: ClusterBuf::FcHead,
     },
     Run(&FC_CLUSTER_KEYS),
 ];
 /// One vertex per floating cell.
-pub const FLOATING_QUADRICS: &[CStep] = &[Run(&FC_QUADRICS)];
+pub const FLOATING_QUADRICS: &[ClusterStep] = &[Run(&FC_QUADRICS)];
 
 /// Every part of a build, for the schedule's test.
 #[cfg(test)]
-const PARTS: &[&[CStep]] = &[
+const PARTS: &[&[ClusterStep]] = &[
     ADJACENCY,
     PLANES,
     KEYS,
@@ -292,7 +299,7 @@ const PARTS: &[&[CStep]] = &[
 // The uniforms the runner writes (and the twins in tests/cluster_twins take).
 
 /// The uniform of a build at `grid`.
-pub fn cluster_params(grid: &Grid, vertices: usize, faces: usize) -> ClusterParams {
+pub fn cluster_params(grid: &CellGrid, vertices: usize, faces: usize) -> ClusterParams {
     ClusterParams {
         lo_h: [grid.lo[0], grid.lo[1], grid.lo[2], grid.h],
         dims: [grid.dims[0], grid.dims[1], grid.dims[2], 0],
@@ -350,15 +357,15 @@ pub fn cluster_passes(vertices: usize) -> u32 {
 /// (`compute::tests`); a binding's variable names its buffer but for the roles listed here.
 #[cfg(test)]
 pub(crate) fn check_schedule() {
-    const ROLES: &[(&str, CBuf)] = &[
-        ("counts", CBuf::Offsets),
-        ("bucket_counts", CBuf::BucketOffsets),
-        ("keys", CBuf::SortKeys),
-        ("vals", CBuf::SortVals),
-        ("keys_out", CBuf::SortKeysOut),
-        ("vals_out", CBuf::SortValsOut),
-        ("scan", CBuf::ScanCount),
-        ("data", CBuf::ScanData),
+    const ROLES: &[(&str, ClusterBuf)] = &[
+        ("counts", ClusterBuf::Offsets),
+        ("bucket_counts", ClusterBuf::BucketOffsets),
+        ("keys", ClusterBuf::SortKeys),
+        ("vals", ClusterBuf::SortVals),
+        ("keys_out", ClusterBuf::SortKeysOut),
+        ("vals_out", ClusterBuf::SortValsOut),
+        ("scan", ClusterBuf::ScanCount),
+        ("data", ClusterBuf::ScanData),
     ];
     crate::compute::schedule::check::family("clustering", STAGES, ROLES, PARTS);
 }

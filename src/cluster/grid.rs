@@ -14,7 +14,7 @@ pub const MAX_CELLS: u32 = 1024;
 
 /// A grid of cubes of side `h` from `lo`, `dims` cells an axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Grid {
+pub struct CellGrid {
     pub lo: V3,
     pub h: f32,
     /// `1 / h`: cells are found by multiplying, which Vulkan rounds correctly where a division
@@ -24,16 +24,16 @@ pub struct Grid {
     pub dims: [u32; 3],
 }
 
-impl Grid {
+impl CellGrid {
     /// The grid of size `h` over the box `[lo, hi]`; `h` is raised to what 1024 cells an axis
     /// allow.
-    pub fn new(lo: V3, hi: V3, h: f32) -> Grid {
+    pub fn new(lo: V3, hi: V3, h: f32) -> CellGrid {
         let extent = (0..3).map(|i| hi[i] - lo[i]).fold(0.0f32, f32::max);
         let h = h
             .max(extent / (MAX_CELLS - 1) as f32)
             .max(f32::MIN_POSITIVE);
         let dims = [0, 1, 2].map(|i| (((hi[i] - lo[i]) / h).floor() as u32 + 1).min(MAX_CELLS));
-        Grid {
+        CellGrid {
             lo,
             h,
             inv_h: 1.0 / h,
@@ -110,7 +110,7 @@ fn unmorton(k: u32) -> [u32; 3] {
 /// took as long on the 1M scan (0.012 s) and six times as long on horse.
 ///
 /// Each vertex's cell in each of (at most four) `grids`, for [`probe_count`].
-pub fn probe_cells(grids: &[Grid], positions: &[[f32; 4]], locked: &[bool]) -> Vec<[u32; 4]> {
+pub fn probe_cells(grids: &[CellGrid], positions: &[[f32; 4]], locked: &[bool]) -> Vec<[u32; 4]> {
     assert!(grids.len() <= 4, "a probe counts four grids at most");
     let lo = grids.first().map_or([0.0; 3], |g| g.lo);
     assert!(
@@ -138,7 +138,7 @@ pub fn probe_cells(grids: &[Grid], positions: &[[f32; 4]], locked: &[bool]) -> V
             }
             let axis = |i: usize| {
                 let d = p[i] - lo[i];
-                // SAFETY: each `top` is `Grid::tops`' or 0.
+                // SAFETY: each `top` is `CellGrid::tops`' or 0.
                 [0, 1, 2, 3].map(|g| unsafe { cell_index(d * inv[g], top[i][g]) })
             };
             let (x, y, z) = (axis(0), axis(1), axis(2));
@@ -158,9 +158,9 @@ pub fn probe_count(cells: &[[u32; 4]], faces: &[[u32; 3]]) -> [usize; 4] {
             || [0usize; 4],
             |mut acc, (f, t)| {
                 // The faces' corners are scattered over the vertices: asked for ahead.
-                if let Some(ahead) = faces.get(f + crate::cache::AHEAD) {
+                if let Some(ahead) = faces.get(f + crate::prefetch::AHEAD) {
                     for &v in ahead {
-                        crate::cache::prefetch(cells, v as usize);
+                        crate::prefetch::prefetch(cells, v as usize);
                     }
                 }
                 let [a, b, c] = t.map(|v| cells[v as usize]);
@@ -203,8 +203,8 @@ pub fn fit(points: &[(f64, f64)], target: f64) -> Option<f64> {
 mod tests {
     use super::*;
 
-    /// What [`Grid::coords`] computed before [`cell_index`]: a saturating cast, then a clamp.
-    fn coords_by_casting(g: &Grid, p: V3) -> [u32; 3] {
+    /// What [`CellGrid::coords`] computed before [`cell_index`]: a saturating cast, then a clamp.
+    fn coords_by_casting(g: &CellGrid, p: V3) -> [u32; 3] {
         [0, 1, 2].map(|i| (((p[i] - g.lo[i]) * g.inv_h).max(0.0) as u32).min(g.dims[i] - 1))
     }
 
@@ -241,7 +241,7 @@ mod tests {
         let (lo, hi) = ([-0.3, 0.1, -0.05], [0.4, 0.35, 0.6]);
         // One cell an axis, a few, and the 1024 that cap the size.
         for h in [1.0, 0.09, 0.013, 1e-6] {
-            let g = Grid::new(lo, hi, h);
+            let g = CellGrid::new(lo, hi, h);
             for p in points(lo, hi) {
                 assert_eq!(g.coords(p), coords_by_casting(&g, p), "{p:?} in {g:?}");
             }
@@ -257,9 +257,9 @@ mod tests {
             .map(|[x, y, z]| [x, y, z, 1.0])
             .collect();
         let locked: Vec<bool> = (0..positions.len()).map(|v| v % 7 == 3).collect();
-        let all: Vec<Grid> = [0.011, 0.02, 0.05, 0.3]
+        let all: Vec<CellGrid> = [0.011, 0.02, 0.05, 0.3]
             .iter()
-            .map(|&h| Grid::new(lo, hi, h))
+            .map(|&h| CellGrid::new(lo, hi, h))
             .collect();
         // Fewer grids leave the other slots 0.
         for used in 1..=4 {

@@ -207,7 +207,7 @@ pub(crate) fn rounds_upload(
 
 #[cfg(test)]
 mod tests {
-    use super::super::grid::Grid;
+    use super::super::grid::CellGrid;
     use super::*;
 
     /// The border vertices are the grid's outline and none of its inside; a closed sphere has
@@ -264,14 +264,14 @@ mod tests {
     /// planes (with a border weight) at the grid's outline and nowhere inside it.
     #[test]
     fn the_gather_adds_border_planes_at_the_outline_only() {
-        use super::super::stages::{Csr, Surface, cluster_quadric, face_planes};
+        use super::super::stages::{ClusterSurface, Csr, cluster_quadric, face_planes};
         let g = crate::mesh::grid(9);
         let (positions, _, _) = super::super::unit_frame_points(&g);
         let csr = Csr::new(positions.len(), &g.triangles);
         let planes = face_planes(&positions, &g.triangles);
         let b = g.bounds().unwrap();
         let quadric = |v: usize, border_weight: f32| {
-            let s = Surface {
+            let s = ClusterSurface {
                 positions: &positions,
                 faces: &g.triangles,
                 planes: &planes,
@@ -302,7 +302,7 @@ mod tests {
         // Two sides of a seam: coincident vertices, joined by position.
         m.positions.push(m.positions[0]);
         let (positions, lo, hi) = super::super::unit_frame_points(&m);
-        let grid = Grid::new(lo, hi, 0.04);
+        let grid = CellGrid::new(lo, hi, 0.04);
         let keys = cell_keys(&grid, &positions, &vec![false; positions.len()]);
         let (sorted, members) = radix_sort(keys);
         let cells = cell_ranges(&sorted, members);

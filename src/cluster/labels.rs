@@ -166,7 +166,7 @@ const SMALL_CELL: usize = 16;
 
 #[cfg(test)]
 mod tests {
-    use super::super::grid::Grid;
+    use super::super::grid::CellGrid;
     use super::super::stages::{cell_keys, cell_ranges, radix_sort};
     use super::*;
 
@@ -192,7 +192,7 @@ mod tests {
         let nv = positions.len();
         let hi = [n as f32, n as f32, 0.0];
         for (h, large) in [(1.5f32, false), (7.0, true)] {
-            let grid = Grid::new([0.0; 3], hi, h);
+            let grid = CellGrid::new([0.0; 3], hi, h);
             let (sorted, members) = radix_sort(cell_keys(&grid, &positions, &vec![false; nv]));
             let cells = cell_ranges(&sorted, members);
             let largest = (0..cells.key.len())

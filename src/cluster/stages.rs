@@ -4,14 +4,14 @@
 //! walks its members in (key, id) order, a member its faces in id order), so the result does
 //! not depend on the thread count, and integer outputs depend on positions and keys alone.
 
-use super::grid::Grid;
+use super::grid::CellGrid;
 pub use super::grid::SINGLETON;
-use crate::cache::{AHEAD, prefetch};
 use crate::compute::common::{
     V3, add, cross, dot, length, quadric_add, quadric_eval, quadric_from_plane, quadric_shift,
     scale, sub, xyz,
 };
 use crate::compute::types::Quadric;
+use crate::prefetch::{AHEAD, prefetch};
 use rayon::prelude::*;
 
 /// The vertex→face lists (CSR): `faces_of(v) = vertex_faces[offsets[v]..offsets[v + 1]]`, each
@@ -77,7 +77,7 @@ pub fn face_plane(positions: &[[f32; 4]], t: &[u32; 3]) -> [f32; 4] {
 }
 
 /// `cell_keys`: per vertex, the Morton key of its cell, or [`SINGLETON`] for a locked vertex.
-pub fn cell_keys(grid: &Grid, positions: &[[f32; 4]], locked: &[bool]) -> Vec<u32> {
+pub fn cell_keys(grid: &CellGrid, positions: &[[f32; 4]], locked: &[bool]) -> Vec<u32> {
     positions
         .par_iter()
         .zip(locked)
@@ -281,7 +281,7 @@ pub struct Placed {
 }
 
 /// What `cluster_quadrics` reads.
-pub struct Surface<'a> {
+pub struct ClusterSurface<'a> {
     pub positions: &'a [[f32; 4]],
     pub faces: &'a [[u32; 3]],
     pub planes: &'a [[f32; 4]],
@@ -298,7 +298,7 @@ const REGULARISE: f32 = 1e-3;
 /// `cluster_quadrics`, the gather: the cluster's quadric from its members' faces (each face
 /// once per member corner, area-weighted, as the sum of the members' vertex quadrics would be)
 /// and the border planes at its members, relative to the cell centre `o`; then [`place`].
-pub fn cluster_quadric(s: &Surface, members: &[u32], o: V3, lo: V3, hi: V3) -> Placed {
+pub fn cluster_quadric(s: &ClusterSurface, members: &[u32], o: V3, lo: V3, hi: V3) -> Placed {
     if members.len() == 1 {
         let p = xyz(s.positions[members[0] as usize]);
         return place(s.positions, gather(s, members, p), members, p, p, p);
@@ -451,21 +451,21 @@ pub fn scatter_quadrics(
 }
 
 /// Σ over members and their faces of the face planes (and border planes), relative to `o`.
-fn gather(s: &Surface, members: &[u32], o: V3) -> Quadric {
+fn gather(s: &ClusterSurface, members: &[u32], o: V3) -> Quadric {
     let mut q = Quadric::default();
     // The members' faces are scattered through the mesh: every face's plane and corners asked
     // of the cache first, then the first corners' positions, then the sums, so the loads
-    // overlap instead of each waiting on the last. On the 1M scan at 10% (`hybrid`, two cores,
-    // median of 20 builds) the placements took 0.049 s before, 0.043 s after.
+    // overlap instead of each waiting on the last (on the 1M scan at 10%, `hybrid`, 12% off the
+    // placements' time, median of 20 builds).
     for &m in members {
         for &f in s.csr.faces_of(m) {
-            crate::cache::prefetch(s.planes, f as usize);
-            crate::cache::prefetch(s.faces, f as usize);
+            crate::prefetch::prefetch(s.planes, f as usize);
+            crate::prefetch::prefetch(s.faces, f as usize);
         }
     }
     for &m in members {
         for &f in s.csr.faces_of(m) {
-            crate::cache::prefetch(s.positions, s.faces[f as usize][0] as usize);
+            crate::prefetch::prefetch(s.positions, s.faces[f as usize][0] as usize);
         }
     }
     for &m in members {
@@ -544,7 +544,7 @@ pub fn on_border(faces: &[[u32; 3]], list: &[u32], v: u32) -> bool {
 const SMALL_FAN: usize = 16;
 
 /// Whether two or more faces of `list` contain `u`.
-fn on_two_faces(s: &Surface, list: &[u32], u: u32) -> bool {
+fn on_two_faces(s: &ClusterSurface, list: &[u32], u: u32) -> bool {
     list.iter()
         .filter(|&&g| s.faces[g as usize].contains(&u))
         .nth(1)

@@ -12,7 +12,7 @@ use meshslim::cluster::gpu::ClusterBuild;
 use meshslim::cluster::gpu_schedule::{
     RANK_PASSES, ROUND_SLOTS, cluster_params, cluster_passes, float_params,
 };
-use meshslim::cluster::grid::Grid;
+use meshslim::cluster::grid::CellGrid;
 use meshslim::cluster::stages::{self, Csr};
 use meshslim::compute::common::{V3, dot, sub, xyz};
 use meshslim::compute::types::{ClusterParams, ClusterPlaced, FloatParams, Params, Quadric};
@@ -246,7 +246,7 @@ pub struct Round {
 /// Every buffer of a floating-cell build on the CPU, as each stage leaves it.
 pub struct FloatBuild {
     pub cluster: ClusterParams,
-    pub grid: Grid,
+    pub grid: CellGrid,
     pub grades: Vec<f32>,
     pub ranks: Vec<u32>,
     /// `fc_ranks`' keys and values, then the rank sort's passes.

@@ -13,16 +13,16 @@ pub mod floating;
 
 use meshslim::cluster::gpu::ClusterBuild;
 use meshslim::cluster::gpu_schedule::{cluster_params, radix_params, radix_passes};
-use meshslim::cluster::grid::{Grid, SINGLETON};
-use meshslim::cluster::stages::{self, Csr, Placed, Placement, Surface};
+use meshslim::cluster::grid::{CellGrid, SINGLETON};
+use meshslim::cluster::stages::{self, ClusterSurface, Csr, Placed, Placement};
 use meshslim::compute::common::{quadric_eval, quadric_shift, sub, xyz};
 use meshslim::compute::types::{
     ClusterParams, ClusterPlaced, Quadric, RadixParams, SORT_BLOCK, place,
 };
 use meshslim::rounds::cpu::prefix_sum::prefix_sum;
 
-pub fn grid_of(c: &ClusterParams) -> Grid {
-    Grid {
+pub fn grid_of(c: &ClusterParams) -> CellGrid {
+    CellGrid {
         lo: [c.lo_h[0], c.lo_h[1], c.lo_h[2]],
         h: c.lo_h[3],
         inv_h: c.inv_h,
@@ -178,8 +178,8 @@ pub(super) fn gather_surface<'a>(
     indices: &'a [u32],
     face_normals: &'a [[f32; 4]],
     csr: &'a Csr,
-) -> Surface<'a> {
-    Surface {
+) -> ClusterSurface<'a> {
+    ClusterSurface {
         positions,
         faces: bytemuck::cast_slice(&indices[..3 * cluster.face_count as usize]),
         planes: face_normals,
@@ -452,7 +452,12 @@ pub fn faces(c: &ClusterParams, indices: &[u32], vertex_cell: &[u32]) -> FacesOu
 }
 
 /// The whole build through the twins, stage by stage.
-pub fn run(positions: &[[f32; 4]], faces: &[[u32; 3]], locked: &[bool], grid: &Grid) -> CpuBuild {
+pub fn run(
+    positions: &[[f32; 4]],
+    faces: &[[u32; 3]],
+    locked: &[bool],
+    grid: &CellGrid,
+) -> CpuBuild {
     let (nv, nf) = (positions.len(), faces.len());
     let indices: &[u32] = bytemuck::cast_slice(faces);
     let c = cluster_params(grid, nv, nf);
