@@ -1,6 +1,7 @@
 //! The report presented: the table on stdout, the error-against-time plot as SVG, and that SVG
 //! rendered to PNG.
 
+use std::fmt::Write as _;
 use std::io::Write;
 
 use super::backends::BACKENDS;
@@ -271,7 +272,26 @@ fn tick_label(m: f64, e: f64) -> String {
 /// marker shape and colour per backend, each backend's markers in one
 /// `<g class="series" data-backend="NAME">` group. Rows without an error are left out.
 pub fn plot_svg(report: &Report) -> String {
-    use std::fmt::Write as _;
+    let (ratios, backends, meshes) = distinct_keys(report);
+    let points: Vec<&Row> = report
+        .rows
+        .iter()
+        .filter(|r| r.mean_err_rel.is_some_and(|e| e > 0.0) && r.median_s > 0.0)
+        .collect();
+    let plot = Plot::new(&points, ratios.len());
+    let mut s = String::new();
+    write_heading(&mut s, &plot, report, &meshes);
+    for (i, &ratio) in ratios.iter().enumerate() {
+        write_panel(&mut s, &plot, report, i, ratio);
+    }
+    write_series(&mut s, &plot, &points, &ratios, &backends, meshes.len() > 1);
+    write_legend(&mut s, &plot, &backends);
+    let _ = writeln!(s, "</svg>");
+    s
+}
+
+/// The ratios, backends and meshes of the rows, each in order of first appearance.
+fn distinct_keys(report: &Report) -> (Vec<f64>, Vec<&str>, Vec<&str>) {
     let mut ratios: Vec<f64> = Vec::new();
     let mut backends: Vec<&str> = Vec::new();
     let mut meshes: Vec<&str> = Vec::new();
@@ -286,21 +306,85 @@ pub fn plot_svg(report: &Report) -> String {
             meshes.push(&r.mesh);
         }
     }
-    let points: Vec<&Row> = report
-        .rows
-        .iter()
-        .filter(|r| r.mean_err_rel.is_some_and(|e| e > 0.0) && r.median_s > 0.0)
-        .collect();
-    let (x0, x1) = log_range(points.iter().map(|r| r.median_s));
-    let (y0, y1) = log_range(points.iter().filter_map(|r| r.mean_err_rel));
+    (ratios, backends, meshes)
+}
 
-    let (pw, ph) = (400.0, 330.0); // one panel, plot area and its margins
-    let (ml, mr, mt, mb) = (78.0, 18.0, 76.0, 52.0);
-    let legend_w = 190.0;
-    let n = ratios.len().max(1) as f64;
+/// The plot's geometry: the axes' decade ranges, one panel's plot area and its margins, and the
+/// number of panels.
+#[derive(Clone, Copy)]
+struct Plot {
+    /// log10 of the time axis' ends.
+    x0: f64,
+    x1: f64,
+    /// log10 of the error axis' ends.
+    y0: f64,
+    y1: f64,
+    pw: f64,
+    ph: f64,
+    ml: f64,
+    mr: f64,
+    mt: f64,
+    mb: f64,
+    legend_w: f64,
+    /// The number of panels (at least one).
+    n: f64,
+}
+
+impl Plot {
+    /// The geometry for `points` in `panels` panels.
+    fn new(points: &[&Row], panels: usize) -> Plot {
+        let (x0, x1) = log_range(points.iter().map(|r| r.median_s));
+        let (y0, y1) = log_range(points.iter().filter_map(|r| r.mean_err_rel));
+        Plot {
+            x0,
+            x1,
+            y0,
+            y1,
+            pw: 400.0,
+            ph: 330.0,
+            ml: 78.0,
+            mr: 18.0,
+            mt: 76.0,
+            mb: 52.0,
+            legend_w: 190.0,
+            n: panels.max(1) as f64,
+        }
+    }
+
+    /// The x of time `t` in panel `panel`.
+    fn px(&self, panel: usize, t: f64) -> f64 {
+        panel as f64 * (self.ml + self.pw + self.mr)
+            + self.ml
+            + (t.log10() - self.x0) / (self.x1 - self.x0) * self.pw
+    }
+
+    /// The y of error `e`.
+    fn py(&self, e: f64) -> f64 {
+        self.mt + self.ph - (e.log10() - self.y0) / (self.y1 - self.y0) * self.ph
+    }
+
+    /// The x of panel `i`'s plot area's left edge.
+    fn left(&self, i: usize) -> f64 {
+        i as f64 * (self.ml + self.pw + self.mr) + self.ml
+    }
+}
+
+/// The `<svg>` element, the white background, the title and the line naming the meshes and the
+/// machine.
+fn write_heading(s: &mut String, plot: &Plot, report: &Report, meshes: &[&str]) {
+    let Plot {
+        pw,
+        ph,
+        ml,
+        mr,
+        mt,
+        mb,
+        legend_w,
+        n,
+        ..
+    } = *plot;
     let width = n * (ml + pw + mr) + legend_w;
     let height = mt + ph + mb;
-    let mut s = String::new();
     let _ = writeln!(
         s,
         r##"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}" font-family="DejaVu Sans, Helvetica, Arial, sans-serif" font-size="12">"##
@@ -321,108 +405,138 @@ pub fn plot_svg(report: &Report) -> String {
         report.machine.cores,
         report.repeat
     );
-    let px = |panel: usize, t: f64| {
-        panel as f64 * (ml + pw + mr) + ml + (t.log10() - x0) / (x1 - x0) * pw
-    };
-    let py = |e: f64| mt + ph - (e.log10() - y0) / (y1 - y0) * ph;
-    let many = |lo: f64, hi: f64| hi - lo <= 2.0;
-    for (i, &ratio) in ratios.iter().enumerate() {
-        let left = i as f64 * (ml + pw + mr) + ml;
-        let faces: Vec<usize> = report
-            .rows
-            .iter()
-            .filter(|r| r.ratio == ratio)
-            .map(|r| r.target_faces)
-            .fold(Vec::new(), |mut v, f| {
-                if !v.contains(&f) {
-                    v.push(f);
-                }
-                v
-            });
-        let title = if faces.len() == 1 {
-            format!("ratio {ratio} (target {} faces)", faces[0])
-        } else {
-            format!("ratio {ratio}")
-        };
-        let _ = writeln!(
-            s,
-            r##"<text x="{:.1}" y="{:.1}" text-anchor="middle" font-size="14" font-weight="bold">{}</text>"##,
-            left + pw / 2.0,
-            mt - 10.0,
-            xml(&title)
-        );
-        // Grid: every decade labelled; minor lines at 2..9, labelled at 2 and 5 when the axis
-        // spans few decades, so that a narrow range still has numbers to read.
-        for (lo, hi, vertical) in [(x0, x1, true), (y0, y1, false)] {
-            let mut e = lo;
-            while e <= hi {
-                for m in 1..10 {
-                    let v = m as f64 * 10f64.powf(e);
-                    if v.log10() > hi + 1e-9 {
-                        break;
-                    }
-                    let major = m == 1;
-                    let labelled = major || (many(lo, hi) && (m == 2 || m == 5));
-                    let colour = if major { "#bbb" } else { "#e6e6e6" };
-                    let label = tick_label(m as f64, e);
-                    if vertical {
-                        let x = px(i, v);
-                        let _ = writeln!(
-                            s,
-                            r##"<line x1="{x:.1}" y1="{mt}" x2="{x:.1}" y2="{:.1}" stroke="{colour}"/>"##,
-                            mt + ph
-                        );
-                        if labelled {
-                            let _ = writeln!(
-                                s,
-                                r##"<text x="{x:.1}" y="{:.1}" text-anchor="middle" fill="#333">{label}</text>"##,
-                                mt + ph + 16.0
-                            );
-                        }
-                    } else {
-                        let y = py(v);
-                        let _ = writeln!(
-                            s,
-                            r##"<line x1="{left:.1}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="{colour}"/>"##,
-                            left + pw
-                        );
-                        if labelled {
-                            let _ = writeln!(
-                                s,
-                                r##"<text x="{:.1}" y="{:.1}" text-anchor="end" fill="#333">{label}</text>"##,
-                                left - 6.0,
-                                y + 4.0
-                            );
-                        }
-                    }
-                }
-                e += 1.0;
+}
+
+/// Panel `i`, for `ratio`: its title (with the target face count when the rows agree on one),
+/// grid, frame and axis labels.
+fn write_panel(s: &mut String, plot: &Plot, report: &Report, i: usize, ratio: f64) {
+    let Plot { pw, ph, mt, .. } = *plot;
+    let left = plot.left(i);
+    let faces: Vec<usize> = report
+        .rows
+        .iter()
+        .filter(|r| r.ratio == ratio)
+        .map(|r| r.target_faces)
+        .fold(Vec::new(), |mut v, f| {
+            if !v.contains(&f) {
+                v.push(f);
             }
+            v
+        });
+    let title = if faces.len() == 1 {
+        format!("ratio {ratio} (target {} faces)", faces[0])
+    } else {
+        format!("ratio {ratio}")
+    };
+    let _ = writeln!(
+        s,
+        r##"<text x="{:.1}" y="{:.1}" text-anchor="middle" font-size="14" font-weight="bold">{}</text>"##,
+        left + pw / 2.0,
+        mt - 10.0,
+        xml(&title)
+    );
+    write_grid(s, plot, i);
+    let _ = writeln!(
+        s,
+        r##"<rect x="{left:.1}" y="{mt}" width="{pw}" height="{ph}" fill="none" stroke="#333"/>"##
+    );
+    let _ = writeln!(
+        s,
+        r##"<text x="{:.1}" y="{:.1}" text-anchor="middle">median simplify time (s)</text>"##,
+        left + pw / 2.0,
+        mt + ph + 38.0
+    );
+    let (lx, ly) = (left - 58.0, mt + ph / 2.0);
+    let _ = writeln!(
+        s,
+        r##"<text x="{lx:.1}" y="{ly:.1}" text-anchor="middle" transform="rotate(-90 {lx:.1} {ly:.1})">mean two-sided error / bbox diagonal</text>"##
+    );
+}
+
+/// Panel `i`'s grid: every decade labelled; minor lines at 2..9, labelled at 2 and 5 when the
+/// axis spans few decades, so that a narrow range still has numbers to read.
+fn write_grid(s: &mut String, plot: &Plot, i: usize) {
+    let Plot {
+        x0,
+        x1,
+        y0,
+        y1,
+        pw,
+        ph,
+        mt,
+        ..
+    } = *plot;
+    let left = plot.left(i);
+    let many = |lo: f64, hi: f64| hi - lo <= 2.0;
+    for (lo, hi, vertical) in [(x0, x1, true), (y0, y1, false)] {
+        let mut e = lo;
+        while e <= hi {
+            for m in 1..10 {
+                let v = m as f64 * 10f64.powf(e);
+                if v.log10() > hi + 1e-9 {
+                    break;
+                }
+                let major = m == 1;
+                let labelled = major || (many(lo, hi) && (m == 2 || m == 5));
+                let colour = if major { "#bbb" } else { "#e6e6e6" };
+                let label = tick_label(m as f64, e);
+                if vertical {
+                    let x = plot.px(i, v);
+                    let _ = writeln!(
+                        s,
+                        r##"<line x1="{x:.1}" y1="{mt}" x2="{x:.1}" y2="{:.1}" stroke="{colour}"/>"##,
+                        mt + ph
+                    );
+                    if labelled {
+                        let _ = writeln!(
+                            s,
+                            r##"<text x="{x:.1}" y="{:.1}" text-anchor="middle" fill="#333">{label}</text>"##,
+                            mt + ph + 16.0
+                        );
+                    }
+                } else {
+                    let y = plot.py(v);
+                    let _ = writeln!(
+                        s,
+                        r##"<line x1="{left:.1}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="{colour}"/>"##,
+                        left + pw
+                    );
+                    if labelled {
+                        let _ = writeln!(
+                            s,
+                            r##"<text x="{:.1}" y="{:.1}" text-anchor="end" fill="#333">{label}</text>"##,
+                            left - 6.0,
+                            y + 4.0
+                        );
+                    }
+                }
+            }
+            e += 1.0;
         }
-        let _ = writeln!(
-            s,
-            r##"<rect x="{left:.1}" y="{mt}" width="{pw}" height="{ph}" fill="none" stroke="#333"/>"##
-        );
-        let _ = writeln!(
-            s,
-            r##"<text x="{:.1}" y="{:.1}" text-anchor="middle">median simplify time (s)</text>"##,
-            left + pw / 2.0,
-            mt + ph + 38.0
-        );
-        let (lx, ly) = (left - 58.0, mt + ph / 2.0);
-        let _ = writeln!(
-            s,
-            r##"<text x="{lx:.1}" y="{ly:.1}" text-anchor="middle" transform="rotate(-90 {lx:.1} {ly:.1})">mean two-sided error / bbox diagonal</text>"##
-        );
     }
-    for backend in &backends {
+}
+
+/// Each backend's markers, in its panel, in one `<g class="series">` group; each marker named by
+/// its mesh when there are several.
+fn write_series(
+    s: &mut String,
+    plot: &Plot,
+    points: &[&Row],
+    ratios: &[f64],
+    backends: &[&str],
+    name_meshes: bool,
+) {
+    for backend in backends {
         let (shape, colour) = style(backend);
         let _ = writeln!(s, r##"<g class="series" data-backend="{}">"##, xml(backend));
         for r in points.iter().filter(|r| r.backend == *backend) {
             let panel = ratios.iter().position(|&q| q == r.ratio).unwrap_or(0);
-            let (x, y) = (px(panel, r.median_s), py(r.mean_err_rel.unwrap_or(0.0)));
+            let (x, y) = (
+                plot.px(panel, r.median_s),
+                plot.py(r.mean_err_rel.unwrap_or(0.0)),
+            );
             let _ = writeln!(s, "{}", marker(shape, x, y, colour));
-            if meshes.len() > 1 {
+            if name_meshes {
                 let _ = writeln!(
                     s,
                     r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#555">{}</text>"##,
@@ -434,6 +548,13 @@ pub fn plot_svg(report: &Report) -> String {
         }
         let _ = writeln!(s, "</g>");
     }
+}
+
+/// The legend right of the panels: a marker and the name of each backend.
+fn write_legend(s: &mut String, plot: &Plot, backends: &[&str]) {
+    let Plot {
+        pw, ml, mr, mt, n, ..
+    } = *plot;
     let lx = n * (ml + pw + mr) + 10.0;
     let _ = writeln!(
         s,
@@ -452,8 +573,6 @@ pub fn plot_svg(report: &Report) -> String {
             xml(backend)
         );
     }
-    let _ = writeln!(s, "</svg>");
-    s
 }
 
 /// Renders an SVG (the plot) to PNG bytes with resvg, text in the system's fonts.

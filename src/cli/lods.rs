@@ -357,10 +357,35 @@ pub(super) fn run_pareto(args: ParetoArgs) -> Result<ExitCode> {
     make_outdir(&args.outdir)?;
     let progress = Progress::new(!(args.quiet || args.json) && std::io::stderr().is_terminal());
     let mesh = load(&args.input, &progress)?;
+    let opts = pareto_options(&args);
+    let t = Instant::now();
+    let run = progress
+        .bar("searching", |set| {
+            lod::pareto_front(&mesh, &opts, &mut |f| set(f))
+        })
+        .map_err(lib)
+        .context("cannot search the Pareto front")?;
+    let search_s = t.elapsed().as_secs_f64();
+    let members = write_members(&args, &run, (&stem, &ext))?;
+    let out = pareto_manifest(&args, &opts, &run, members, search_s);
+    let json_path = args.outdir.join(format!("{stem}.pareto.json"));
+    write_json(&json_path, &out)?;
+    let svg_path = write_fronts_svg(&args, &run, &stem)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    }
+    if !args.quiet {
+        print_pareto_summary(&args, &run, search_s, (&json_path, &svg_path));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The search's options from the command line.
+fn pareto_options(args: &ParetoArgs) -> ParetoOptions {
     let mut engine = SimplifyOptions::with_faces(0);
     engine.feature_angle_deg = args.feature_angle;
     engine.removal = args.removal.removal();
-    let opts = ParetoOptions {
+    ParetoOptions {
         population: args.population,
         generations: args.generations,
         offspring: args.offspring,
@@ -385,16 +410,16 @@ pub(super) fn run_pareto(args: ParetoArgs) -> Result<ExitCode> {
         search_samples: args.search_samples,
         measure: !args.no_measure,
         engine,
-    };
-    let t = Instant::now();
-    let run = progress
-        .bar("searching", |set| {
-            lod::pareto_front(&mesh, &opts, &mut |f| set(f))
-        })
-        .map_err(lib)
-        .context("cannot search the Pareto front")?;
-    let search_s = t.elapsed().as_secs_f64();
+    }
+}
 
+/// Each member of the front written beside the input's name (and the greedy chain's mesh at its
+/// vertex count with --write-baseline), as the manifest lists them.
+fn write_members(
+    args: &ParetoArgs,
+    run: &lod::ParetoRun,
+    (stem, ext): (&str, &str),
+) -> Result<Vec<manifest::MemberEntry>> {
     let mut members = Vec::new();
     for (k, (c, m)) in run.front.iter().zip(&run.front_measured).enumerate() {
         let file = args
@@ -422,6 +447,17 @@ pub(super) fn run_pareto(args: ParetoArgs) -> Result<ExitCode> {
             greedy_at_same_vertices: greedy,
         });
     }
+    Ok(members)
+}
+
+/// The manifest of the run: options, every generation's front and hypervolume, the members.
+fn pareto_manifest(
+    args: &ParetoArgs,
+    opts: &ParetoOptions,
+    run: &lod::ParetoRun,
+    members: Vec<manifest::MemberEntry>,
+    search_s: f64,
+) -> manifest::ParetoManifest {
     let measured = !run.baseline.is_empty();
     let hv = |of: &[crate::lod::Measured]| measured.then(|| run.metro_hypervolume(of));
     let generations = run
@@ -434,7 +470,7 @@ pub(super) fn run_pareto(args: ParetoArgs) -> Result<ExitCode> {
             front: gen_.front.clone(),
         })
         .collect();
-    let out = manifest::ParetoManifest {
+    manifest::ParetoManifest {
         input: args.input.display(),
         input_from_manifest: input_from(&args.input, &args.outdir),
         vertices: run.input_vertices,
@@ -466,9 +502,11 @@ pub(super) fn run_pareto(args: ParetoArgs) -> Result<ExitCode> {
             greedy_chain: hv(&run.baseline),
         },
         seconds: search_s,
-    };
-    let json_path = args.outdir.join(format!("{stem}.pareto.json"));
-    write_json(&json_path, &out)?;
+    }
+}
+
+/// The SVG of every generation's front beside the greedy chain; its path.
+fn write_fronts_svg(args: &ParetoArgs, run: &lod::ParetoRun, stem: &str) -> Result<PathBuf> {
     let fronts: Vec<Vec<crate::lod::nsga::Point>> =
         run.generations.iter().map(|g| g.front.clone()).collect();
     let n = run.input_vertices as f64;
@@ -485,41 +523,47 @@ pub(super) fn run_pareto(args: ParetoArgs) -> Result<ExitCode> {
     );
     std::fs::write(&svg_path, lod::svg::fronts_svg(&title, &fronts, &baseline))
         .with_context(|| format!("cannot write {}", svg_path.display()))?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&out)?);
+    Ok(svg_path)
+}
+
+/// What the search found, on stderr.
+fn print_pareto_summary(
+    args: &ParetoArgs,
+    run: &lod::ParetoRun,
+    search_s: f64,
+    (json_path, svg_path): (&Path, &Path),
+) {
+    let last = run
+        .generations
+        .last()
+        .expect("the first population at least");
+    eprintln!(
+        "{}: {} vertices, {} removable; {} evaluations in {search_s:.2} s",
+        args.input.display(),
+        run.input_vertices,
+        run.removable,
+        run.evaluations
+    );
+    eprintln!(
+        "front    {} members, hypervolume {:.6e} (first population {:.6e})",
+        run.front.len(),
+        last.hypervolume,
+        run.generations[0].hypervolume
+    );
+    let measured = !run.baseline.is_empty();
+    let hv = |of: &[crate::lod::Measured]| measured.then(|| run.metro_hypervolume(of));
+    if let (Some(f), Some(b)) = (hv(&run.front_measured), hv(&run.baseline)) {
+        eprintln!(
+            "metro    hypervolume of the front {f:.6e}, of the greedy chain at the same \
+             vertex counts {b:.6e} ({:+.3}%)",
+            100.0 * (f - b) / b
+        );
     }
-    if !args.quiet {
-        let last = run
-            .generations
-            .last()
-            .expect("the first population at least");
-        eprintln!(
-            "{}: {} vertices, {} removable; {} evaluations in {search_s:.2} s",
-            args.input.display(),
-            run.input_vertices,
-            run.removable,
-            run.evaluations
-        );
-        eprintln!(
-            "front    {} members, hypervolume {:.6e} (first population {:.6e})",
-            run.front.len(),
-            last.hypervolume,
-            run.generations[0].hypervolume
-        );
-        if let (Some(f), Some(b)) = (hv(&run.front_measured), hv(&run.baseline)) {
-            eprintln!(
-                "metro    hypervolume of the front {f:.6e}, of the greedy chain at the same \
-                 vertex counts {b:.6e} ({:+.3}%)",
-                100.0 * (f - b) / b
-            );
-        }
-        eprintln!(
-            "wrote    {} and {}",
-            json_path.display(),
-            svg_path.display()
-        );
-    }
-    Ok(ExitCode::SUCCESS)
+    eprintln!(
+        "wrote    {} and {}",
+        json_path.display(),
+        svg_path.display()
+    );
 }
 
 /// The input file's path from the output folder (where the manifest goes).

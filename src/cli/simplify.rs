@@ -2,7 +2,7 @@
 //! backend for `auto`) and writes.
 
 use std::io::{IsTerminal, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -255,17 +255,35 @@ Learn more:
   meshslim simplify --help
   meshslim --help";
 
+/// The face target as given: a ratio of the input's faces or a face count.
+#[derive(Clone, Copy)]
 enum Target {
     Ratio(f64),
     Faces(usize),
 }
 
-pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
-    let Some(input) = args.input else {
+/// A simplification done, streamed or in memory, with what the report needs of how it went.
+struct Simplified {
+    mesh: crate::Mesh,
+    report: crate::SimplifyReport,
+    load_s: f64,
+    simplify_s: f64,
+    /// How clustering changed the topology (in memory only).
+    topology: Option<super::report::TopologyChange>,
+    /// Why the input was streamed, when it was.
+    streamed: Option<String>,
+    /// The input mesh, when it was read whole.
+    original: Option<crate::Mesh>,
+}
+
+/// Runs `meshslim simplify`: reads (or streams) the input, simplifies it, remeshes it when asked,
+/// writes it and prints the report.
+pub(super) fn run_simplify(mut args: SimplifyArgs) -> Result<ExitCode> {
+    let Some(input) = args.input.take() else {
         eprintln!("{GETTING_STARTED}");
         return Ok(ExitCode::from(2));
     };
-    let Some(output) = args.output else {
+    let Some(output) = args.output.take() else {
         return Err(UsageError(format!(
             "no output file: write it after the input, as in\n  meshslim simplify {} OUT.ply \
              [OPTIONS]\n\nFor more information, try 'meshslim simplify --help'.",
@@ -281,13 +299,35 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
         (None, None) => Target::Ratio(0.1),
     };
     let progress = Progress::new(!(args.quiet || args.json) && std::io::stderr().is_terminal());
+    let opts = simplify_options(&args, target);
+    let done = match stream_choice(&input, &args, &opts)? {
+        Some((path, why)) => simplify_streamed(&args, &progress, path, why, target, &opts)?,
+        None => simplify_in_memory(&args, &progress, &input, target, opts)?,
+    };
+    let (done, remeshed) = remesh_if_asked(&args, &progress, done);
+    note_what_the_format_loses(&args, &output, &done.mesh);
+    let save_s = write_output(&progress, &input, &output, &done.mesh)?;
+    let times = Times {
+        load: done.load_s,
+        simplify: done.simplify_s,
+        save: save_s,
+    };
+    print_report(&args, &input, &output, &done, &times, remeshed.as_ref())?;
+    Ok(ExitCode::SUCCESS)
+}
 
-    let method = args.method.method();
-    let say = |msg: String| {
-        if !args.quiet {
+impl SimplifyArgs {
+    /// Prints a message on stderr unless `--quiet`.
+    fn say(&self, msg: String) {
+        if !self.quiet {
             eprintln!("{msg}");
         }
-    };
+    }
+}
+
+/// The library's options from the arguments; a ratio target is turned into a face count once
+/// the input's faces are known.
+fn simplify_options(args: &SimplifyArgs, target: Target) -> SimplifyOptions {
     let mut opts = SimplifyOptions::with_faces(match target {
         Target::Faces(n) => n,
         Target::Ratio(_) => 0,
@@ -299,10 +339,20 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
     opts.max_normal_angle_deg = args.max_normal_angle;
     opts.quality_threshold = args.quality_threshold;
     opts.backend = args.backend.backend();
-    opts.method = method;
+    opts.method = args.method.method();
     opts.feature_angle_deg = args.feature_angle;
     opts.removal = args.removal.removal();
-    let stream = match &input {
+    opts
+}
+
+/// Whether to stream the input, and why: `--stream` (a file only), or the library's policy for
+/// a cluster or hybrid input that would not fit in memory.
+fn stream_choice(
+    input: &Input,
+    args: &SimplifyArgs,
+    opts: &SimplifyOptions,
+) -> Result<Option<(PathBuf, String)>> {
+    Ok(match input {
         Input::Builtin { .. } if args.stream => {
             return Err(UsageError(
                 "--stream reads a file; a builtin mesh is made in memory".into(),
@@ -312,164 +362,208 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
         Input::File(path) if args.stream => Some((path.clone(), "--stream".to_string())),
         // The library's policy: stream a cluster or hybrid input that would not fit in memory.
         Input::File(path) => {
-            crate::simplify::stream_reason(path, &opts, args.memory).map(|why| (path.clone(), why))
+            crate::simplify::stream_reason(path, opts, args.memory).map(|why| (path.clone(), why))
         }
         _ => None,
+    })
+}
+
+/// Simplifies the file at `path` by streaming its faces (`why` says why), timed as one step.
+fn simplify_streamed(
+    args: &SimplifyArgs,
+    progress: &Progress,
+    path: PathBuf,
+    why: String,
+    target: Target,
+    opts: &SimplifyOptions,
+) -> Result<Simplified> {
+    args.say(format!("streaming {}: {why}", path.display()));
+    let t = Instant::now();
+    let target = match target {
+        Target::Faces(n) => crate::cluster::stream::Target::Faces(n),
+        Target::Ratio(r) => crate::cluster::stream::Target::Ratio(r),
     };
+    let (mesh, report) = progress
+        .bar("simplifying (streamed)", |set| {
+            crate::cluster::stream::simplify_file(&path, target, opts, &mut |f| set(f))
+        })
+        .map_err(lib)
+        .with_context(|| format!("cannot simplify {}", path.display()))?;
+    Ok(Simplified {
+        mesh,
+        report,
+        load_s: 0.0,
+        simplify_s: t.elapsed().as_secs_f64(),
+        topology: None,
+        streamed: Some(why),
+        original: None,
+    })
+}
 
-    let (simplified, report, load_s, simplify_s, topology, streamed, original) =
-        if let Some((path, why)) = stream {
-            say(format!("streaming {}: {why}", path.display()));
-            let t = Instant::now();
-            let target = match target {
-                Target::Faces(n) => crate::cluster::stream::Target::Faces(n),
-                Target::Ratio(r) => crate::cluster::stream::Target::Ratio(r),
-            };
-            let (simplified, report) = progress
-                .bar("simplifying (streamed)", |set| {
-                    crate::cluster::stream::simplify_file(&path, target, &opts, &mut |f| set(f))
-                })
-                .map_err(lib)
-                .with_context(|| format!("cannot simplify {}", path.display()))?;
-            (
-                simplified,
-                report,
-                0.0,
-                t.elapsed().as_secs_f64(),
-                None,
-                Some(why),
-                None,
-            )
-        } else {
-            let t = Instant::now();
-            let mesh = load(&input, &progress)?;
-            let load_s = t.elapsed().as_secs_f64();
-            if let Target::Ratio(r) = target {
-                opts.target_faces = SimplifyOptions::with_ratio(mesh.face_count(), r)
-                    .map_err(lib)?
-                    .target_faces;
-            }
-            // Said before the long part; the library makes the same choice (the process's one
-            // shared device), and its report says so again only if the GPU then failed.
-            let early = (opts.backend == Backend::Auto).then(|| {
-                let (_, why) = crate::simplify::auto_backend();
-                say(format!("backend auto: {why}"));
-                why
-            });
+/// Loads the input whole and simplifies it, saying which backend `auto` chose, and how
+/// clustering changed the topology.
+fn simplify_in_memory(
+    args: &SimplifyArgs,
+    progress: &Progress,
+    input: &Input,
+    target: Target,
+    mut opts: SimplifyOptions,
+) -> Result<Simplified> {
+    let t = Instant::now();
+    let mesh = load(input, progress)?;
+    let load_s = t.elapsed().as_secs_f64();
+    if let Target::Ratio(r) = target {
+        opts.target_faces = SimplifyOptions::with_ratio(mesh.face_count(), r)
+            .map_err(lib)?
+            .target_faces;
+    }
+    // Said before the long part; the library makes the same choice (the process's one
+    // shared device), and its report says so again only if the GPU then failed.
+    let early = (opts.backend == Backend::Auto).then(|| {
+        let (_, why) = crate::simplify::auto_backend();
+        args.say(format!("backend auto: {why}"));
+        why
+    });
 
-            let t = Instant::now();
-            let result = progress.bar("simplifying", |set| {
-                crate::simplify_with_progress(&mesh, &opts, &mut |f| set(f))
-            });
-            if let Ok((_, report)) = &result
-                && let Some(note) = &report.auto
-                && Some(note) != early.as_ref()
-            {
-                say(format!("backend auto: {note}"));
-            }
-            let (simplified, report) = result
-                .map_err(lib)
-                .with_context(|| format!("cannot simplify {}", input.display()))?;
-            let simplify_s = t.elapsed().as_secs_f64();
-            // Clustering may change the topology: say how (outside the timed call).
-            let topology = report
-                .clustering
-                .is_some()
-                .then(|| super::report::TopologyChange::of(&mesh, &simplified));
-            (
-                simplified,
+    let t = Instant::now();
+    let result = progress.bar("simplifying", |set| {
+        crate::simplify_with_progress(&mesh, &opts, &mut |f| set(f))
+    });
+    if let Ok((_, report)) = &result
+        && let Some(note) = &report.auto
+        && Some(note) != early.as_ref()
+    {
+        args.say(format!("backend auto: {note}"));
+    }
+    let (simplified, report) = result
+        .map_err(lib)
+        .with_context(|| format!("cannot simplify {}", input.display()))?;
+    let simplify_s = t.elapsed().as_secs_f64();
+    // Clustering may change the topology: say how (outside the timed call).
+    let topology = report
+        .clustering
+        .is_some()
+        .then(|| super::report::TopologyChange::of(&mesh, &simplified));
+    Ok(Simplified {
+        mesh: simplified,
+        report,
+        load_s,
+        simplify_s,
+        topology,
+        streamed: None,
+        original: Some(mesh),
+    })
+}
+
+/// With `--remesh K`, remeshes the simplified mesh (its time counted in simplify's, the report
+/// describing the remeshed mesh); a failure is a warning and keeps the simplified mesh.
+fn remesh_if_asked(
+    args: &SimplifyArgs,
+    progress: &Progress,
+    done: Simplified,
+) -> (Simplified, Option<crate::remesh::RemeshReport>) {
+    if args.remesh == 0 {
+        return (done, None);
+    }
+    let remeshed = progress.bar("remeshing", |set| {
+        // Onto the original where it is in memory (not when streamed): nearer it.
+        crate::remesh::remesh_simplified(
+            &done.mesh,
+            done.original.as_ref(),
+            args.remesh,
+            args.lock_border,
+            set,
+        )
+    });
+    match remeshed {
+        Ok((out, r)) => {
+            let simplify_s = done.simplify_s + r.seconds.total;
+            // The report describes the file written: the remeshed mesh's counts.
+            let report = done.report.describing(&out);
+            let done = Simplified {
+                mesh: out,
                 report,
-                load_s,
                 simplify_s,
-                topology,
-                None,
-                Some(mesh),
-            )
-        };
-
-    let (simplified, simplify_s, remeshed) = if args.remesh > 0 {
-        let remeshed = progress.bar("remeshing", |set| {
-            // Onto the original where it is in memory (not when streamed): nearer it.
-            crate::remesh::remesh_simplified(
-                &simplified,
-                original.as_ref(),
-                args.remesh,
-                args.lock_border,
-                set,
-            )
-        });
-        match remeshed {
-            Ok((out, r)) => {
-                let total = simplify_s + r.seconds.total;
-                (out, total, Some(r))
-            }
-            // The simplification is done and good: keep it rather than lose it.
-            Err(e) => {
-                eprintln!(
-                    "warning: cannot remesh the simplified mesh ({e}); writing it as simplified"
-                );
-                (simplified, simplify_s, None)
-            }
+                ..done
+            };
+            (done, Some(r))
         }
-    } else {
-        (simplified, simplify_s, None)
-    };
-    // The report describes the file written: the remeshed mesh's counts.
-    let report = match &remeshed {
-        Some(_) => report.describing(&simplified),
-        None => report,
-    };
+        // The simplification is done and good: keep it rather than lose it.
+        Err(e) => {
+            eprintln!("warning: cannot remesh the simplified mesh ({e}); writing it as simplified");
+            (done, None)
+        }
+    }
+}
 
-    if let Ok(format) = crate::io::Format::from_path(&output) {
-        for lost in crate::io::not_kept(&simplified, format) {
-            say(format!(
+/// Notes each attribute of the mesh the output's format does not keep.
+fn note_what_the_format_loses(args: &SimplifyArgs, output: &Path, mesh: &crate::Mesh) {
+    if let Ok(format) = crate::io::Format::from_path(output) {
+        for lost in crate::io::not_kept(mesh, format) {
+            args.say(format!(
                 "note: {} ({}) does not keep {lost}",
                 output.display(),
                 format.extension()
             ));
         }
     }
+}
+
+/// Writes the mesh to `output` (carrying what the input file had beside it); returns the
+/// seconds it took.
+fn write_output(
+    progress: &Progress,
+    input: &Input,
+    output: &Path,
+    mesh: &crate::Mesh,
+) -> Result<f64> {
     let t = Instant::now();
     progress
-        .spinner(format!("writing {}", output.display()), || match &input {
-            Input::File(from) => crate::io::write_from(&output, &simplified, from),
-            Input::Builtin { .. } => crate::io::write(&output, &simplified),
+        .spinner(format!("writing {}", output.display()), || match input {
+            Input::File(from) => crate::io::write_from(output, mesh, from),
+            Input::Builtin { .. } => crate::io::write(output, mesh),
         })
         .map_err(lib)
         .context("cannot write the output")?;
-    let save_s = t.elapsed().as_secs_f64();
+    Ok(t.elapsed().as_secs_f64())
+}
 
-    let times = Times {
-        load: load_s,
-        simplify: simplify_s,
-        save: save_s,
-    };
+/// Prints the report on stdout: the JSON object with `--json`, else the summary (with the
+/// remesh and stream lines) unless `--quiet`.
+fn print_report(
+    args: &SimplifyArgs,
+    input: &Input,
+    output: &Path,
+    done: &Simplified,
+    times: &Times,
+    remeshed: Option<&crate::remesh::RemeshReport>,
+) -> Result<()> {
     let out = std::io::stdout();
     let mut out = out.lock();
     if args.json {
-        let mut json = simplify_json(&input, &output, &report, &times, topology.as_ref());
-        json["streamed"] = serde_json::json!(streamed);
+        let mut json = simplify_json(input, output, &done.report, times, done.topology.as_ref());
+        json["streamed"] = serde_json::json!(done.streamed);
         json["remesh"] = serde_json::json!(remeshed);
         json["peak_resident_bytes"] = serde_json::json!(crate::memory::peak_resident_bytes());
         writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
     } else if !args.quiet {
         write_summary(
             &mut out,
-            &input,
-            &output,
-            &report,
-            &times,
+            input,
+            output,
+            &done.report,
+            times,
             args.stats,
-            topology.as_ref(),
+            done.topology.as_ref(),
         )?;
-        if let Some(r) = &remeshed {
+        if let Some(r) = remeshed {
             writeln!(
                 out,
                 "remesh   {} iterations at edge length {:.6}: {} simplified faces -> {} in {:.3} s (in simplify)",
                 r.iterations, r.edge_length, r.input_faces, r.output_faces, r.seconds.total
             )?;
         }
-        if let Some(why) = &streamed {
+        if let Some(why) = &done.streamed {
             let peak =
                 crate::memory::peak_resident_bytes().map_or("unknown".into(), crate::memory::mib);
             writeln!(
@@ -479,5 +573,5 @@ pub(super) fn run_simplify(args: SimplifyArgs) -> Result<ExitCode> {
         }
     }
     out.flush()?;
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }

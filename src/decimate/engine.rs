@@ -197,7 +197,43 @@ impl Engine {
         }
         let n = self.fan.len();
         let pv = self.at(v);
-        // The sides of the hole and the line of an edge or border vertex.
+        let (sides, nsides, line) = self.hole_sides(class);
+        let (foot_plane, line_t) = self.replacement_foot(line, pv);
+        if class == VertexClass::Boundary && self.params.lock_border {
+            // The outline stays exactly: only a vertex on the straight line between its border
+            // neighbours may go.
+            let (a, b) = (self.at(self.fan.x[0]), self.at(self.fan.x[n]));
+            let off = (pv - a).cross(b - a).length();
+            if off > 1e-12 * (b - a).length() {
+                return Err(Refusal::LockedBorder);
+            }
+        }
+        let q = self.p.quadrics[v as usize];
+        let (cands, ncand) = self.candidates(line, &q, fill_up_to);
+        for &cand in &cands[..ncand] {
+            let (foot, transfer) = self.candidate_target(cand, line_t, foot_plane, pv);
+            let cost = self.held(&q, &transfer).eval(foot.to_array());
+            let plan = Plan {
+                cost,
+                error: rms(cost, &q),
+                transfer,
+                filled: false,
+            };
+            if fill_up_to.is_none_or(|k| key(cost) > k) {
+                return Ok(plan);
+            }
+            if self.fill(v, &sides[..nsides], self.fan.x[cand]) {
+                return self.filled_plan(plan, pv, &q);
+            }
+        }
+        Err(Refusal::NoValidFill)
+    }
+
+    /// The sides of the hole `v`'s removal leaves (one, or two for an edge vertex), and the
+    /// line of an edge or border vertex: the fan places of its two feature or border
+    /// neighbours.
+    fn hole_sides(&self, class: VertexClass) -> ([Side; 2], usize, Option<(usize, usize)>) {
+        let n = self.fan.len();
         let mut sides = [Side {
             start: 0,
             count: n,
@@ -229,11 +265,20 @@ impl Engine {
                 (2, Some((ia, ib)))
             }
         };
-        // Where the surface that replaces v passes: the average plane's foot (simple), the
-        // line through the two feature or border neighbours (Schroeder 1992's criteria).
-        let (foot_plane, line_t) = match line {
+        (sides, nsides, line)
+    }
+
+    /// Where the surface that replaces the vertex at `pv` passes: the average plane's foot
+    /// (simple), the line through the two feature or border neighbours (Schroeder 1992's
+    /// criteria), with the foot's parameter along that line.
+    fn replacement_foot(
+        &self,
+        line: Option<(usize, usize)>,
+        pv: DVec3,
+    ) -> (DVec3, Option<(usize, usize, f64)>) {
+        match line {
             None => {
-                let (nrm, c) = self.fan.average_plane(&self.p.pos, 0..n);
+                let (nrm, c) = self.fan.average_plane(&self.p.pos, 0..self.fan.len());
                 (pv - nrm * nrm.dot(pv - c), None)
             }
             Some((ia, ib)) => {
@@ -246,19 +291,19 @@ impl Engine {
                 };
                 (a + d * t, Some((ia, ib, t)))
             }
-        };
-        if class == VertexClass::Boundary && self.params.lock_border {
-            // The outline stays exactly: only a vertex on the straight line between its border
-            // neighbours may go.
-            let (a, b) = (self.at(self.fan.x[0]), self.at(self.fan.x[n]));
-            let off = (pv - a).cross(b - a).length();
-            if off > 1e-12 * (b - a).length() {
-                return Err(Refusal::LockedBorder);
-            }
         }
-        let q = self.p.quadrics[v as usize];
-        // The candidates: one filling for loop splitting; for a half-edge collapse, the
-        // allowed neighbours nearest first.
+    }
+
+    /// The candidates, as fan places, and their count: one filling for loop splitting; for a
+    /// half-edge collapse, the allowed neighbours, the cheapest under `q` first (all sorted by
+    /// cost when the hole is to be filled, `fill_up_to`).
+    fn candidates(
+        &self,
+        line: Option<(usize, usize)>,
+        q: &Quadric,
+        fill_up_to: Option<u32>,
+    ) -> ([usize; super::fan::MAX_FAN + 1], usize) {
+        let n = self.fan.len();
         let mut cands = [0usize; super::fan::MAX_FAN + 1];
         let ncand = match (self.params.removal, line) {
             (Removal::LoopSplit, _) => 1,
@@ -281,7 +326,7 @@ impl Engine {
             let mut cost = [0.0f64; super::fan::MAX_FAN + 1];
             for &i in &cands[..ncand] {
                 let to = [(self.fan.x[i], 1.0), (u32::MAX, 0.0), (u32::MAX, 0.0)];
-                cost[i] = self.held(&q, &to).eval(self.at(self.fan.x[i]).to_array());
+                cost[i] = self.held(q, &to).eval(self.at(self.fan.x[i]).to_array());
             }
             if fill_up_to.is_some() {
                 cands[..ncand].sort_by(|&i, &j| cost[i].total_cmp(&cost[j]).then(i.cmp(&j)));
@@ -293,59 +338,62 @@ impl Engine {
                 cands.swap(0, best);
             }
         }
-        for &cand in &cands[..ncand] {
-            let (foot, transfer) = match (self.params.removal, line_t) {
-                (Removal::HalfEdge, _) => (
-                    self.at(self.fan.x[cand]),
-                    [(self.fan.x[cand], 1.0), (u32::MAX, 0.0), (u32::MAX, 0.0)],
-                ),
-                (Removal::LoopSplit, Some((ia, ib, t))) => (
-                    foot_plane,
-                    [
-                        (self.fan.x[ia], 1.0 - t),
-                        (self.fan.x[ib], t),
-                        (u32::MAX, 0.0),
-                    ],
-                ),
-                (Removal::LoopSplit, None) => {
-                    let [a, b] = self.nearest_two(pv);
-                    (foot_plane, [a, b, (u32::MAX, 0.0)])
-                }
-            };
-            let cost = self.held(&q, &transfer).eval(foot.to_array());
-            let mut plan = Plan {
-                cost,
-                error: rms(cost, &q),
-                transfer,
-                filled: false,
-            };
-            if fill_up_to.is_none_or(|k| key(cost) > k) {
-                return Ok(plan);
-            }
-            if self.fill(v, &sides[..nsides], self.fan.x[cand]) {
-                if self.params.removal == Removal::LoopSplit {
-                    // The surface that really replaces v, not its average plane: measured on
-                    // horse at 10%, charging the average plane's foot gave a mean two-sided
-                    // distance of 2.62e-4 of the diagonal, the new faces' nearest point
-                    // 1.96e-4. The queue's key stays the average plane's (no filling needed);
-                    // a removal that costs more than its key goes back in the queue.
-                    let (foot, transfer) = self.nearest_on_new(pv);
-                    let cost = self.held(&q, &transfer).eval(foot.to_array());
-                    plan = Plan {
-                        cost,
-                        error: rms(cost, &q),
-                        transfer,
-                        filled: true,
-                    };
-                }
-                plan.filled = true;
-                if self.params.max_error.is_some_and(|m| plan.error > m) {
-                    return Err(Refusal::OverMaxError);
-                }
-                return Ok(plan);
+        (cands, ncand)
+    }
+
+    /// Where candidate `cand` puts the removed vertex at `pv` and who takes its quadric: the
+    /// neighbour itself for a half-edge collapse; for loop splitting `foot_plane`, the
+    /// quadric shared by the line's two ends (`line_t`) or the two nearest loop vertices.
+    fn candidate_target(
+        &self,
+        cand: usize,
+        line_t: Option<(usize, usize, f64)>,
+        foot_plane: DVec3,
+        pv: DVec3,
+    ) -> (DVec3, [(u32, f64); 3]) {
+        match (self.params.removal, line_t) {
+            (Removal::HalfEdge, _) => (
+                self.at(self.fan.x[cand]),
+                [(self.fan.x[cand], 1.0), (u32::MAX, 0.0), (u32::MAX, 0.0)],
+            ),
+            (Removal::LoopSplit, Some((ia, ib, t))) => (
+                foot_plane,
+                [
+                    (self.fan.x[ia], 1.0 - t),
+                    (self.fan.x[ib], t),
+                    (u32::MAX, 0.0),
+                ],
+            ),
+            (Removal::LoopSplit, None) => {
+                let [a, b] = self.nearest_two(pv);
+                (foot_plane, [a, b, (u32::MAX, 0.0)])
             }
         }
-        Err(Refusal::NoValidFill)
+    }
+
+    /// The plan of a removal whose hole was filled: for loop splitting costed again on the
+    /// new faces; refused over `max_error`.
+    fn filled_plan(&self, mut plan: Plan, pv: DVec3, q: &Quadric) -> Result<Plan, Refusal> {
+        if self.params.removal == Removal::LoopSplit {
+            // The surface that really replaces v, not its average plane: measured on horse at
+            // 10%, charging the average plane's foot gave a mean two-sided distance of 2.62e-4
+            // of the diagonal, the new faces' nearest point 1.96e-4. The queue's key stays the
+            // average plane's (no filling needed); a removal that costs more than its key goes
+            // back in the queue.
+            let (foot, transfer) = self.nearest_on_new(pv);
+            let cost = self.held(q, &transfer).eval(foot.to_array());
+            plan = Plan {
+                cost,
+                error: rms(cost, q),
+                transfer,
+                filled: true,
+            };
+        }
+        plan.filled = true;
+        if self.params.max_error.is_some_and(|m| plan.error > m) {
+            return Err(Refusal::OverMaxError);
+        }
+        Ok(plan)
     }
 
     fn at(&self, x: u32) -> DVec3 {

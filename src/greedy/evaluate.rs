@@ -325,9 +325,42 @@ impl<'a> State<'a> {
             return Evaluation::Refused;
         };
         let (k, r) = (keep as usize, remove as usize);
+        let Some(min_quality) = self.moved_faces_quality(k, r, pos) else {
+            return Evaluation::Refused;
+        };
+        // The worst resulting quality scales the priority.
+        let qt = self.opts.quality_threshold;
+        let priority = if qt > 0.0 && min_quality < qt {
+            error * qt / min_quality.max(1e-12)
+        } else {
+            error
+        };
+        if key(priority) > bound {
+            return Evaluation::Later(key(priority));
+        }
+        let Some((edge_faces, opposite)) = self.link_condition(keep, remove) else {
+            return Evaluation::Refused;
+        };
+        if self.pinches(keep, remove, edge_faces, opposite) {
+            return Evaluation::Refused;
+        }
+        let Some(attr_map) = self.attribute_map(keep, remove) else {
+            return Evaluation::Refused;
+        };
+        Evaluation::Collapse(Collapse {
+            keep,
+            remove,
+            pos,
+            error,
+            attr_map,
+        })
+    }
 
-        // Faces that move: the normal may not turn more than the limit, no needle may appear,
-        // and the worst resulting quality scales the priority.
+    /// The worst quality of the faces that move when `k` and `r` meet at `pos`, or `None` when
+    /// one of them refuses the collapse: its normal may not turn more than the limit (from its
+    /// current and its reference normal) and no needle may appear.
+    #[inline]
+    fn moved_faces_quality(&self, k: usize, r: usize, pos: [f64; 3]) -> Option<f64> {
         let mut min_quality = f64::INFINITY;
         for (moved, other) in [(k, r), (r, k)] {
             for &f in self.vert_faces.get(moved) {
@@ -352,14 +385,14 @@ impl<'a> State<'a> {
                 let n_new = cross(e[0], e[1]);
                 let (l_old, l_new) = (norm(n_old), norm(n_new));
                 if l_new <= 0.0 {
-                    return Evaluation::Refused;
+                    return None;
                 }
                 if l_old > 0.0 && dot(n_old, n_new) < self.cos_max_angle * l_old * l_new {
-                    return Evaluation::Refused;
+                    return None;
                 }
                 let n_ref = self.p.ref_normal[f as usize].map(f64::from);
                 if dot(n_ref, n_new) < self.cos_max_angle * l_new && n_ref != [0.0; 3] {
-                    return Evaluation::Refused;
+                    return None;
                 }
                 // `triangle_quality(new)`, reusing |n_new|: the same bits, one cross product and
                 // square root fewer.
@@ -367,23 +400,21 @@ impl<'a> State<'a> {
                 let q_new = if longest > 0.0 { l_new / longest } else { 0.0 };
                 if q_new < self.opts.min_quality && q_new < triangle_quality(old[0], old[1], old[2])
                 {
-                    return Evaluation::Refused;
+                    return None;
                 }
                 min_quality = min_quality.min(q_new);
             }
         }
-        let qt = self.opts.quality_threshold;
-        let priority = if qt > 0.0 && min_quality < qt {
-            error * qt / min_quality.max(1e-12)
-        } else {
-            error
-        };
-        if key(priority) > bound {
-            return Evaluation::Later(key(priority));
-        }
+        Some(min_quality)
+    }
 
-        // Link condition: the common neighbours of the endpoints are exactly the vertices
-        // opposite the edge in its faces (Dey et al. 1999), which keeps a manifold manifold.
+    /// Link condition: the common neighbours of the endpoints are exactly the vertices
+    /// opposite the edge in its faces (Dey et al. 1999), which keeps a manifold manifold; no
+    /// new edge may join two caller-pinned vertices either. Returns the edge's live faces (1
+    /// or 2) and their opposite vertices, or `None` when the collapse is refused.
+    #[inline]
+    fn link_condition(&mut self, keep: u32, remove: u32) -> Option<(u32, [u32; 2])> {
+        let (k, r) = (keep as usize, remove as usize);
         // m marks keep's neighbours, m + 1 those of them already counted as common.
         let m = self.next_marks(2);
         for &f in self.vert_faces.get(k) {
@@ -404,11 +435,9 @@ impl<'a> State<'a> {
             let t = self.topo_faces[f as usize];
             if t.contains(&keep) {
                 if edge_faces >= 2 {
-                    return Evaluation::Refused;
+                    return None;
                 }
-                let Some(c) = t.into_iter().find(|&u| u != keep && u != remove) else {
-                    return Evaluation::Refused;
-                };
+                let c = t.into_iter().find(|&u| u != keep && u != remove)?;
                 opposite[edge_faces as usize] = c;
                 edge_faces += 1;
             }
@@ -423,17 +452,25 @@ impl<'a> State<'a> {
                         // A new edge between two caller-pinned vertices (a tile's border):
                         // the tile next door may have that edge, and the weld would give it
                         // three faces.
-                        return Evaluation::Refused;
+                        return None;
                     }
                 }
             }
         }
         if edge_faces == 0 || common != edge_faces {
-            return Evaluation::Refused;
+            return None;
         }
+        Some((edge_faces, opposite))
+    }
+
+    /// True when collapsing edge (keep, remove), on `edge_faces` faces with `opposite`
+    /// vertices, would pinch the surface, delete a lone triangle or make a face twice.
+    #[inline]
+    fn pinches(&self, keep: u32, remove: u32, edge_faces: u32, opposite: [u32; 2]) -> bool {
+        let (k, r) = (keep as usize, remove as usize);
         // Joining two border vertices through the interior would pinch the surface.
         if edge_faces == 2 && self.p.border[k] && self.p.border[r] {
-            return Evaluation::Refused;
+            return true;
         }
         // A border edge whose face has its other two edges on the border too is a lone
         // triangle: collapsing it would delete a whole component (the link condition with the
@@ -449,7 +486,7 @@ impl<'a> State<'a> {
                     == 1
             };
             if border_edge(self, k) && border_edge(self, r) {
-                return Evaluation::Refused;
+                return true;
             }
         }
         // A tetrahedral fan: faces (keep, c, d) and (remove, c, d) off the edge would become
@@ -463,22 +500,25 @@ impl<'a> State<'a> {
                 })
             };
             if on_cd(self, k, remove) && on_cd(self, r, keep) {
-                return Evaluation::Refused;
+                return true;
             }
         }
+        false
+    }
 
-        // Attribute vertices of `keep` that the removed vertex's corners take: its only one, or
-        // for a seam vertex the one it uses in the faces on the edge, which must agree — unless
-        // the removed vertex slides along the seam, when each side maps to its own.
+    /// Attribute vertices of `keep` that the removed vertex's corners take: its only one, or
+    /// for a seam vertex the one it uses in the faces on the edge, which must agree (`None`
+    /// when they do not) — unless the removed vertex slides along the seam, when each side
+    /// maps to its own.
+    #[inline]
+    fn attribute_map(&self, keep: u32, remove: u32) -> Option<[(u32, u32); 2]> {
+        let (k, r) = (keep as usize, remove as usize);
         let mut attr_map = [
             (self.p.first_attr[r], self.p.first_attr[k]),
             (u32::MAX, u32::MAX),
         ];
         if self.p.mobility[r] == Mobility::Seam {
-            let Some(sides) = self.seam_slide(remove, keep) else {
-                return Evaluation::Refused;
-            };
-            attr_map = sides;
+            attr_map = self.seam_slide(remove, keep)?;
         } else if self.p.seam[k] {
             let mut keep_attr = u32::MAX;
             for &f in self.vert_faces.get(r) {
@@ -489,20 +529,14 @@ impl<'a> State<'a> {
                 if let Some(i) = t.iter().position(|&u| u == keep) {
                     let av = self.p.faces[f as usize][i];
                     if keep_attr != u32::MAX && keep_attr != av {
-                        return Evaluation::Refused;
+                        return None;
                     }
                     keep_attr = av;
                 }
             }
             attr_map[0].1 = keep_attr;
         }
-        Evaluation::Collapse(Collapse {
-            keep,
-            remove,
-            pos,
-            error,
-            attr_map,
-        })
+        Some(attr_map)
     }
 }
 

@@ -11,7 +11,7 @@
 //! which retires every older entry of its edges.
 //!
 //! [`simplify_greedy`] here drives the parts: `prepare` (welding, the Morton order, quadrics and
-//! vertex mobility), `state` (the collapse state and the faces around each vertex), `queue` (the
+//! vertex mobility, with its per-vertex passes in `vertex_pass`), `state` (the collapse state and the faces around each vertex), `queue` (the
 //! bucket queue and its keys), `evaluate` (placement and the checks on one edge), `collapse`
 //! (applying collapses, the run to a target), `partition` (the partitioned levels), `epochs`
 //! (their rising cost ceilings, run without a barrier after each), `output`
@@ -26,6 +26,7 @@ pub(crate) mod prepare;
 pub(crate) mod queue;
 pub(crate) mod state;
 mod vec;
+mod vertex_pass;
 
 use crate::error::Result;
 use crate::mesh::Mesh;

@@ -2,30 +2,14 @@
 //! vertices in Morton order, normalized, with per-vertex quadrics (faces, borders, seams) and
 //! how each vertex may move.
 
-use super::vec::{cross, dot, norm, sub};
+use super::vertex_pass::{Around, Geometry, VertexPass};
+pub(crate) use super::vertex_pass::{Carried, Mobility};
 use crate::mesh::Mesh;
 use crate::mesh::prepare::{Surface, counting_sort, denormalize, normalize};
 use crate::options::SimplifyOptions;
 use crate::quadric::Quadric;
-use crate::quadric::attributes::{Attributes, FaceTerms, Layout, MAX_STRIDE};
+use crate::quadric::attributes::{Attributes, Layout};
 use rayon::prelude::*;
-
-/// How a vertex may take part in collapses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Mobility {
-    /// May move and may be removed.
-    Free,
-    /// Keeps its position; may survive a collapse, never be removed: attribute seams and
-    /// non-manifold spots.
-    Pinned,
-    /// A border vertex under `lock_border`: keeps its position, and may be removed only by sliding
-    /// along a straight stretch of border onto a border neighbour.
-    LockedBorder,
-    /// On an attribute seam (a UV, normal or colour discontinuity): keeps its position, and may be
-    /// removed only by sliding along the seam onto a seam neighbour, each side of the seam
-    /// taking that neighbour's attributes on its side. Seams thin out without tearing.
-    Seam,
-}
 
 /// The prepared surface: welded topology, normalized positions, per-vertex quadrics and flags.
 /// Shared by the greedy backend and (later) the parallel ones, which start from the same state.
@@ -67,21 +51,6 @@ pub(crate) struct Prepared {
     pub attr_global: Vec<u32>,
 }
 
-/// What an earlier phase hands the greedy with its mesh (the hybrid's clusters): the frame to
-/// normalize in (the original's, so errors keep its units), and per input face the normal of
-/// the original face under it, for the flip test (a clustered face can already lean).
-///
-/// The clusters' quadrics are not carried: the queue ranks collapses by the clustered
-/// surface's own planes. Measured on the four shared scans and both 1M meshes at 10% and 1%,
-/// that gave a mean error 4–19% below the rounds' from the carried quadrics (docs/PERFORMANCE.md,
-/// "`hybrid`"), and 3–17% below this queue's from them. Summed over a whole cell, the members'
-/// planes charge every collapse for the cell's spread of orientations, where the clustered
-/// surface keeps only what is left of it.
-pub(crate) struct Carried<'a> {
-    pub frame: ([f64; 3], f64),
-    pub normals: &'a [[f32; 3]],
-}
-
 impl Prepared {
     /// The set-up, with the attributes `opts.attributes` weighs in the quadrics.
     pub fn new(input: &Mesh, opts: &SimplifyOptions) -> Prepared {
@@ -109,266 +78,32 @@ impl Prepared {
             .par_iter()
             .map(|&v| normalize(mesh.positions[v as usize], center, scale))
             .collect();
-
-        let tf = |f: &[u32; 3]| f.map(|v| topo[v as usize]);
-        // A face's plane: its unit normal, offset and twice its area, no area for a face
-        // without a normal.
-        let plane = |f: usize| -> [f64; 5] {
-            let [p0, p1, p2] = tf(&faces[f]).map(|v| pos[v as usize]);
-            let c = cross(sub(p1, p0), sub(p2, p0));
-            let len = norm(c);
-            if len > 0.0 {
-                let n = c.map(|x| x / len);
-                [n[0], n[1], n[2], -dot(n, p0), len]
-            } else {
-                [0.0; 5]
-            }
+        let geo = Geometry {
+            topo: &topo,
+            faces: &faces,
+            pos: &pos,
         };
         // The faces around each vertex, in face order (a counting sort, mostly on one core),
-        // and beside it each face's plane and reference normal: on the 1M scan 0.045-0.054 s
-        // one after the other, 0.030-0.037 s side by side.
+        // and beside it each face's plane and reference normal.
         let ((corners, corner_start), (ref_normal, planes)) = rayon::join(
             || counting_sort(nt, faces.len() * 3, |c| topo[faces[c / 3][c % 3] as usize]),
-            || -> (Vec<[f32; 3]>, Vec<[f64; 5]>) {
-                (0..faces.len())
-                    .into_par_iter()
-                    .map(|f| {
-                        let plane = plane(f);
-                        let own = (plane[4] > 0.0).then(|| [0, 1, 2].map(|k| plane[k] as f32));
-                        // The original face under a carried one, as the rounds' upload takes it.
-                        let under = carried.and_then(|c| c.normals.get(face_origin[f] as usize));
-                        let normal = match (own, under) {
-                            (Some(_), Some(&n)) if n != [0.0; 3] => n,
-                            (own, _) => own.unwrap_or([0.0; 3]),
-                        };
-                        (normal, plane)
-                    })
-                    .unzip()
-            },
+            || geo.planes_and_normals(&face_origin, carried),
         );
-        let faces_of = |v: usize| {
-            corners[corner_start[v] as usize..corner_start[v + 1] as usize]
-                .iter()
-                .map(|&c| c / 3)
+        let around = Around {
+            geo,
+            corners: &corners,
+            corner_start: &corner_start,
         };
-        // Per vertex, in parallel: the sum of its faces' plane quadrics in face order, then the
-        // constraint planes of its border and seam edges in ascending order of the other end,
-        // which is the order one pass over all edges sorted by (low, high) end gives each
-        // vertex; so the sums do not depend on the thread count. Each face's plane is read
-        // from the reference normals' pass (40 bytes a face) and its quadric made per vertex:
-        // cheaper than one 88-byte quadric per face written out and read back, and than the
-        // plane worked out again at each corner (`hybrid` on the 1M scan at 10%: this set-up
-        // 0.0390 -> 0.0348 s, medians of 21 calls; `cpu` 0.191 -> 0.184 s, of 9). Each
-        // constraint is computed once per vertex that needs it. Measured on the 1M scan, the
-        // sequential pass over all edges with a union-find over all corners took 0.12 s.
-        // Straight into the three arrays: collecting tuples and copying them out took 0.027 s,
-        // on one core, of the 0.25 s set-up of the 1M scan.
-        let seamless = !attr_count.par_iter().any(|&c| c > 1);
-        let (mut quadrics, (mut mobility, border)): (Vec<Quadric>, (Vec<Mobility>, Vec<bool>)) = (0
-            ..nt)
-            .into_par_iter()
-            .map_init(
-                || (Vec::new(), Vec::new()),
-                |(edges, fan): &mut (Vec<u64>, Vec<u32>), v| {
-                    let mut q = Quadric::default();
-                    for f in faces_of(v) {
-                        let [n0, n1, n2, d, len] = planes[f as usize];
-                        if len > 0.0 {
-                            q.add(&Quadric::from_plane([n0, n1, n2], d, 0.5 * len));
-                        }
-                    }
-                    // Most vertices are inside a surface without seams: their edges need no
-                    // sorting, since they add no constraint plane. The 1M scan at 10% (`cpu`,
-                    // two cores, 8 calls each way, turn about): this pass 0.073 -> 0.064 s.
-                    if seamless {
-                        let around = faces_of(v).map(|f| tf(&faces[f as usize]));
-                        if let Some(fans) = interior_fans(around, v as u32, fan) {
-                            let mobility = if fans > 1 {
-                                Mobility::Pinned
-                            } else {
-                                Mobility::Free
-                            };
-                            return (q, (mobility, false));
-                        }
-                    }
-                    let mut mobility = if attr_count[v] > 1 {
-                        Mobility::Seam
-                    } else {
-                        Mobility::Free
-                    };
-                    let mut border = false;
-                    // The edges at v, each with the place of its face among v's faces (so in
-                    // face order within an edge): 1 face for a border, 2 for a manifold edge,
-                    // more for a non-manifold one. Packed `other end << 32 | place` and sorted
-                    // as one integer: the order of (other end, face, place) triples, since the
-                    // places follow the faces. This per-vertex pass on the 1M scan at 10%
-                    // (two cores, median of 15): 0.0996 s sorting triples, 0.0965 s this.
-                    let vt = v as u32;
-                    let face_at =
-                        |i: u64| corners[corner_start[v] as usize + i as u32 as usize] / 3;
-                    edges.clear();
-                    for (i, f) in faces_of(v).enumerate() {
-                        let t = tf(&faces[f as usize]);
-                        edges.extend(
-                            t.into_iter()
-                                .filter(|&u| u != vt)
-                                .map(|u| (u as u64) << 32 | i as u64),
-                        );
-                    }
-                    edges.sort_unstable();
-                    // v's faces joined across its manifold edges: the fans around v.
-                    fan.clear();
-                    fan.extend(0..faces_of(v).len() as u32);
-                    let mut i = 0;
-                    while i < edges.len() {
-                        let mut j = i + 1;
-                        while j < edges.len() && edges[j] >> 32 == edges[i] >> 32 {
-                            j += 1;
-                        }
-                        let u = (edges[i] >> 32) as u32;
-                        let (a, b) = (vt.min(u), vt.max(u));
-                        let (pa, pb) = (pos[a as usize], pos[b as usize]);
-                        match j - i {
-                            1 => {
-                                border = true;
-                                // Hoppe's boundary constraint: a plane through the edge,
-                                // perpendicular to its face, weighted by the squared edge length
-                                // so it scales like an area.
-                                let t = tf(&faces[face_at(edges[i]) as usize]);
-                                let [p0, p1, p2] = t.map(|v| pos[v as usize]);
-                                let fnrm = cross(sub(p1, p0), sub(p2, p0));
-                                if let Some(c) = edge_constraint(pa, pb, fnrm, opts.border_weight) {
-                                    q.add(&c);
-                                }
-                            }
-                            2 => {
-                                let (f1, f2) = (face_at(edges[i]), face_at(edges[i + 1]));
-                                join(fan, edges[i] as u32, edges[i + 1] as u32);
-                                // A seam edge (the faces disagree on an endpoint's attribute
-                                // vertex) gets a constraint plane like a border, so the seam
-                                // keeps its course.
-                                let attr = |fi: u32, x: u32| {
-                                    let t = tf(&faces[fi as usize]);
-                                    faces[fi as usize][t.iter().position(|&y| y == x).unwrap_or(0)]
-                                };
-                                // Only a seam vertex (more than one attribute vertex) can
-                                // disagree; skipping the four lookups for the others saved 60M
-                                // of 3.8G instructions simplifying builtin:bumpy-sphere to 1%.
-                                let seam_end =
-                                    attr_count[a as usize] > 1 || attr_count[b as usize] > 1;
-                                if seam_end
-                                    && (attr(f1, a) != attr(f2, a) || attr(f1, b) != attr(f2, b))
-                                    && opts.border_weight > 0.0
-                                {
-                                    let normal = |fi: u32| {
-                                        let [p0, p1, p2] =
-                                            tf(&faces[fi as usize]).map(|v| pos[v as usize]);
-                                        let c = cross(sub(p1, p0), sub(p2, p0));
-                                        let l = norm(c);
-                                        if l > 0.0 { c.map(|x| x / l) } else { c }
-                                    };
-                                    let (n1, n2) = (normal(f1), normal(f2));
-                                    let avg = [0, 1, 2].map(|k| n1[k] + n2[k]);
-                                    if let Some(c) =
-                                        edge_constraint(pa, pb, avg, opts.border_weight)
-                                    {
-                                        q.add(&c);
-                                    }
-                                }
-                            }
-                            _ => mobility = Mobility::Pinned,
-                        }
-                        i = j;
-                    }
-                    // A vertex whose faces form more than one fan (a bow-tie) is pinned:
-                    // collapsing around it cannot keep the surface's topology well defined.
-                    if fan_count(fan) > 1 {
-                        mobility = Mobility::Pinned;
-                    }
-                    if opts.lock_border && border {
-                        mobility = match mobility {
-                            Mobility::Free => Mobility::LockedBorder,
-                            _ => Mobility::Pinned,
-                        };
-                    }
-                    (q, (mobility, border))
-                },
-            )
-            .unzip();
+        let pass = VertexPass {
+            around,
+            planes: &planes,
+            attr_count: &attr_count,
+            opts,
+        };
+        let (mut quadrics, (mut mobility, border)) = pass.quadrics_and_mobility(nt);
         drop(planes);
-        let attrs = layout.map(|layout| {
-            let mut at = Attributes::new(&mesh, layout);
-            let stride = at.layout.stride();
-            // Per vertex, in parallel and in face order like the geometric part: each face's
-            // attribute functions folded into the vertex's quadric and added to the sums of the
-            // attribute vertex the face uses there (a seam vertex has one per side).
-            // In place, per vertex: the folded terms straight into its quadric, the first
-            // side's sums into a row of its own (scattered to the attribute vertices after),
-            // further sides (seams only) in a list, so most vertices allocate and copy nothing.
-            // Collecting 400-byte tuples per vertex was most of the 70M instructions of memcpy
-            // simplifying the painted horse.
-            let mut first_sums = vec![0.0f64; nt * stride];
-            let mut first_id = vec![u32::MAX; nt];
-            let extra: Vec<Vec<(u32, [f64; MAX_STRIDE])>> = quadrics
-                .par_iter_mut()
-                .zip(first_sums.par_chunks_mut(stride))
-                .zip(first_id.par_iter_mut())
-                .enumerate()
-                .map(|(v, ((q, first), first_av))| {
-                    let mut sides: Vec<(u32, [f64; MAX_STRIDE])> = Vec::new();
-                    let mut ft = FaceTerms::default();
-                    for f in faces_of(v) {
-                        let f = f as usize;
-                        let t = tf(&faces[f]);
-                        let p = t.map(|u| pos[u as usize]);
-                        let area = 0.5 * norm(cross(sub(p[1], p[0]), sub(p[2], p[0])));
-                        if !ft.set(&at.layout, p, faces[f].map(|a| at.values(a))) {
-                            continue;
-                        }
-                        ft.fold_into(q, area);
-                        let av = faces[f][t.iter().position(|&u| u == v as u32).unwrap_or(0)];
-                        if *first_av == u32::MAX {
-                            *first_av = av;
-                        }
-                        if *first_av == av {
-                            ft.add_to(first, area);
-                        } else {
-                            let i = match sides.iter().position(|s| s.0 == av) {
-                                Some(i) => i,
-                                None => {
-                                    sides.push((av, [0.0; MAX_STRIDE]));
-                                    sides.len() - 1
-                                }
-                            };
-                            ft.add_to(&mut sides[i].1[..stride], area);
-                        }
-                    }
-                    sides
-                })
-                .collect();
-            for (v, sides) in extra.into_iter().enumerate() {
-                let av = first_id[v];
-                if av != u32::MAX {
-                    at.sums[av as usize * stride..(av as usize + 1) * stride]
-                        .copy_from_slice(&first_sums[v * stride..(v + 1) * stride]);
-                }
-                for (av, s) in sides {
-                    let at_v = av as usize * stride;
-                    at.sums[at_v..at_v + stride].copy_from_slice(&s[..stride]);
-                }
-            }
-            at
-        });
-        // The caller's pins (a tile's border) override whatever the vertex would be.
-        let mut held = vec![false; nt];
-        // Pins name the original's vertices, which a carried mesh does not have; `simplify`
-        // refuses pins for every method but qem.
-        debug_assert!(carried.is_none() || opts.pin.is_empty());
-        for &v in opts.pin.iter().filter(|_| carried.is_none()) {
-            let t = topo[weld_remap[v as usize] as usize] as usize;
-            mobility[t] = Mobility::Pinned;
-            held[t] = true;
-        }
+        let attrs = layout.map(|layout| around.fold_attributes(&mesh, layout, &mut quadrics));
+        let held = hold_pins(opts, carried, &topo, &weld_remap, &mut mobility);
         Prepared {
             mesh,
             topo,
@@ -521,84 +256,30 @@ impl Prepared {
     }
 }
 
-/// Neighbour entries (two per face) up to which [`interior_fans`] works on a fixed-width row:
-/// eight faces around a vertex.
-const FAN_ROW: usize = 16;
-
-/// The number of fans `v`'s faces `around` (topological, each holding `v` once) make when
-/// every neighbour is on exactly two of them: no border, seam or non-manifold edge at `v`, so
-/// its set-up adds no constraint plane. `None` otherwise, or beyond [`FAN_ROW`] entries.
-/// Counted against a fixed-width row (which the compiler vectorizes) instead of sorting the
-/// entries; the fans are the same sets whatever order their faces are joined in.
-fn interior_fans(
-    around: impl Iterator<Item = [u32; 3]>,
-    v: u32,
-    fan: &mut Vec<u32>,
-) -> Option<usize> {
-    // Padded with no vertex: ids are below the vertex count.
-    let mut row = [u32::MAX; FAN_ROW];
-    let mut n = 0;
-    for t in around {
-        for u in t {
-            if u != v {
-                *row.get_mut(n)? = u;
-                n += 1;
-            }
-        }
+/// The caller's pins (a tile's border), which override whatever the vertex would be: pins
+/// `mobility` there and returns which vertices they hold.
+fn hold_pins(
+    opts: &SimplifyOptions,
+    carried: Option<&Carried>,
+    topo: &[u32],
+    weld_remap: &[u32],
+    mobility: &mut [Mobility],
+) -> Vec<bool> {
+    let mut held = vec![false; mobility.len()];
+    // Pins name the original's vertices, which a carried mesh does not have; `simplify`
+    // refuses pins for every method but qem.
+    debug_assert!(carried.is_none() || opts.pin.is_empty());
+    for &v in opts.pin.iter().filter(|_| carried.is_none()) {
+        let t = topo[weld_remap[v as usize] as usize] as usize;
+        mobility[t] = Mobility::Pinned;
+        held[t] = true;
     }
-    if !row[..n]
-        .iter()
-        .all(|&u| row.iter().filter(|&&w| w == u).count() == 2)
-    {
-        return None;
-    }
-    // Entries 2i and 2i + 1 are face i's.
-    fan.clear();
-    fan.extend(0..(n / 2) as u32);
-    for j in 0..n {
-        if let Some(k) = (j + 1..n).find(|&k| row[k] == row[j]) {
-            join(fan, j as u32 / 2, k as u32 / 2);
-        }
-    }
-    Some(fan_count(fan))
-}
-
-/// The root of `x` in the union-find `fan` (halving the path on the way).
-fn fan_root(fan: &mut [u32], mut x: u32) -> u32 {
-    while fan[x as usize] != x {
-        fan[x as usize] = fan[fan[x as usize] as usize];
-        x = fan[x as usize];
-    }
-    x
-}
-
-/// Joins the sets of faces `a` and `b` in `fan` (the lower root stays).
-fn join(fan: &mut [u32], a: u32, b: u32) {
-    let (a, b) = (fan_root(fan, a), fan_root(fan, b));
-    fan[a.max(b) as usize] = a.min(b);
-}
-
-/// The number of sets (fans) in `fan`.
-fn fan_count(fan: &mut [u32]) -> usize {
-    (0..fan.len() as u32)
-        .filter(|&x| fan_root(fan, x) == x)
-        .count()
-}
-
-/// Hoppe's edge constraint: the plane through edge (pa, pb) perpendicular to the surface
-/// (normal `surface`), weighted by the squared edge length so it scales like a face area.
-fn edge_constraint(pa: [f64; 3], pb: [f64; 3], surface: [f64; 3], weight: f64) -> Option<Quadric> {
-    let e = sub(pb, pa);
-    let n = cross(e, surface);
-    let l = norm(n);
-    (l > 0.0 && weight > 0.0).then(|| {
-        let n = n.map(|x| x / l);
-        Quadric::from_plane(n, -dot(n, pa), weight * dot(e, e))
-    })
+    held
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::vertex_pass::{FAN_ROW, interior_fans};
     use super::*;
 
     /// Faces around vertex 0: each fan a ring of `ring` new neighbours, closed (the last face

@@ -2,8 +2,8 @@
 //! vertex, liveness, versions that retire stale queue entries, and the run's statistics.
 
 use super::prepare::Prepared;
-use crate::cache::{prefetch, prefetch_ptr};
 use crate::options::SimplifyOptions;
+use crate::prefetch::{prefetch, prefetch_ptr};
 
 /// The faces around each vertex, all in one arena: a vertex's list is `data[start..start + len]`
 /// with room up to `cap`. Built in vertex (Morton) order, so the lists of neighbours sit side by

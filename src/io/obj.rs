@@ -250,183 +250,246 @@ pub fn read_into(path: &Path, sink: &mut dyn crate::io::sink::Sink) -> Result<()
 }
 
 fn read_from(r: impl BufRead, path: &Path) -> Result<Mesh> {
-    let mut positions: Vec<[f32; 3]> = Vec::new();
-    let mut colors: Vec<[f32; 4]> = Vec::new();
-    let mut any_color = false;
-    let mut texcoords: Vec<[f32; 2]> = Vec::new();
-    let mut normals: Vec<[f32; 3]> = Vec::new();
-    // For each position: the (vt, vn) of the vertex that bears the position's index.
-    let mut pos_key: Vec<[u32; 2]> = Vec::new();
-    let mut pos_used: Vec<bool> = Vec::new();
-    // Attribute seams: extra vertices appended after the file's positions, tagged with SEAM
-    // in `triangles` until the number of positions is known.
-    let mut seams: HashMap<[u32; 3], u32> = HashMap::new();
-    let mut seam_keys: Vec<[u32; 3]> = Vec::new();
-    let mut triangles: Vec<[u32; 3]> = Vec::new();
-    let mut face_groups: Vec<u32> = Vec::new();
-    let mut face_materials: Vec<u32> = Vec::new();
-    let mut groups = Names::default();
-    let mut materials = Names::default();
-    let mut cur_group = NONE;
-    let mut cur_mat = NONE;
-    let mut libs = Vec::new();
-    let mut any_vt_corner = false;
-    let mut any_vn_corner = false;
-    let mut poly: Vec<u32> = Vec::new();
-
+    // No group or material until a line names one.
+    let mut obj = ObjReader {
+        cur_group: NONE,
+        cur_mat: NONE,
+        ..Default::default()
+    };
     let mut lines = Lines::new(r, path);
     while let Some((at, text)) = lines.next_line()? {
         let err = |m: String| Error::parse(path, at, m);
         let (kw, rest) = keyword(&text);
-        let floats = |rest: &str, what: &str| floats(rest, what, &err);
         match kw {
-            "v" => {
-                let (p, f) = vertex(rest, positions.len(), &err)?;
-                if f.len() == 6 {
-                    if !any_color {
-                        any_color = true;
-                        colors.resize(positions.len(), [1.0; 4]);
-                    }
-                    colors.push([f[3], f[4], f[5], 1.0]);
-                } else if any_color {
-                    colors.push([1.0; 4]);
-                }
-                if positions.len() >= SEAM as usize - 1 {
-                    return Err(err("too many vertices for 32-bit indices".into()));
-                }
-                positions.push(p);
-                pos_key.push([NONE; 2]);
-                pos_used.push(false);
-            }
-            "vt" => {
-                let f = floats(rest, "texture coordinate")?;
-                if f.is_empty() || f.len() > 3 {
-                    return Err(err(format!(
-                        "texture coordinate: expected 1 to 3 numbers, found {}",
-                        f.len()
-                    )));
-                }
-                texcoords.push([f[0], f.get(1).copied().unwrap_or(0.0)]);
-            }
-            "vn" => {
-                let f = floats(rest, "normal")?;
-                if f.len() != 3 {
-                    return Err(err(format!(
-                        "normal: expected 3 numbers, found {}",
-                        f.len()
-                    )));
-                }
-                normals.push([f[0], f[1], f[2]]);
-            }
-            "f" | "fo" => {
-                poly.clear();
-                for c in rest.split_ascii_whitespace() {
-                    let counts = [positions.len(), texcoords.len(), normals.len()];
-                    let idx = corner(c, counts, &err)?;
-                    any_vt_corner |= idx[1] != NONE;
-                    any_vn_corner |= idx[2] != NONE;
-                    let pos = idx[0] as usize;
-                    let key = [idx[1], idx[2]];
-                    let v = if !pos_used[pos] {
-                        pos_used[pos] = true;
-                        pos_key[pos] = key;
-                        pos as u32
-                    } else if pos_key[pos] == key {
-                        pos as u32
-                    } else {
-                        let next = seam_keys.len() as u32;
-                        let id = *seams.entry(idx).or_insert(next);
-                        if id == next {
-                            if next >= SEAM - 1 {
-                                return Err(err("too many vertices for 32-bit indices".into()));
-                            }
-                            seam_keys.push(idx);
-                        }
-                        id | SEAM
-                    };
-                    poly.push(v);
-                }
-                fan(&poly, &err, |t| {
-                    triangles.push(t);
-                    face_groups.push(cur_group);
-                    face_materials.push(cur_mat);
-                })?;
-            }
+            "v" => obj.vertex_line(rest, &err)?,
+            "vt" => obj.texcoord_line(rest, &err)?,
+            "vn" => obj.normal_line(rest, &err)?,
+            "f" | "fo" => obj.face_line(rest, &err)?,
             "o" | "g" => {
-                groups.used = true;
-                cur_group = groups.id(if rest.is_empty() { "default" } else { rest });
+                obj.groups.used = true;
+                obj.cur_group = obj
+                    .groups
+                    .id(if rest.is_empty() { "default" } else { rest });
             }
             "usemtl" => {
-                materials.used = true;
-                cur_mat = materials.id(if rest.is_empty() { "default" } else { rest });
+                obj.materials.used = true;
+                obj.cur_mat = obj
+                    .materials
+                    .id(if rest.is_empty() { "default" } else { rest });
             }
-            "mtllib" if !rest.is_empty() => libs.push(rest.to_string()),
+            "mtllib" if !rest.is_empty() => obj.libs.push(rest.to_string()),
             _ => {}
         }
     }
     if lines.line_no == 0 {
         return Err(Error::parse(path, Location::Byte(0), "empty file"));
     }
-    if positions.is_empty() {
+    if obj.positions.is_empty() {
         return Err(Error::parse(
             path,
             Location::Line(lines.line_no),
             "no vertices (`v` lines) found",
         ));
     }
-    let np = positions.len() as u32;
-    if (np as u64) + seam_keys.len() as u64 >= u32::MAX as u64 {
-        return Err(Error::parse(
-            path,
-            Location::Line(lines.line_no),
-            "too many vertices for 32-bit indices",
-        ));
+    obj.finish(path, lines.line_no)
+}
+
+/// What an OBJ file has said so far, line by line.
+#[derive(Default)]
+struct ObjReader {
+    positions: Vec<[f32; 3]>,
+    colors: Vec<[f32; 4]>,
+    any_color: bool,
+    texcoords: Vec<[f32; 2]>,
+    normals: Vec<[f32; 3]>,
+    /// For each position: the (vt, vn) of the vertex that bears the position's index.
+    pos_key: Vec<[u32; 2]>,
+    pos_used: Vec<bool>,
+    /// Attribute seams: extra vertices appended after the file's positions, tagged with SEAM
+    /// in `triangles` until the number of positions is known.
+    seams: HashMap<[u32; 3], u32>,
+    seam_keys: Vec<[u32; 3]>,
+    triangles: Vec<[u32; 3]>,
+    face_groups: Vec<u32>,
+    face_materials: Vec<u32>,
+    groups: Names,
+    materials: Names,
+    cur_group: u32,
+    cur_mat: u32,
+    libs: Vec<String>,
+    any_vt_corner: bool,
+    any_vn_corner: bool,
+    /// The face being read, reused from line to line.
+    poly: Vec<u32>,
+}
+
+impl ObjReader {
+    /// A `v` line: a position, and its colour when the line has one.
+    fn vertex_line(&mut self, rest: &str, err: &dyn Fn(String) -> Error) -> Result<()> {
+        let (p, f) = vertex(rest, self.positions.len(), err)?;
+        if f.len() == 6 {
+            if !self.any_color {
+                self.any_color = true;
+                self.colors.resize(self.positions.len(), [1.0; 4]);
+            }
+            self.colors.push([f[3], f[4], f[5], 1.0]);
+        } else if self.any_color {
+            self.colors.push([1.0; 4]);
+        }
+        if self.positions.len() >= SEAM as usize - 1 {
+            return Err(err("too many vertices for 32-bit indices".into()));
+        }
+        self.positions.push(p);
+        self.pos_key.push([NONE; 2]);
+        self.pos_used.push(false);
+        Ok(())
     }
-    for t in &mut triangles {
-        *t = t.map(|v| if v & SEAM != 0 { np + (v & !SEAM) } else { v });
+
+    /// A `vt` line: a texture coordinate (a third number is dropped).
+    fn texcoord_line(&mut self, rest: &str, err: &dyn Fn(String) -> Error) -> Result<()> {
+        let f = floats(rest, "texture coordinate", err)?;
+        if f.is_empty() || f.len() > 3 {
+            return Err(err(format!(
+                "texture coordinate: expected 1 to 3 numbers, found {}",
+                f.len()
+            )));
+        }
+        self.texcoords
+            .push([f[0], f.get(1).copied().unwrap_or(0.0)]);
+        Ok(())
     }
-    // (position, vt, vn) of every mesh vertex.
-    // A position no face uses takes the vt/vn of the same number when the file has one per
-    // position (as files written by `write_obj` do).
-    let (same_t, same_n) = (texcoords.len() == np as usize, normals.len() == np as usize);
-    let corners_of: Vec<[u32; 3]> = (0..np)
-        .map(|p| match pos_used[p as usize] {
-            true => [p, pos_key[p as usize][0], pos_key[p as usize][1]],
-            false => [
-                p,
-                if same_t { p } else { NONE },
-                if same_n { p } else { NONE },
-            ],
-        })
-        .chain(seam_keys)
-        .collect();
-    let mut mesh = Mesh {
-        positions: corners_of
-            .iter()
-            .map(|c| positions[c[0] as usize])
-            .collect(),
-        triangles,
-        ..Default::default()
-    };
-    if any_vt_corner {
-        mesh.uvs = Some(per_vertex(&corners_of, 1, &texcoords));
+
+    /// A `vn` line: a normal.
+    fn normal_line(&mut self, rest: &str, err: &dyn Fn(String) -> Error) -> Result<()> {
+        let f = floats(rest, "normal", err)?;
+        if f.len() != 3 {
+            return Err(err(format!(
+                "normal: expected 3 numbers, found {}",
+                f.len()
+            )));
+        }
+        self.normals.push([f[0], f[1], f[2]]);
+        Ok(())
     }
-    if any_vn_corner {
-        mesh.normals = Some(per_vertex(&corners_of, 2, &normals));
+
+    /// An `f` line: its corners as vertices (a position with another vt/vn than its first
+    /// use becomes a seam vertex), fanned into triangles of the current group and material.
+    fn face_line(&mut self, rest: &str, err: &dyn Fn(String) -> Error) -> Result<()> {
+        self.poly.clear();
+        for c in rest.split_ascii_whitespace() {
+            let counts = [
+                self.positions.len(),
+                self.texcoords.len(),
+                self.normals.len(),
+            ];
+            let idx = corner(c, counts, err)?;
+            self.any_vt_corner |= idx[1] != NONE;
+            self.any_vn_corner |= idx[2] != NONE;
+            let pos = idx[0] as usize;
+            let key = [idx[1], idx[2]];
+            let v = if !self.pos_used[pos] {
+                self.pos_used[pos] = true;
+                self.pos_key[pos] = key;
+                pos as u32
+            } else if self.pos_key[pos] == key {
+                pos as u32
+            } else {
+                let next = self.seam_keys.len() as u32;
+                let id = *self.seams.entry(idx).or_insert(next);
+                if id == next {
+                    if next >= SEAM - 1 {
+                        return Err(err("too many vertices for 32-bit indices".into()));
+                    }
+                    self.seam_keys.push(idx);
+                }
+                id | SEAM
+            };
+            self.poly.push(v);
+        }
+        fan(&self.poly, err, |t| {
+            self.triangles.push(t);
+            self.face_groups.push(self.cur_group);
+            self.face_materials.push(self.cur_mat);
+        })?;
+        Ok(())
     }
-    if any_color {
-        mesh.colors = Some(corners_of.iter().map(|c| colors[c[0] as usize]).collect());
+
+    /// The mesh: seam vertices numbered after the positions, every vertex's attributes, the
+    /// groups, materials and libraries; `line_no` is the file's last line, for errors.
+    fn finish(self, path: &Path, line_no: u64) -> Result<Mesh> {
+        let ObjReader {
+            positions,
+            colors,
+            any_color,
+            texcoords,
+            normals,
+            pos_key,
+            pos_used,
+            seam_keys,
+            mut triangles,
+            face_groups,
+            face_materials,
+            groups,
+            materials,
+            libs,
+            any_vt_corner,
+            any_vn_corner,
+            ..
+        } = self;
+        let np = positions.len() as u32;
+        if (np as u64) + seam_keys.len() as u64 >= u32::MAX as u64 {
+            return Err(Error::parse(
+                path,
+                Location::Line(line_no),
+                "too many vertices for 32-bit indices",
+            ));
+        }
+        for t in &mut triangles {
+            *t = t.map(|v| if v & SEAM != 0 { np + (v & !SEAM) } else { v });
+        }
+        // (position, vt, vn) of every mesh vertex.
+        // A position no face uses takes the vt/vn of the same number when the file has one per
+        // position (as files written by `write_obj` do).
+        let (same_t, same_n) = (texcoords.len() == np as usize, normals.len() == np as usize);
+        let corners_of: Vec<[u32; 3]> = (0..np)
+            .map(|p| match pos_used[p as usize] {
+                true => [p, pos_key[p as usize][0], pos_key[p as usize][1]],
+                false => [
+                    p,
+                    if same_t { p } else { NONE },
+                    if same_n { p } else { NONE },
+                ],
+            })
+            .chain(seam_keys)
+            .collect();
+        let mut mesh = Mesh {
+            positions: corners_of
+                .iter()
+                .map(|c| positions[c[0] as usize])
+                .collect(),
+            triangles,
+            ..Default::default()
+        };
+        if any_vt_corner {
+            mesh.uvs = Some(per_vertex(&corners_of, 1, &texcoords));
+        }
+        if any_vn_corner {
+            mesh.normals = Some(per_vertex(&corners_of, 2, &normals));
+        }
+        if any_color {
+            mesh.colors = Some(corners_of.iter().map(|c| colors[c[0] as usize]).collect());
+        }
+        if let Some((ids, names)) = groups.per_face(face_groups) {
+            mesh.face_groups = Some(ids);
+            mesh.groups = names;
+        }
+        if let Some((ids, names)) = materials.per_face(face_materials) {
+            mesh.face_materials = Some(ids);
+            mesh.materials = names.into_iter().map(Material::named).collect();
+        }
+        mesh.material_libs = libs;
+        Ok(mesh)
     }
-    if let Some((ids, names)) = groups.per_face(face_groups) {
-        mesh.face_groups = Some(ids);
-        mesh.groups = names;
-    }
-    if let Some((ids, names)) = materials.per_face(face_materials) {
-        mesh.face_materials = Some(ids);
-        mesh.materials = names.into_iter().map(Material::named).collect();
-    }
-    mesh.material_libs = libs;
-    Ok(mesh)
 }
 
 /// A name as it can stand on one OBJ line.

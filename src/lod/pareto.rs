@@ -312,32 +312,107 @@ fn search(
     pool: &rayon::ThreadPool,
     progress: &mut dyn FnMut(f32),
 ) -> Result<ParetoRun> {
-    let cancel = &opts.engine.cancel;
-    let pr = pool.install(|| Pareto::new(mesh, &opts.engine))?;
-    // `meshslim compare`'s sampling, so the figures are the ones it prints.
-    let full = MeanDistance::new(mesh, &CompareOptions::default())?;
-    let metro = MeanDistance::new(
-        mesh,
-        &CompareOptions {
-            samples: opts.search_samples,
-            ..CompareOptions::default()
-        },
-    )?;
-    let m = pr.order.len();
-    if m == 0 {
-        return Err(Error::InvalidMesh(
-            "no vertex of the mesh can be removed (every one is a corner, complex or locked), \
-             so it has one level of detail only"
-                .into(),
-        ));
-    }
-    let n = pr.live as f64;
-    let reference = [1.0, opts.reference_error];
+    let s = Search::new(mesh, opts, pool)?;
+    let m = s.pr.order.len();
     let total =
         (opts.population + opts.generations * opts.offspring * (1 + opts.anchor as usize)) as f32;
-    let point = |c: &Candidate| [c.vertices as f64 / n, c.error];
-    let front_of = |pop: &[Candidate]| -> Generation {
-        let pts: Vec<Point> = pop.iter().map(point).collect();
+    let seeded = match opts.init {
+        Initialisation::Greedy => opts.population / 2,
+        Initialisation::Random => 0,
+    };
+    let mut pop = s.first_population(seeded)?;
+    // The greedy masks evaluated (the seeds, the twins), by vertex count.
+    let mut greedy_known: BTreeMap<usize, Candidate> = pop[..seeded]
+        .iter()
+        .map(|c| (c.vertices, c.clone()))
+        .collect();
+    let (twins, evaluated) = anchor(&s.pr, pool, &s.metro, opts, &pop, &[], &mut greedy_known)?;
+    pop.extend(twins);
+    let mut done = opts.population + evaluated;
+    progress(done as f32 / total);
+    let mut generations = vec![s.front_of(&pop)];
+    for g in 1..=opts.generations {
+        pop = s.generation(g, pop, &mut greedy_known, &mut done)?;
+        generations.push(s.front_of(&pop));
+        progress(done as f32 / total);
+    }
+    let front = s.final_front(&pop);
+    let (front_meshes, front_measured) = s.measure_front(&front)?;
+    let (baseline_meshes, baseline) = if opts.measure {
+        s.baselines(&front, &front_meshes, &front_measured, &greedy_known)?
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    Ok(ParetoRun {
+        input_vertices: s.pr.live,
+        removable: m,
+        reference: s.reference,
+        generations,
+        front,
+        front_meshes,
+        front_measured,
+        baseline_meshes,
+        baseline,
+        evaluations: done,
+    })
+}
+
+/// What the search's steps share: the engine's run over the mesh, the Metro measures, the
+/// options and the pool every parallel step runs on.
+struct Search<'a> {
+    pr: Pareto,
+    /// `meshslim compare`'s sampling, so the figures are the ones it prints.
+    full: MeanDistance<'a>,
+    /// The search's own sampling (`opts.search_samples`).
+    metro: MeanDistance<'a>,
+    opts: &'a ParetoOptions,
+    pool: &'a rayon::ThreadPool,
+    /// The hypervolume's reference point.
+    reference: [f64; 2],
+}
+
+impl<'a> Search<'a> {
+    /// The engine's greedy run over `mesh` and the Metro measures against it; an error when no
+    /// vertex can be removed.
+    fn new(
+        mesh: &'a Mesh,
+        opts: &'a ParetoOptions,
+        pool: &'a rayon::ThreadPool,
+    ) -> Result<Search<'a>> {
+        let pr = pool.install(|| Pareto::new(mesh, &opts.engine))?;
+        let full = MeanDistance::new(mesh, &CompareOptions::default())?;
+        let metro = MeanDistance::new(
+            mesh,
+            &CompareOptions {
+                samples: opts.search_samples,
+                ..CompareOptions::default()
+            },
+        )?;
+        if pr.order.is_empty() {
+            return Err(Error::InvalidMesh(
+                "no vertex of the mesh can be removed (every one is a corner, complex or locked), \
+                 so it has one level of detail only"
+                    .into(),
+            ));
+        }
+        Ok(Search {
+            pr,
+            full,
+            metro,
+            opts,
+            pool,
+            reference: [1.0, opts.reference_error],
+        })
+    }
+
+    /// A candidate's objectives: the fraction of the vertices it keeps and its error.
+    fn point(&self, c: &Candidate) -> Point {
+        [c.vertices as f64 / self.pr.live as f64, c.error]
+    }
+
+    /// The points of `pop`'s first front, sorted and deduplicated, and their hypervolume.
+    fn front_of(&self, pop: &[Candidate]) -> Generation {
+        let pts: Vec<Point> = pop.iter().map(|c| self.point(c)).collect();
         let mut front: Vec<Point> = nsga::non_dominated_sort(&pts)[0]
             .iter()
             .map(|&i| pts[i])
@@ -345,66 +420,74 @@ fn search(
         front.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
         front.dedup();
         Generation {
-            hypervolume: nsga::hypervolume(&front, reference),
+            hypervolume: nsga::hypervolume(&front, self.reference),
             front,
         }
-    };
+    }
 
-    let seeded = match opts.init {
-        Initialisation::Greedy => opts.population / 2,
-        Initialisation::Random => 0,
-    };
-    let mut pop: Vec<Candidate> = pool.install(|| {
-        (0..opts.population)
-            .into_par_iter()
-            .map(|i| {
-                cancel.check()?;
-                let keep = if i < seeded {
-                    // Removal counts spread evenly over the greedy run.
-                    pr.greedy_mask(m * (i + 1) / (seeded + 1))
-                } else {
-                    let mut rng = stream(opts.seed, 0, i);
-                    let q = rng.next_f64();
-                    (0..m).map(|_| rng.next_f64() < q).collect()
-                };
-                pr.evaluate(keep, &metro, opts.error)
-            })
-            .collect::<Result<_>>()
-    })?;
-    // The greedy masks evaluated (the seeds, the twins), by vertex count.
-    let mut greedy_known: BTreeMap<usize, Candidate> = pop[..seeded]
-        .iter()
-        .map(|c| (c.vertices, c.clone()))
-        .collect();
-    let (twins, evaluated) = anchor(&pr, pool, &metro, opts, &pop, &[], &mut greedy_known)?;
-    pop.extend(twins);
-    let mut done = opts.population + evaluated;
-    progress(done as f32 / total);
-    let mut generations = vec![front_of(&pop)];
+    /// The first population, evaluated: its first `seeded` candidates the greedy masks, the
+    /// rest random.
+    fn first_population(&self, seeded: usize) -> Result<Vec<Candidate>> {
+        let (pr, opts, m) = (&self.pr, self.opts, self.pr.order.len());
+        self.pool.install(|| {
+            (0..opts.population)
+                .into_par_iter()
+                .map(|i| {
+                    opts.engine.cancel.check()?;
+                    let keep = if i < seeded {
+                        // Removal counts spread evenly over the greedy run.
+                        pr.greedy_mask(m * (i + 1) / (seeded + 1))
+                    } else {
+                        let mut rng = stream(opts.seed, 0, i);
+                        let q = rng.next_f64();
+                        (0..m).map(|_| rng.next_f64() < q).collect()
+                    };
+                    pr.evaluate(keep, &self.metro, opts.error)
+                })
+                .collect::<Result<_>>()
+        })
+    }
 
-    for g in 1..=opts.generations {
-        cancel.check()?;
-        let pts: Vec<Point> = pop.iter().map(point).collect();
+    /// Generation `g`: offspring bred from `pop` and evaluated, their greedy twins (see
+    /// [`anchor`]), then the survivors; adds the evaluations to `done`.
+    fn generation(
+        &self,
+        g: usize,
+        mut pop: Vec<Candidate>,
+        greedy_known: &mut BTreeMap<usize, Candidate>,
+        done: &mut usize,
+    ) -> Result<Vec<Candidate>> {
+        let (pr, opts) = (&self.pr, self.opts);
+        opts.engine.cancel.check()?;
+        let pts: Vec<Point> = pop.iter().map(|c| self.point(c)).collect();
         let rc = nsga::rank_and_crowding(&pts);
-        let children: Vec<Candidate> = pool.install(|| {
+        let children: Vec<Candidate> = self.pool.install(|| {
             (0..opts.offspring)
                 .into_par_iter()
                 .map(|j| {
                     let mut rng = stream(opts.seed, g, j);
                     let a = nsga::tournament(&rc, opts.tournament, &mut rng);
                     let b = nsga::tournament(&rc, opts.tournament, &mut rng);
-                    let mut child = crossover(&pr, &pop[a].keep, &pop[b].keep, opts, &mut rng);
+                    let mut child = crossover(pr, &pop[a].keep, &pop[b].keep, opts, &mut rng);
                     mutate(&mut child, opts, &mut rng);
-                    pr.evaluate(child, &metro, opts.error)
+                    pr.evaluate(child, &self.metro, opts.error)
                 })
                 .collect::<Result<_>>()
         })?;
-        let twins = anchor(&pr, pool, &metro, opts, &children, &pop, &mut greedy_known)?;
-        done += twins.1;
+        let twins = anchor(
+            pr,
+            self.pool,
+            &self.metro,
+            opts,
+            &children,
+            &pop,
+            greedy_known,
+        )?;
+        *done += twins.1;
         let twins = twins.0;
         pop.extend(children);
         pop.extend(twins);
-        let pts: Vec<Point> = pop.iter().map(point).collect();
+        let pts: Vec<Point> = pop.iter().map(|c| self.point(c)).collect();
         let keep = nsga::select_survivors(&pts, opts.population);
         let mut next = Vec::with_capacity(opts.population);
         for (i, c) in pop.into_iter().enumerate() {
@@ -412,37 +495,39 @@ fn search(
                 next.push(c);
             }
         }
-        pop = next;
-        generations.push(front_of(&pop));
-        done += opts.offspring;
-        progress(done as f32 / total);
+        *done += opts.offspring;
+        Ok(next)
     }
 
-    // The final front, by vertices, one candidate per point.
-    let pts: Vec<Point> = pop.iter().map(point).collect();
-    let mut front: Vec<Candidate> = nsga::non_dominated_sort(&pts)[0]
-        .iter()
-        .map(|&i| pop[i].clone())
-        .collect();
-    front.sort_by(|a, b| {
-        a.vertices
-            .cmp(&b.vertices)
-            .then(a.error.total_cmp(&b.error))
-    });
-    front.dedup_by(|a, b| a.vertices == b.vertices && a.error == b.error);
+    /// The final front, by vertices, one candidate per point.
+    fn final_front(&self, pop: &[Candidate]) -> Vec<Candidate> {
+        let pts: Vec<Point> = pop.iter().map(|c| self.point(c)).collect();
+        let mut front: Vec<Candidate> = nsga::non_dominated_sort(&pts)[0]
+            .iter()
+            .map(|&i| pop[i].clone())
+            .collect();
+        front.sort_by(|a, b| {
+            a.vertices
+                .cmp(&b.vertices)
+                .then(a.error.total_cmp(&b.error))
+        });
+        front.dedup_by(|a, b| a.vertices == b.vertices && a.error == b.error);
+        front
+    }
 
-    // Each member's mesh, and with `measure` its Metro mean and the greedy chain's at its
-    // vertex count (the greedy run's first `live - count` removals).
-    // When the search measured with `meshslim compare`'s own sampling, its figures are final.
-    let exact = opts.error == ErrorMeasure::Metro && opts.search_samples.is_none();
-    let decode = |keep: &[bool], known: Option<f64>| -> Result<(Mesh, Measured)> {
-        cancel.check()?;
-        let d = pr.decode(&mut keep.to_vec());
+    /// The mesh `keep` decodes to, measured: with `measure` (or a Metro search) its Metro
+    /// mean, which `known` gives when the search measured with `meshslim compare`'s own
+    /// sampling, as its figures are then final.
+    fn decode(&self, keep: &[bool], known: Option<f64>) -> Result<(Mesh, Measured)> {
+        let opts = self.opts;
+        let exact = opts.error == ErrorMeasure::Metro && opts.search_samples.is_none();
+        opts.engine.cancel.check()?;
+        let d = self.pr.decode(&mut keep.to_vec());
         let out = d.mesh();
         let metro_mean = if let Some(e) = known.filter(|_| exact) {
             e
         } else if opts.measure || opts.error == ErrorMeasure::Metro {
-            full.mean_rel(&out)?
+            self.full.mean_rel(&out)?
         } else {
             f64::NAN
         };
@@ -457,51 +542,55 @@ fn search(
             metro_mean,
         };
         Ok((out, m))
-    };
-    let (front_meshes, front_measured): (Vec<Mesh>, Vec<Measured>) = pool
-        .install(|| {
-            front
-                .par_iter()
-                .map(|c| decode(&c.keep, Some(c.error)))
-                .collect::<Result<Vec<_>>>()
-        })?
-        .into_iter()
-        .unzip();
-    let (baseline_meshes, baseline) = if opts.measure {
-        pool.install(|| {
-            front
-                .par_iter()
-                .zip(&front_meshes)
-                .zip(&front_measured)
-                .map(|((c, mesh), m)| {
-                    let greedy = pr.greedy_mask(pr.live - c.vertices);
-                    // A member that is the greedy's own mask (a seed that survived) is its
-                    // baseline.
-                    if greedy == c.keep {
-                        Ok((mesh.clone(), m.clone()))
-                    } else {
-                        decode(&greedy, greedy_known.get(&c.vertices).map(|t| t.error))
-                    }
-                })
-                .collect::<Result<Vec<_>>>()
-        })?
-        .into_iter()
-        .unzip()
-    } else {
-        (Vec::new(), Vec::new())
-    };
-    Ok(ParetoRun {
-        input_vertices: pr.live,
-        removable: m,
-        reference,
-        generations,
-        front,
-        front_meshes,
-        front_measured,
-        baseline_meshes,
-        baseline,
-        evaluations: done,
-    })
+    }
+
+    /// Each member of `front`'s mesh and its measures.
+    fn measure_front(&self, front: &[Candidate]) -> Result<(Vec<Mesh>, Vec<Measured>)> {
+        Ok(self
+            .pool
+            .install(|| {
+                front
+                    .par_iter()
+                    .map(|c| self.decode(&c.keep, Some(c.error)))
+                    .collect::<Result<Vec<_>>>()
+            })?
+            .into_iter()
+            .unzip())
+    }
+
+    /// The greedy chain's mesh and measures at each member's vertex count (the greedy run's
+    /// first `live - count` removals), the errors of masks evaluated already from
+    /// `greedy_known`.
+    fn baselines(
+        &self,
+        front: &[Candidate],
+        front_meshes: &[Mesh],
+        front_measured: &[Measured],
+        greedy_known: &BTreeMap<usize, Candidate>,
+    ) -> Result<(Vec<Mesh>, Vec<Measured>)> {
+        let pr = &self.pr;
+        Ok(self
+            .pool
+            .install(|| {
+                front
+                    .par_iter()
+                    .zip(front_meshes)
+                    .zip(front_measured)
+                    .map(|((c, mesh), m)| {
+                        let greedy = pr.greedy_mask(pr.live - c.vertices);
+                        // A member that is the greedy's own mask (a seed that survived) is its
+                        // baseline.
+                        if greedy == c.keep {
+                            Ok((mesh.clone(), m.clone()))
+                        } else {
+                            self.decode(&greedy, greedy_known.get(&c.vertices).map(|t| t.error))
+                        }
+                    })
+                    .collect::<Result<Vec<_>>>()
+            })?
+            .into_iter()
+            .unzip())
+    }
 }
 
 /// Greedy anchoring: the greedy's mask at the vertex count of each of `newcomers` joins them

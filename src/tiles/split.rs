@@ -7,8 +7,9 @@ use super::{FORMAT, Manifest, TILE_SHARE, Tile, at, grid_for};
 use crate::Backend;
 use crate::cluster::stream::Target;
 use crate::error::{Error, Result};
-use crate::io::stream::{FileFaces, read_vertices};
+use crate::io::stream::{Colors, FileFaces, read_vertices};
 use rustc_hash::FxHashMap;
+use std::fs::File;
 use std::io::{BufWriter, Read, Write};
 use std::path::Path;
 
@@ -58,6 +59,110 @@ pub fn split(
     opts: &SplitOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<Manifest> {
+    check_options(input, opts)?;
+    clear_manifest(dir)?;
+    // Vertex colours travel with the tiles (coloured scans are the big ones): each tile's
+    // simplification weighs them, the pinned borders keep theirs, and the merge joins them.
+    let (positions, colors) = read_vertices(input, true)?;
+    let cells = Cells::new(&positions, opts.tiles, opts.after);
+    let faces = FileFaces::new(input, opts.block);
+    let tile_of = |t: &[u32; 3]| cells.tile(t.map(|v| positions[v as usize]));
+    progress(0.1);
+
+    let nv = positions.len();
+    let (border, tile_faces) = first_pass(&faces, &tile_of, nv, opts.tiles)?;
+    let total: u64 = tile_faces.iter().sum();
+    let target_faces = target_faces(input, opts, total)?;
+    progress(0.4);
+
+    let _parts = Parts {
+        dir,
+        tiles: opts.tiles,
+    };
+    let mut writers = open_parts(dir, opts.tiles)?;
+    let mut borders = second_pass(
+        &faces,
+        &tile_of,
+        &border,
+        &mut writers,
+        dir,
+        total,
+        progress,
+    )?;
+
+    // Each tile's PLY: the header, its vertices looked up by global id, its face records.
+    let mut tile = Vec::with_capacity(opts.tiles);
+    for (i, parts) in writers.into_iter().enumerate() {
+        let vertices = write_tile(
+            dir,
+            i,
+            opts.tiles,
+            parts,
+            &positions,
+            colors.as_ref(),
+            tile_faces[i],
+        )?;
+        let mut b = std::mem::take(&mut borders[i]);
+        b.sort_unstable();
+        let share = target_faces as f64 * opts.share * tile_faces[i] as f64 / total as f64;
+        tile.push(Tile {
+            file: part_name(i, ".ply"),
+            ids: part_name(i, ".ids"),
+            output: part_name(i, ".out.ply"),
+            output_ids: part_name(i, ".out.ids"),
+            faces: tile_faces[i],
+            vertices,
+            target_faces: (share.round() as u64).min(tile_faces[i]),
+            border: b,
+        });
+        progress(0.8 + 0.2 * (i + 1) as f32 / opts.tiles as f32);
+    }
+    let manifest = Manifest {
+        format: FORMAT.into(),
+        input: input.display().to_string(),
+        input_faces: total,
+        input_vertices: nv as u64,
+        target_faces,
+        backend: opts.backend.name().into(),
+        grid: cells.grid,
+        tiles: opts.tiles,
+        shift: cells.shift,
+        tile,
+    };
+    write_manifest(dir, &manifest)?;
+    Ok(manifest)
+}
+
+/// The faces the merge ends at, from the input's `total` faces; an error when it has none.
+fn target_faces(input: &Path, opts: &SplitOptions, total: u64) -> Result<u64> {
+    if total == 0 {
+        return Err(Error::InvalidMesh(format!(
+            "{} has no faces, so there is nothing to split",
+            input.display()
+        )));
+    }
+    Ok(match opts.target {
+        Target::Faces(n) => n as u64,
+        Target::Ratio(r) => {
+            crate::SimplifyOptions::with_ratio(total as usize, r)?.target_faces as u64
+        }
+    })
+}
+
+/// Writes the manifest into `dir`, after removing the outputs of an earlier split there,
+/// which would be merged with the new tiles.
+fn write_manifest(dir: &Path, manifest: &Manifest) -> Result<()> {
+    for t in &manifest.tile {
+        for f in [&t.output, &t.output_ids] {
+            let _ = std::fs::remove_file(at(dir, f));
+        }
+    }
+    manifest.write(dir)
+}
+
+/// Refuses a split the options or the input's format cannot make: a tile count out of range,
+/// a backend other than `cpu`, an input other than PLY or OBJ.
+fn check_options(input: &Path, opts: &SplitOptions) -> Result<()> {
     if opts.tiles == 0 || opts.tiles > MAX_TILES {
         return Err(Error::InvalidOption(format!(
             "--tiles must be 1 to {MAX_TILES} (two files are open per tile while splitting), got {}",
@@ -78,28 +183,38 @@ pub fn split(
             input.display()
         )));
     }
+    Ok(())
+}
+
+/// Creates `dir` if missing and removes an earlier split's manifest there first, so a split
+/// that fails leaves no manifest that names these tiles with its old borders; its outputs go
+/// at the end.
+fn clear_manifest(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    // An earlier split's manifest goes first, so a split that fails leaves no manifest that
-    // names these tiles with its old borders; its outputs go at the end.
     match std::fs::remove_file(dir.join(super::MANIFEST)) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            return Err(Error::io(&dir.join(super::MANIFEST), e));
+            Err(Error::io(&dir.join(super::MANIFEST), e))
         }
-        _ => {}
+        _ => Ok(()),
     }
-    // Vertex colours travel with the tiles (coloured scans are the big ones): each tile's
-    // simplification weighs them, the pinned borders keep theirs, and the merge joins them.
-    let (positions, colors) = read_vertices(input, true)?;
-    let cells = Cells::new(&positions, opts.tiles, opts.after);
-    let faces = FileFaces::new(input, opts.block);
-    let tile_of = |t: &[u32; 3]| cells.tile(t.map(|v| positions[v as usize]));
-    progress(0.1);
+}
 
-    // Pass 1: each vertex's first tile, and whether a face of another tile uses it too.
-    let nv = positions.len();
+/// The name of tile `i`'s file with extension `ext`.
+fn part_name(i: usize, ext: &str) -> String {
+    format!("tile-{i:04}{ext}")
+}
+
+/// Pass 1 over the `nv` vertices' faces: whether a face of another tile than a vertex's first
+/// uses it too (a border vertex), and each of the `tiles` tiles' face count.
+fn first_pass(
+    faces: &FileFaces,
+    tile_of: &impl Fn(&[u32; 3]) -> u32,
+    nv: usize,
+    tiles: usize,
+) -> Result<(Vec<bool>, Vec<u64>)> {
     let mut first = vec![u32::MAX; nv];
     let mut border = vec![false; nv];
-    let mut tile_faces = vec![0u64; opts.tiles];
+    let mut tile_faces = vec![0u64; tiles];
     faces.blocks(&mut |_, block| {
         for t in block {
             let k = tile_of(t);
@@ -114,41 +229,40 @@ pub fn split(
         }
         Ok(())
     })?;
-    let total: u64 = tile_faces.iter().sum();
-    if total == 0 {
-        return Err(Error::InvalidMesh(format!(
-            "{} has no faces, so there is nothing to split",
-            input.display()
-        )));
-    }
-    let target_faces = match opts.target {
-        Target::Faces(n) => n as u64,
-        Target::Ratio(r) => {
-            crate::SimplifyOptions::with_ratio(total as usize, r)?.target_faces as u64
-        }
-    };
-    drop(first);
-    progress(0.4);
+    Ok((border, tile_faces))
+}
 
-    // Pass 2: faces renumbered per tile in order of first use, written as binary PLY face
-    // records to a part file per tile; each tile's global ids appended as they are numbered.
-    let name = |i: usize, ext: &str| format!("tile-{i:04}{ext}");
-    let _parts = Parts {
-        dir,
-        tiles: opts.tiles,
-    };
-    let mut writers = Vec::with_capacity(opts.tiles);
-    for i in 0..opts.tiles {
-        let open = |ext: &str| -> Result<BufWriter<std::fs::File>> {
-            let p = at(dir, &name(i, ext));
-            let f = std::fs::File::create(&p).map_err(|e| Error::io(&p, e))?;
+/// The part files of `tiles` tiles in `dir`, created: per tile its face records' and its
+/// global ids' writer.
+fn open_parts(dir: &Path, tiles: usize) -> Result<Vec<(BufWriter<File>, BufWriter<File>)>> {
+    let mut writers = Vec::with_capacity(tiles);
+    for i in 0..tiles {
+        let open = |ext: &str| -> Result<BufWriter<File>> {
+            let p = at(dir, &part_name(i, ext));
+            let f = File::create(&p).map_err(|e| Error::io(&p, e))?;
             Ok(BufWriter::with_capacity(1 << 16, f))
         };
         writers.push((open(".faces.part")?, open(".ids.part")?));
     }
-    let mut count = vec![0u32; opts.tiles];
+    Ok(writers)
+}
+
+/// Pass 2: faces renumbered per tile in order of first use, written as binary PLY face
+/// records to a part file per tile; each tile's global ids appended as they are numbered.
+/// Returns each tile's border vertices (global ids, unsorted).
+fn second_pass(
+    faces: &FileFaces,
+    tile_of: &impl Fn(&[u32; 3]) -> u32,
+    border: &[bool],
+    writers: &mut [(BufWriter<File>, BufWriter<File>)],
+    dir: &Path,
+    total: u64,
+    progress: &mut dyn FnMut(f32),
+) -> Result<Vec<Vec<u32>>> {
+    let tiles = writers.len();
+    let mut count = vec![0u32; tiles];
     // Non-border vertices have one tile and so one local id; border vertices one per tile.
-    let mut local = vec![u32::MAX; nv];
+    let mut local = vec![u32::MAX; border.len()];
     let mut local_border: FxHashMap<(u32, u32), u32> = FxHashMap::default();
     let mut done = 0u64;
     faces.blocks(&mut |_, block| {
@@ -178,97 +292,71 @@ pub fn split(
         Ok(())
     })?;
     drop(local);
-    let mut borders: Vec<Vec<u32>> = vec![Vec::new(); opts.tiles];
+    let mut borders: Vec<Vec<u32>> = vec![Vec::new(); tiles];
     for &(k, v) in local_border.keys() {
         borders[k as usize].push(v);
     }
-    drop(local_border);
+    Ok(borders)
+}
 
-    // Each tile's PLY: the header, its vertices looked up by global id, its face records.
-    let mut tile = Vec::with_capacity(opts.tiles);
-    for (i, (fw, iw)) in writers.into_iter().enumerate() {
-        // Scratch files: flushed, not synced (the tile's PLY is written atomically from them).
-        for w in [fw, iw] {
-            w.into_inner().map_err(|e| Error::io(dir, e.into_error()))?;
-        }
-        let part = |ext: &str| at(dir, &name(i, ext));
-        let ids = super::read_ids(&part(".ids.part"))?;
-        let ply = part(".ply");
-        crate::io::write_atomic(&ply, |w| {
-            write!(
-                w,
-                "ply\nformat binary_little_endian 1.0\ncomment meshslim tile {i} of {}\n\
-                 element vertex {}\nproperty float x\nproperty float y\nproperty float z\n{}\
-                 element face {}\nproperty list uchar int vertex_indices\nend_header\n",
-                opts.tiles,
-                ids.len(),
-                if colors.is_some() {
-                    "property float red\nproperty float green\nproperty float blue\n\
-                     property float alpha\n"
-                } else {
-                    ""
-                },
-                tile_faces[i]
-            )?;
-            for &g in &ids {
-                for x in positions[g as usize] {
+/// Tile `i`'s PLY (of `tiles`) from its part files `(fw, iw)`: the header, its vertices
+/// looked up by global id, its `faces` face records; the faces' part removed and the ids'
+/// kept as the tile's ids. Returns its vertex count.
+fn write_tile(
+    dir: &Path,
+    i: usize,
+    tiles: usize,
+    (fw, iw): (BufWriter<File>, BufWriter<File>),
+    positions: &[[f32; 3]],
+    colors: Option<&Colors>,
+    faces: u64,
+) -> Result<u64> {
+    // Scratch files: flushed, not synced (the tile's PLY is written atomically from them).
+    for w in [fw, iw] {
+        w.into_inner().map_err(|e| Error::io(dir, e.into_error()))?;
+    }
+    let part = |ext: &str| at(dir, &part_name(i, ext));
+    let ids = super::read_ids(&part(".ids.part"))?;
+    let ply = part(".ply");
+    crate::io::write_atomic(&ply, |w| {
+        write!(
+            w,
+            "ply\nformat binary_little_endian 1.0\ncomment meshslim tile {i} of {}\n\
+             element vertex {}\nproperty float x\nproperty float y\nproperty float z\n{}\
+             element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+            tiles,
+            ids.len(),
+            if colors.is_some() {
+                "property float red\nproperty float green\nproperty float blue\n\
+                 property float alpha\n"
+            } else {
+                ""
+            },
+            faces
+        )?;
+        for &g in &ids {
+            for x in positions[g as usize] {
+                w.write_all(&x.to_le_bytes())?;
+            }
+            if let Some(c) = colors {
+                for x in c[g as usize] {
                     w.write_all(&x.to_le_bytes())?;
                 }
-                if let Some(c) = &colors {
-                    for x in c[g as usize] {
-                        w.write_all(&x.to_le_bytes())?;
-                    }
-                }
             }
-            let mut body = std::fs::File::open(part(".faces.part"))?;
-            let mut buf = vec![0u8; 1 << 16];
-            loop {
-                let n = body.read(&mut buf)?;
-                if n == 0 {
-                    break Ok(());
-                }
-                w.write_all(&buf[..n])?;
-            }
-        })?;
-        std::fs::remove_file(part(".faces.part"))
-            .map_err(|e| Error::io(&part(".faces.part"), e))?;
-        std::fs::rename(part(".ids.part"), part(".ids"))
-            .map_err(|e| Error::io(&part(".ids"), e))?;
-        let mut b = std::mem::take(&mut borders[i]);
-        b.sort_unstable();
-        let share = target_faces as f64 * opts.share * tile_faces[i] as f64 / total as f64;
-        tile.push(Tile {
-            file: name(i, ".ply"),
-            ids: name(i, ".ids"),
-            output: name(i, ".out.ply"),
-            output_ids: name(i, ".out.ids"),
-            faces: tile_faces[i],
-            vertices: ids.len() as u64,
-            target_faces: (share.round() as u64).min(tile_faces[i]),
-            border: b,
-        });
-        progress(0.8 + 0.2 * (i + 1) as f32 / opts.tiles as f32);
-    }
-    let manifest = Manifest {
-        format: FORMAT.into(),
-        input: input.display().to_string(),
-        input_faces: total,
-        input_vertices: nv as u64,
-        target_faces,
-        backend: opts.backend.name().into(),
-        grid: cells.grid,
-        tiles: opts.tiles,
-        shift: cells.shift,
-        tile,
-    };
-    // Outputs of an earlier split in this folder would be merged with the new tiles: remove them.
-    for t in &manifest.tile {
-        for f in [&t.output, &t.output_ids] {
-            let _ = std::fs::remove_file(at(dir, f));
         }
-    }
-    manifest.write(dir)?;
-    Ok(manifest)
+        let mut body = File::open(part(".faces.part"))?;
+        let mut buf = vec![0u8; 1 << 16];
+        loop {
+            let n = body.read(&mut buf)?;
+            if n == 0 {
+                break Ok(());
+            }
+            w.write_all(&buf[..n])?;
+        }
+    })?;
+    std::fs::remove_file(part(".faces.part")).map_err(|e| Error::io(&part(".faces.part"), e))?;
+    std::fs::rename(part(".ids.part"), part(".ids")).map_err(|e| Error::io(&part(".ids"), e))?;
+    Ok(ids.len() as u64)
 }
 
 /// Removes the part files a split left when it fails (on success they are gone already).

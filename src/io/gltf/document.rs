@@ -13,14 +13,16 @@ pub(super) struct Doc<'a> {
     pub(super) root: json::Root,
     /// Materials, textures, samplers and images as raw JSON: carried through unchanged
     /// (`json::Root` drops the extensions it does not know).
-    pub(super) carried: Carried,
+    pub(super) carried: RawAppearance,
     pub(super) buffers: Vec<Vec<u8>>,
     pub(super) path: &'a Path,
 }
 
+/// The input's materials, textures, samplers, images and required extensions as raw JSON,
+/// for the writer to carry through.
 #[derive(serde::Deserialize, Default)]
 #[serde(default, rename_all = "camelCase")]
-pub(super) struct Carried {
+pub(super) struct RawAppearance {
     pub(super) materials: Vec<Value>,
     pub(super) textures: Vec<Value>,
     pub(super) samplers: Vec<Value>,

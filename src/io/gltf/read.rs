@@ -10,7 +10,7 @@ use gltf::json;
 use json::validation::Checked;
 use serde_json::Value;
 
-use super::document::{Carried, Doc};
+use super::document::{Doc, RawAppearance};
 use super::encoding::{CHUNK_BIN, CHUNK_JSON, GLB_MAGIC, base64_decode, percent_decode};
 use super::transform::{IDENTITY, Mat, det3, local_matrix, mul, normal_matrix};
 use crate::error::{Error, Location, Result};
@@ -144,7 +144,7 @@ pub fn read(path: &Path) -> Result<Mesh> {
         };
         Error::parse(path, at, format!("invalid glTF JSON: {e}"))
     })?;
-    let carried: Carried = serde_json::from_slice(json_bytes)
+    let carried: RawAppearance = serde_json::from_slice(json_bytes)
         .map_err(|e| Error::parse(path, Location::Unknown, format!("invalid glTF JSON: {e}")))?;
     let buffers = load_buffers(&root, blob, path)?;
     let doc = Doc {
@@ -399,69 +399,9 @@ fn add_mesh(doc: &Doc, mi: usize, m: &Mat, out: &mut Out) -> Result<()> {
         let base = match out.shared.get(&(key_m, accs)) {
             Some(&b) => b,
             None => {
-                let base = out.mesh.positions.len();
-                let (p, _) = doc.floats(pos_acc, &[3], &format!("{what} POSITION"))?;
-                let count = p.len() / 3;
-                if base + count >= u32::MAX as usize {
-                    return Err(doc.err("too many vertices for 32-bit indices"));
-                }
-                doc.check_expansion(base + count, "vertices")?;
-                for (k, c) in p.chunks_exact(3).enumerate() {
-                    let q = if identity {
-                        [c[0], c[1], c[2]]
-                    } else {
-                        let v = [c[0] as f64, c[1] as f64, c[2] as f64];
-                        [0, 1, 2].map(|r| {
-                            (m[0][r] * v[0] + m[1][r] * v[1] + m[2][r] * v[2] + m[3][r]) as f32
-                        })
-                    };
-                    if !q.iter().all(|x| x.is_finite()) {
-                        return Err(doc.err(format!(
-                            "{what}: vertex {k} has a non-finite coordinate {q:?}"
-                        )));
-                    }
-                    out.mesh.positions.push(q);
-                }
-                let nv = out.mesh.positions.len();
-                if accs[1] != usize::MAX {
-                    let (n, _) = doc.floats(accs[1], &[3], &format!("{what} NORMAL"))?;
-                    let dst = out.normals.get_or_insert_with(Vec::new);
-                    dst.resize(base, [0.0; 3]);
-                    dst.extend(n.chunks_exact(3).map(|c| {
-                        if identity {
-                            [c[0], c[1], c[2]]
-                        } else {
-                            let v = [0, 1, 2].map(|r| {
-                                nmat[0][r] * c[0] as f64
-                                    + nmat[1][r] * c[1] as f64
-                                    + nmat[2][r] * c[2] as f64
-                            });
-                            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                            let l = if l > 0.0 { l } else { 1.0 };
-                            v.map(|x| (x / l) as f32)
-                        }
-                    }));
-                    dst.resize(nv, [0.0; 3]);
-                }
-                if accs[2] != usize::MAX {
-                    let (t, _) = doc.floats(accs[2], &[2], &format!("{what} TEXCOORD_0"))?;
-                    let dst = out.uvs.get_or_insert_with(Vec::new);
-                    dst.resize(base, [0.0; 2]);
-                    dst.extend(t.chunks_exact(2).map(|c| [c[0], c[1]]));
-                    dst.resize(nv, [0.0; 2]);
-                }
-                if accs[3] != usize::MAX {
-                    let (c, n) = doc.floats(accs[3], &[3, 4], &format!("{what} COLOR_0"))?;
-                    let dst = out.colors.get_or_insert_with(Vec::new);
-                    dst.resize(base, [1.0; 4]);
-                    dst.extend(
-                        c.chunks_exact(n)
-                            .map(|c| [c[0], c[1], c[2], if n == 4 { c[3] } else { 1.0 }]),
-                    );
-                    dst.resize(nv, [1.0; 4]);
-                }
-                out.shared.insert((key_m, accs), base as u32);
-                base as u32
+                let base = add_vertices(doc, &what, accs, (m, &nmat, identity), out)?;
+                out.shared.insert((key_m, accs), base);
+                base
             }
         };
         let count = doc.root.accessors.get(pos_acc).map_or(0, |a| a.count.0) as u32;
@@ -474,38 +414,8 @@ fn add_mesh(doc: &Doc, mi: usize, m: &Mat, out: &mut Out) -> Result<()> {
                 "{what}: index {bad} is out of range ({count} vertices)"
             )));
         }
-        let mut tris = Vec::new();
-        match mode {
-            Mode::Triangles => tris.extend(idx.chunks_exact(3).map(|t| [t[0], t[1], t[2]])),
-            Mode::TriangleStrip => {
-                for k in 2..idx.len() {
-                    let t = if k % 2 == 0 {
-                        [idx[k - 2], idx[k - 1], idx[k]]
-                    } else {
-                        [idx[k - 1], idx[k - 2], idx[k]]
-                    };
-                    if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
-                        tris.push(t);
-                    }
-                }
-            }
-            _ => {
-                for k in 2..idx.len() {
-                    tris.push([idx[0], idx[k - 1], idx[k]]);
-                }
-            }
-        }
-        let mat = match &prim.material {
-            Some(mt) if mt.value() < doc.root.materials.len() => mt.value() as u32,
-            Some(mt) => {
-                return Err(doc.err(format!("{what}: material {} does not exist", mt.value())));
-            }
-            None if doc.root.materials.is_empty() => 0,
-            None => *out.default_material.get_or_insert_with(|| {
-                out.mesh.materials.push(Material::named("default"));
-                out.mesh.materials.len() as u32 - 1
-            }),
-        };
+        let tris = primitive_triangles(mode, &idx);
+        let mat = primitive_material(doc, prim, &what, out)?;
         doc.check_expansion(out.mesh.triangles.len() + tris.len(), "triangles")?;
         for t in tris {
             let t = t.map(|v| v + base);
@@ -517,4 +427,122 @@ fn add_mesh(doc: &Doc, mi: usize, m: &Mat, out: &mut Out) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The vertices of a primitive's accessors `accs` (POSITION, NORMAL, TEXCOORD_0, COLOR_0;
+/// `usize::MAX` for one it lacks) appended to `out` under `(m, its normal matrix, whether m is
+/// the identity)`: the mesh's first new vertex.
+fn add_vertices(
+    doc: &Doc,
+    what: &str,
+    accs: [usize; 4],
+    (m, nmat, identity): (&Mat, &[[f64; 3]; 3], bool),
+    out: &mut Out,
+) -> Result<u32> {
+    let pos_acc = accs[0];
+    let base = out.mesh.positions.len();
+    let (p, _) = doc.floats(pos_acc, &[3], &format!("{what} POSITION"))?;
+    let count = p.len() / 3;
+    if base + count >= u32::MAX as usize {
+        return Err(doc.err("too many vertices for 32-bit indices"));
+    }
+    doc.check_expansion(base + count, "vertices")?;
+    for (k, c) in p.chunks_exact(3).enumerate() {
+        let q = if identity {
+            [c[0], c[1], c[2]]
+        } else {
+            let v = [c[0] as f64, c[1] as f64, c[2] as f64];
+            [0, 1, 2].map(|r| (m[0][r] * v[0] + m[1][r] * v[1] + m[2][r] * v[2] + m[3][r]) as f32)
+        };
+        if !q.iter().all(|x| x.is_finite()) {
+            return Err(doc.err(format!(
+                "{what}: vertex {k} has a non-finite coordinate {q:?}"
+            )));
+        }
+        out.mesh.positions.push(q);
+    }
+    let nv = out.mesh.positions.len();
+    if accs[1] != usize::MAX {
+        let (n, _) = doc.floats(accs[1], &[3], &format!("{what} NORMAL"))?;
+        let dst = out.normals.get_or_insert_with(Vec::new);
+        dst.resize(base, [0.0; 3]);
+        dst.extend(n.chunks_exact(3).map(|c| {
+            if identity {
+                [c[0], c[1], c[2]]
+            } else {
+                let v = [0, 1, 2].map(|r| {
+                    nmat[0][r] * c[0] as f64 + nmat[1][r] * c[1] as f64 + nmat[2][r] * c[2] as f64
+                });
+                let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                let l = if l > 0.0 { l } else { 1.0 };
+                v.map(|x| (x / l) as f32)
+            }
+        }));
+        dst.resize(nv, [0.0; 3]);
+    }
+    if accs[2] != usize::MAX {
+        let (t, _) = doc.floats(accs[2], &[2], &format!("{what} TEXCOORD_0"))?;
+        let dst = out.uvs.get_or_insert_with(Vec::new);
+        dst.resize(base, [0.0; 2]);
+        dst.extend(t.chunks_exact(2).map(|c| [c[0], c[1]]));
+        dst.resize(nv, [0.0; 2]);
+    }
+    if accs[3] != usize::MAX {
+        let (c, n) = doc.floats(accs[3], &[3, 4], &format!("{what} COLOR_0"))?;
+        let dst = out.colors.get_or_insert_with(Vec::new);
+        dst.resize(base, [1.0; 4]);
+        dst.extend(
+            c.chunks_exact(n)
+                .map(|c| [c[0], c[1], c[2], if n == 4 { c[3] } else { 1.0 }]),
+        );
+        dst.resize(nv, [1.0; 4]);
+    }
+    Ok(base as u32)
+}
+
+/// A primitive's triangles from its indices in `mode` (a strip's degenerate turns dropped).
+fn primitive_triangles(mode: json::mesh::Mode, idx: &[u32]) -> Vec<[u32; 3]> {
+    use json::mesh::Mode;
+    let mut tris = Vec::new();
+    match mode {
+        Mode::Triangles => tris.extend(idx.chunks_exact(3).map(|t| [t[0], t[1], t[2]])),
+        Mode::TriangleStrip => {
+            for k in 2..idx.len() {
+                let t = if k % 2 == 0 {
+                    [idx[k - 2], idx[k - 1], idx[k]]
+                } else {
+                    [idx[k - 1], idx[k - 2], idx[k]]
+                };
+                if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                    tris.push(t);
+                }
+            }
+        }
+        _ => {
+            for k in 2..idx.len() {
+                tris.push([idx[0], idx[k - 1], idx[k]]);
+            }
+        }
+    }
+    tris
+}
+
+/// The material a primitive's faces take: its own, else the file's default (made once).
+fn primitive_material(
+    doc: &Doc,
+    prim: &json::mesh::Primitive,
+    what: &str,
+    out: &mut Out,
+) -> Result<u32> {
+    Ok(match &prim.material {
+        Some(mt) if mt.value() < doc.root.materials.len() => mt.value() as u32,
+        Some(mt) => {
+            return Err(doc.err(format!("{what}: material {} does not exist", mt.value())));
+        }
+        None if doc.root.materials.is_empty() => 0,
+        None => *out.default_material.get_or_insert_with(|| {
+            out.mesh.materials.push(Material::named("default"));
+            out.mesh.materials.len() as u32 - 1
+        }),
+    })
 }

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use serde_json::{Value, json};
 
 use super::encoding::{CHUNK_BIN, CHUNK_JSON, GLB_MAGIC, base64_encode};
-use crate::mesh::{Mesh, UvOrigin};
+use crate::mesh::{Mesh, Textures, UvOrigin};
 
 /// The names of the extensions `v` uses: the keys of every `extensions` object in it.
 fn extension_names(v: &Value, out: &mut std::collections::BTreeSet<String>) {
@@ -27,68 +27,115 @@ fn extension_names(v: &Value, out: &mut std::collections::BTreeSet<String>) {
 
 /// Builds the glTF JSON and the binary buffer for `mesh`.
 fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
-    let mut bin: Vec<u8> = Vec::new();
-    let mut views: Vec<Value> = Vec::new();
-    let mut accessors: Vec<Value> = Vec::new();
-    let nv = mesh.positions.len();
-    let mut attrs = serde_json::Map::new();
-    // One vertex attribute: its floats appended to the buffer, a view and an accessor over
-    // them, and the accessor named in the primitives' `attributes`.
-    let mut push_attr = |name: &str,
-                         data: &mut dyn Iterator<Item = f32>,
-                         ty: &str,
-                         extra: Value| {
-        let start = bin.len();
+    let mut buf = Buffer::default();
+    let attrs = write_attributes(mesh, &mut buf);
+    let buckets = faces_by_group_and_material(mesh);
+    let meshes = write_meshes(mesh, &buckets, &attrs, &mut buf);
+    let t = &mesh.textures;
+    let images = (!t.is_empty()).then(|| write_images(t, &mut buf));
+    let mut root = scene_root(meshes, &buf);
+    if mesh.face_materials.is_some() {
+        root["materials"] = materials(mesh);
+    }
+    if let Some((images, new_index)) = images {
+        add_textures(&mut root, t, images, &new_index);
+    }
+    declare_extensions(&mut root, t);
+    (root, buf.bin)
+}
+
+/// The binary buffer as it is written, with the buffer views and accessors over it.
+#[derive(Default)]
+struct Buffer {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Buffer {
+    /// Appends one vertex attribute of `count` vertices: its floats, a view and an accessor
+    /// over them (with the `extra` accessor fields); returns the accessor's index.
+    fn push_attribute(
+        &mut self,
+        data: &mut dyn Iterator<Item = f32>,
+        count: usize,
+        ty: &str,
+        extra: Value,
+    ) -> usize {
+        let start = self.bin.len();
         for x in data {
-            bin.extend_from_slice(&x.to_le_bytes());
+            self.bin.extend_from_slice(&x.to_le_bytes());
         }
-        views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start, "target": 34962}));
-        let mut a =
-            json!({"bufferView": views.len() - 1, "componentType": 5126, "count": nv, "type": ty});
+        self.views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": self.bin.len() - start, "target": 34962}));
+        let mut a = json!({"bufferView": self.views.len() - 1, "componentType": 5126, "count": count, "type": ty});
         if let (Value::Object(a), Value::Object(e)) = (&mut a, extra) {
             a.extend(e);
         }
-        accessors.push(a);
-        attrs.insert(name.into(), json!(accessors.len() - 1));
-    };
-    if nv > 0 {
-        let b = mesh.bounds().unwrap_or(crate::mesh::Aabb {
-            min: [0.0; 3],
-            max: [0.0; 3],
-        });
-        push_attr(
-            "POSITION",
-            &mut mesh.positions.iter().flatten().copied(),
-            "VEC3",
-            json!({"min": b.min, "max": b.max}),
-        );
-        if let Some(n) = &mesh.normals {
-            push_attr(
-                "NORMAL",
-                &mut n.iter().flatten().copied(),
-                "VEC3",
-                json!({}),
-            );
-        }
-        // glTF counts UVs from the image's top-left corner.
-        if let Some(t) = mesh.uvs_from(UvOrigin::TopLeft) {
-            push_attr(
-                "TEXCOORD_0",
-                &mut t.iter().flatten().copied(),
-                "VEC2",
-                json!({}),
-            );
-        }
-        if let Some(c) = &mesh.colors {
-            push_attr(
-                "COLOR_0",
-                &mut c.iter().flatten().copied(),
-                "VEC4",
-                json!({}),
-            );
-        }
+        self.accessors.push(a);
+        self.accessors.len() - 1
     }
-    // Faces by (group, material), in face order within each.
+
+    /// Appends one primitive's triangle indices, a view and an accessor over them; returns the
+    /// accessor's index.
+    fn push_indices(&mut self, idx: &[u32]) -> usize {
+        let start = self.bin.len();
+        for &i in idx {
+            self.bin.extend_from_slice(&i.to_le_bytes());
+        }
+        self.views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": self.bin.len() - start, "target": 34963}));
+        self.accessors.push(json!({"bufferView": self.views.len() - 1, "componentType": 5125, "count": idx.len(), "type": "SCALAR"}));
+        self.accessors.len() - 1
+    }
+
+    /// Appends an encoded image's bytes, 4-byte aligned, and a view over them; returns the
+    /// view's index.
+    fn push_image(&mut self, data: &[u8]) -> usize {
+        self.bin.resize(self.bin.len().next_multiple_of(4), 0);
+        let start = self.bin.len();
+        self.bin.extend_from_slice(data);
+        self.views
+            .push(json!({"buffer": 0, "byteOffset": start, "byteLength": data.len()}));
+        self.views.len() - 1
+    }
+}
+
+/// Writes the vertex attributes the mesh has (positions with their bounds, normals, UVs,
+/// colours) to the buffer; returns the primitives' `attributes` object naming their accessors.
+fn write_attributes(mesh: &Mesh, buf: &mut Buffer) -> serde_json::Map<String, Value> {
+    let nv = mesh.positions.len();
+    let mut attrs = serde_json::Map::new();
+    if nv == 0 {
+        return attrs;
+    }
+    let b = mesh.bounds().unwrap_or(crate::mesh::Aabb {
+        min: [0.0; 3],
+        max: [0.0; 3],
+    });
+    let a = buf.push_attribute(
+        &mut mesh.positions.iter().flatten().copied(),
+        nv,
+        "VEC3",
+        json!({"min": b.min, "max": b.max}),
+    );
+    attrs.insert("POSITION".into(), json!(a));
+    if let Some(n) = &mesh.normals {
+        let a = buf.push_attribute(&mut n.iter().flatten().copied(), nv, "VEC3", json!({}));
+        attrs.insert("NORMAL".into(), json!(a));
+    }
+    // glTF counts UVs from the image's top-left corner.
+    if let Some(t) = mesh.uvs_from(UvOrigin::TopLeft) {
+        let a = buf.push_attribute(&mut t.iter().flatten().copied(), nv, "VEC2", json!({}));
+        attrs.insert("TEXCOORD_0".into(), json!(a));
+    }
+    if let Some(c) = &mesh.colors {
+        let a = buf.push_attribute(&mut c.iter().flatten().copied(), nv, "VEC4", json!({}));
+        attrs.insert("COLOR_0".into(), json!(a));
+    }
+    attrs
+}
+
+/// The triangles' indices by group, then by material, in face order within each.
+fn faces_by_group_and_material(mesh: &Mesh) -> Vec<Vec<Vec<u32>>> {
     let ngroups = if mesh.face_groups.is_some() {
         mesh.groups.len().max(1)
     } else {
@@ -113,6 +160,17 @@ fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
             .min(nmats - 1);
         buckets[g][m].extend_from_slice(t);
     }
+    buckets
+}
+
+/// Writes each bucket's indices to the buffer; returns a glTF mesh per group that has faces,
+/// with a primitive per material that has faces.
+fn write_meshes(
+    mesh: &Mesh,
+    buckets: &[Vec<Vec<u32>>],
+    attrs: &serde_json::Map<String, Value>,
+    buf: &mut Buffer,
+) -> Vec<Value> {
     let mut meshes = Vec::new();
     for (g, mats) in buckets.iter().enumerate() {
         let mut prims = Vec::new();
@@ -120,13 +178,8 @@ fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
             if idx.is_empty() {
                 continue;
             }
-            let start = bin.len();
-            for &i in idx {
-                bin.extend_from_slice(&i.to_le_bytes());
-            }
-            views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start, "target": 34963}));
-            accessors.push(json!({"bufferView": views.len() - 1, "componentType": 5125, "count": idx.len(), "type": "SCALAR"}));
-            let mut p = json!({"attributes": attrs, "indices": accessors.len() - 1, "mode": 4});
+            let indices = buf.push_indices(idx);
+            let mut p = json!({"attributes": attrs, "indices": indices, "mode": 4});
             if mesh.face_materials.is_some() && m < mesh.materials.len() {
                 p["material"] = json!(m);
             }
@@ -141,94 +194,109 @@ fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
         }
         meshes.push(gm);
     }
+    meshes
+}
+
+/// The root object: the asset, one scene with a node per mesh, the meshes and the buffer's
+/// accessors and views.
+fn scene_root(meshes: Vec<Value>, buf: &Buffer) -> Value {
     let nodes: Vec<Value> = (0..meshes.len()).map(|i| json!({"mesh": i})).collect();
-    let mut root = json!({
+    json!({
         "asset": {"version": "2.0", "generator": "meshslim"},
         "scene": 0,
         "scenes": [{"nodes": (0..nodes.len()).collect::<Vec<_>>()}],
         "nodes": nodes,
         "meshes": meshes,
-        "accessors": accessors,
-        "bufferViews": views,
-    });
-    if mesh.face_materials.is_some() {
-        root["materials"] = Value::Array(
-            mesh.materials
-                .iter()
-                .map(|m| match &m.gltf {
-                    Some(Value::Object(o)) => {
-                        let mut o = Value::Object(o.clone());
-                        drop_other_uv_sets(&mut o);
-                        o["name"] = json!(m.name);
-                        o
-                    }
-                    _ => json!({"name": m.name}),
-                })
-                .collect(),
-        );
-    }
-    let t = &mesh.textures;
-    if !t.is_empty() {
-        let mut images = Vec::with_capacity(t.images.len());
-        // One buffer view per distinct image: images that shared bytes when read share them.
-        let mut written: HashMap<*const u8, usize> = HashMap::new();
-        // An image with neither bytes nor a URI (a bad buffer view in the input) cannot be
-        // written: it is left out and the textures' `source` indices follow.
-        let mut new_index = Vec::with_capacity(t.images.len());
-        for img in &t.images {
-            if img.data.is_none() && img.uri.is_none() {
-                new_index.push(None);
-                continue;
-            }
-            new_index.push(Some(images.len()));
-            let mut out = serde_json::Map::new();
-            if let Some(n) = &img.name {
-                out.insert("name".into(), json!(n));
-            }
-            if let Some(data) = &img.data {
-                let view = *written.entry(data.as_ptr()).or_insert_with(|| {
-                    bin.resize(bin.len().next_multiple_of(4), 0);
-                    let start = bin.len();
-                    bin.extend_from_slice(data);
-                    views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": data.len()}));
-                    views.len() - 1
-                });
-                out.insert("bufferView".into(), json!(view));
-                // An image in a buffer view must name its type.
-                let mime = img
-                    .mime_type
-                    .clone()
-                    .unwrap_or_else(|| sniff_mime(data).into());
-                out.insert("mimeType".into(), json!(mime));
-            } else if let Some(uri) = &img.uri {
-                out.insert("uri".into(), json!(uri));
-                if let Some(m) = &img.mime_type {
-                    out.insert("mimeType".into(), json!(m));
-                }
-            }
-            images.push(Value::Object(out));
-        }
-        root["bufferViews"] = json!(views);
-        let textures: Vec<Value> = t
-            .textures
+        "accessors": buf.accessors,
+        "bufferViews": buf.views,
+    })
+}
+
+/// The materials: each as read from a glTF file (less references to other UV sets) or just its
+/// name, in material order.
+fn materials(mesh: &Mesh) -> Value {
+    Value::Array(
+        mesh.materials
             .iter()
-            .map(|tex| {
-                let mut tex = tex.clone();
-                remap_sources(&mut tex, &new_index);
-                tex
+            .map(|m| match &m.gltf {
+                Some(Value::Object(o)) => {
+                    let mut o = Value::Object(o.clone());
+                    drop_other_uv_sets(&mut o);
+                    o["name"] = json!(m.name);
+                    o
+                }
+                _ => json!({"name": m.name}),
             })
-            .collect();
-        for (key, list) in [("textures", &textures), ("samplers", &t.samplers)] {
-            if !list.is_empty() {
-                root[key] = json!(list);
+            .collect(),
+    )
+}
+
+/// Writes the images' bytes to the buffer (once per distinct image: images that shared bytes
+/// when read share them); returns the image objects and, for each image read, its index among
+/// those written.
+fn write_images(t: &Textures, buf: &mut Buffer) -> (Vec<Value>, Vec<Option<usize>>) {
+    let mut images = Vec::with_capacity(t.images.len());
+    let mut written: HashMap<*const u8, usize> = HashMap::new();
+    // An image with neither bytes nor a URI (a bad buffer view in the input) cannot be
+    // written: it is left out and the textures' `source` indices follow.
+    let mut new_index = Vec::with_capacity(t.images.len());
+    for img in &t.images {
+        if img.data.is_none() && img.uri.is_none() {
+            new_index.push(None);
+            continue;
+        }
+        new_index.push(Some(images.len()));
+        let mut out = serde_json::Map::new();
+        if let Some(n) = &img.name {
+            out.insert("name".into(), json!(n));
+        }
+        if let Some(data) = &img.data {
+            let view = *written
+                .entry(data.as_ptr())
+                .or_insert_with(|| buf.push_image(data));
+            out.insert("bufferView".into(), json!(view));
+            // An image in a buffer view must name its type.
+            let mime = img
+                .mime_type
+                .clone()
+                .unwrap_or_else(|| sniff_mime(data).into());
+            out.insert("mimeType".into(), json!(mime));
+        } else if let Some(uri) = &img.uri {
+            out.insert("uri".into(), json!(uri));
+            if let Some(m) = &img.mime_type {
+                out.insert("mimeType".into(), json!(m));
             }
         }
-        if !images.is_empty() {
-            root["images"] = json!(images);
+        images.push(Value::Object(out));
+    }
+    (images, new_index)
+}
+
+/// Adds the textures (their `source`s mapped to the images written), the samplers and the
+/// images to `root`, each list only when it is not empty.
+fn add_textures(root: &mut Value, t: &Textures, images: Vec<Value>, new_index: &[Option<usize>]) {
+    let textures: Vec<Value> = t
+        .textures
+        .iter()
+        .map(|tex| {
+            let mut tex = tex.clone();
+            remap_sources(&mut tex, new_index);
+            tex
+        })
+        .collect();
+    for (key, list) in [("textures", &textures), ("samplers", &t.samplers)] {
+        if !list.is_empty() {
+            root[key] = json!(list);
         }
     }
-    // Every extension the written materials, textures and samplers use is declared; those the
-    // input required stay required.
+    if !images.is_empty() {
+        root["images"] = json!(images);
+    }
+}
+
+/// Declares every extension the written materials, textures and samplers use; those the input
+/// required stay required.
+fn declare_extensions(root: &mut Value, t: &Textures) {
     let mut used = std::collections::BTreeSet::new();
     for key in ["materials", "textures", "samplers", "images"] {
         if let Some(v) = root.get(key) {
@@ -246,7 +314,6 @@ fn build_gltf(mesh: &Mesh) -> (Value, Vec<u8>) {
             root["extensionsRequired"] = json!(required);
         }
     }
-    (root, bin)
 }
 
 /// The MIME type of an encoded image, from its first bytes.

@@ -6,7 +6,7 @@ use std::fs::File;
 use std::io::{self, BufRead, BufReader};
 use std::path::Path;
 
-use super::header::{Element, Kind, PlyEncoding, Scalar, read_header};
+use super::header::{Element, Header, Kind, PlyEncoding, Scalar, read_header};
 use crate::error::{Error, Location, Result};
 use crate::io::sink::{MeshSink, Sink, Vertex, VertexAttributes};
 use crate::mesh::Mesh;
@@ -225,50 +225,8 @@ pub fn read_into(path: &Path, sink: &mut dyn Sink) -> Result<()> {
     let header = read_header(&mut r, path)?;
     let remaining = file_len.saturating_sub(header.len);
     let binary = header.encoding != PlyEncoding::Ascii;
-
-    // Fail fast when the declared counts cannot fit in the bytes that follow the header.
-    let mut need: u128 = 0;
-    for el in &header.elements {
-        let per = if binary {
-            el.min_binary_bytes() as u128
-        } else {
-            // Every value is at least one character plus a separator.
-            2 * el.props.len() as u128
-        };
-        need += per * el.count as u128;
-        let need_here = if binary { need } else { need.saturating_sub(1) };
-        if need_here > remaining as u128 {
-            let at = if binary {
-                Location::Byte(header.len)
-            } else {
-                Location::Line(header.lines + 1)
-            };
-            return Err(Error::parse(
-                path,
-                at,
-                format!(
-                    "the header declares {} {} elements (line {}), which need at least {} bytes, \
-                     but the file has only {} bytes after the header",
-                    el.count, el.name, el.line, need_here, remaining
-                ),
-            ));
-        }
-    }
-    let Some(vi) = header.elements.iter().position(|e| e.name == "vertex") else {
-        return Err(Error::parse(
-            path,
-            Location::Line(header.lines),
-            "the PLY header declares no vertex element",
-        ));
-    };
-    let nverts = header.elements[vi].count;
-    if nverts > u32::MAX as u64 {
-        return Err(Error::parse(
-            path,
-            Location::Line(header.elements[vi].line),
-            format!("{nverts} vertices exceed the 32-bit index range"),
-        ));
-    }
+    check_declared_counts(&header, remaining, path)?;
+    let (vi, nverts) = vertex_element(&header, path)?;
 
     let mut body = Body {
         r,
@@ -309,133 +267,131 @@ pub fn read_into(path: &Path, sink: &mut dyn Sink) -> Result<()> {
             seen_vertex = true;
             read_vertices(&mut body, el, sink, remaining, &mut scratch, path, &fail)?;
         } else if (el.name == "face" || el.name == "tristrips") && sink.wants_faces() {
-            let strips = el.name == "tristrips";
-            let li = el
-                .props
-                .iter()
-                .position(|p| p.name == "vertex_indices" || p.name == "vertex_index")
-                .or_else(|| {
-                    el.props
-                        .iter()
-                        .position(|p| matches!(p.kind, Kind::List { .. }))
-                });
-            let what = if strips { "triangle strip" } else { "face" };
-            let est = if binary {
-                let item = match li.map(|i| el.props[i].kind) {
-                    Some(Kind::List { count, item }) => count.size() + 3 * item.size(),
-                    _ => 4,
-                };
-                remaining / item as u64
-            } else {
-                remaining / 8
-            };
-            sink.begin_faces(el.count.min(est).min(1 << 28) as usize);
-            let mut poly: Vec<u32> = Vec::new();
-            for i in 0..el.count {
-                for (pi, p) in el.props.iter().enumerate() {
-                    match p.kind {
-                        Kind::Scalar(s) => {
-                            body.scalar(s, &mut scratch)
-                                .map_err(|f| fail(&body, f, what, i))?;
-                        }
-                        Kind::List { count, item } => {
-                            let start = body.location();
-                            let n = body
-                                .scalar(count, &mut scratch)
-                                .map_err(|f| fail(&body, f, what, i))?;
-                            let at = if binary { start } else { body.location() };
-                            let n = to_index(n).filter(|&n| n >= 0).ok_or_else(|| {
-                                Error::parse(path, at, format!("{what} {i}: bad list length {n}"))
-                            })? as usize;
-                            if Some(pi) != li {
-                                body.list(n, item, &mut scratch, |_| Ok(()))
-                                    .map_err(|f| fail(&body, f, what, i))?;
-                                continue;
-                            }
-                            poly.clear();
-                            // Strip state: the previous two indices and the position in the strip.
-                            let mut k = 0usize;
-                            let mut prev = [0u32; 2];
-                            body.list(n, item, &mut scratch, |v| {
-                                let idx = to_index(v);
-                                if strips && idx == Some(-1) {
-                                    k = 0;
-                                    return Ok(());
-                                }
-                                let idx = match idx {
-                                    Some(x) if x >= 0 && (x as u64) < nverts => x as u32,
-                                    _ => {
-                                        return Err(Fail::Bad(format!(
-                                            "vertex index {v} is out of range (the file has {nverts} vertices)"
-                                        )));
-                                    }
-                                };
-                                if strips {
-                                    if k >= 2 {
-                                        let t = if k.is_multiple_of(2) {
-                                            [prev[0], prev[1], idx]
-                                        } else {
-                                            [prev[1], prev[0], idx]
-                                        };
-                                        if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
-                                            sink.triangle(t);
-                                        }
-                                    }
-                                    prev = [prev[1], idx];
-                                    k += 1;
-                                } else {
-                                    poly.push(idx);
-                                }
-                                Ok(())
-                            })
-                            .map_err(|f| fail(&body, f, what, i))?;
-                            if !strips && poly.len() >= 3 {
-                                for j in 1..poly.len() - 1 {
-                                    sink.triangle([poly[0], poly[j], poly[j + 1]]);
-                                }
-                            }
-                        }
-                    }
-                }
-            }
+            read_faces(
+                &mut body,
+                el,
+                sink,
+                remaining,
+                nverts,
+                &mut scratch,
+                path,
+                &fail,
+            )?;
         } else {
             if ei == vi {
                 seen_vertex = true;
             }
-            // Unknown element (or a second vertex element, or one this pass skips): skip it
-            // value by value.
-            if let (true, Some(size)) = (binary, el.fixed_size()) {
-                let done = body
-                    .skip(el.count * size as u64)
-                    .map_err(|e| Error::io(path, e))?;
-                if done < el.count * size as u64 {
-                    let i = done / size as u64;
-                    return Err(fail(&body, Fail::Eof, &el.name, i));
+            // Unknown element (or a second vertex element, or one this pass skips).
+            skip_element(&mut body, el, &mut scratch, path, &fail)?;
+        }
+    }
+    Ok(())
+}
+
+/// Fails fast when the declared counts cannot fit in the `remaining` bytes that follow the
+/// header.
+fn check_declared_counts(header: &Header, remaining: u64, path: &Path) -> Result<()> {
+    let binary = header.encoding != PlyEncoding::Ascii;
+    let mut need: u128 = 0;
+    for el in &header.elements {
+        let per = if binary {
+            el.min_binary_bytes() as u128
+        } else {
+            // Every value is at least one character plus a separator.
+            2 * el.props.len() as u128
+        };
+        need += per * el.count as u128;
+        let need_here = if binary { need } else { need.saturating_sub(1) };
+        if need_here > remaining as u128 {
+            let at = if binary {
+                Location::Byte(header.len)
+            } else {
+                Location::Line(header.lines + 1)
+            };
+            return Err(Error::parse(
+                path,
+                at,
+                format!(
+                    "the header declares {} {} elements (line {}), which need at least {} bytes, \
+                     but the file has only {} bytes after the header",
+                    el.count, el.name, el.line, need_here, remaining
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Finds the vertex element: its position among the elements and its count, which must fit
+/// 32-bit indices.
+fn vertex_element(header: &Header, path: &Path) -> Result<(usize, u64)> {
+    let Some(vi) = header.elements.iter().position(|e| e.name == "vertex") else {
+        return Err(Error::parse(
+            path,
+            Location::Line(header.lines),
+            "the PLY header declares no vertex element",
+        ));
+    };
+    let nverts = header.elements[vi].count;
+    if nverts > u32::MAX as u64 {
+        return Err(Error::parse(
+            path,
+            Location::Line(header.elements[vi].line),
+            format!("{nverts} vertices exceed the 32-bit index range"),
+        ));
+    }
+    Ok((vi, nverts))
+}
+
+/// Turns a read failure into an error naming the element and its number.
+type FailFn<'a, R> = dyn Fn(&Body<R>, Fail, &str, u64) -> Error + 'a;
+
+/// Reads a `face` or `tristrips` element into `sink`: polygons fan-triangulated, strips cut
+/// into their triangles, every other property skipped.
+#[allow(clippy::too_many_arguments)]
+fn read_faces<R: BufRead>(
+    body: &mut Body<R>,
+    el: &Element,
+    sink: &mut dyn Sink,
+    remaining: u64,
+    nverts: u64,
+    scratch: &mut Vec<u8>,
+    path: &Path,
+    fail: &FailFn<'_, R>,
+) -> Result<()> {
+    let strips = el.name == "tristrips";
+    let li = index_list_property(el);
+    let what = if strips { "triangle strip" } else { "face" };
+    sink.begin_faces(face_reservation(el, li, body.binary, remaining));
+    let mut out = Triangles {
+        sink,
+        strips,
+        nverts,
+        poly: Vec::new(),
+    };
+    for i in 0..el.count {
+        for (pi, p) in el.props.iter().enumerate() {
+            match p.kind {
+                Kind::Scalar(s) => {
+                    body.scalar(s, scratch)
+                        .map_err(|f| fail(body, f, what, i))?;
                 }
-                continue;
-            }
-            for i in 0..el.count {
-                for p in &el.props {
-                    match p.kind {
-                        Kind::Scalar(s) => {
-                            body.scalar(s, &mut scratch)
-                                .map_err(|f| fail(&body, f, &el.name, i))?;
-                        }
-                        Kind::List { count, item } => {
-                            let n = body
-                                .scalar(count, &mut scratch)
-                                .map_err(|f| fail(&body, f, &el.name, i))?;
-                            let n = to_index(n).filter(|&n| n >= 0).ok_or_else(|| {
-                                Error::parse(
-                                    path,
-                                    body.location(),
-                                    format!("{} {i}: bad list length {n}", el.name),
-                                )
-                            })?;
-                            body.list(n as usize, item, &mut scratch, |_| Ok(()))
-                                .map_err(|f| fail(&body, f, &el.name, i))?;
-                        }
+                Kind::List { count, item } => {
+                    let start = body.location();
+                    let n = body
+                        .scalar(count, scratch)
+                        .map_err(|f| fail(body, f, what, i))?;
+                    let at = if body.binary { start } else { body.location() };
+                    let n = to_index(n).filter(|&n| n >= 0).ok_or_else(|| {
+                        Error::parse(path, at, format!("{what} {i}: bad list length {n}"))
+                    })? as usize;
+                    if Some(pi) != li {
+                        body.list(n, item, scratch, |_| Ok(()))
+                            .map_err(|f| fail(body, f, what, i))?;
+                        continue;
                     }
+                    out.read_list(body, n, item, scratch)
+                        .map_err(|f| fail(body, f, what, i))?;
                 }
             }
         }
@@ -443,9 +399,150 @@ pub fn read_into(path: &Path, sink: &mut dyn Sink) -> Result<()> {
     Ok(())
 }
 
-/// Turns a read failure into an error naming the element and its number.
-type FailFn<'a, R> = dyn Fn(&Body<R>, Fail, &str, u64) -> Error + 'a;
+/// Which property of a face element holds the vertex indices: `vertex_indices` (or
+/// `vertex_index`), else the first list.
+fn index_list_property(el: &Element) -> Option<usize> {
+    el.props
+        .iter()
+        .position(|p| p.name == "vertex_indices" || p.name == "vertex_index")
+        .or_else(|| {
+            el.props
+                .iter()
+                .position(|p| matches!(p.kind, Kind::List { .. }))
+        })
+}
 
+/// How many faces to reserve for: the declared count, capped by what the `remaining` bytes can
+/// hold (a triangle's list in binary, eight characters in ascii) and by 2^28.
+fn face_reservation(el: &Element, li: Option<usize>, binary: bool, remaining: u64) -> usize {
+    let est = if binary {
+        let item = match li.map(|i| el.props[i].kind) {
+            Some(Kind::List { count, item }) => count.size() + 3 * item.size(),
+            _ => 4,
+        };
+        remaining / item as u64
+    } else {
+        remaining / 8
+    };
+    el.count.min(est).min(1 << 28) as usize
+}
+
+/// Where a face element's triangles go, with what checking and cutting its index lists needs.
+struct Triangles<'s> {
+    sink: &'s mut dyn Sink,
+    /// A `tristrips` element: each list is a strip, not a polygon.
+    strips: bool,
+    nverts: u64,
+    /// The current polygon's indices, reused from face to face.
+    poly: Vec<u32>,
+}
+
+impl Triangles<'_> {
+    /// Reads one list of `n` vertex indices and sends its triangles to the sink.
+    #[inline]
+    fn read_list<R: BufRead>(
+        &mut self,
+        body: &mut Body<R>,
+        n: usize,
+        item: Scalar,
+        scratch: &mut Vec<u8>,
+    ) -> Result<(), Fail> {
+        let (strips, nverts) = (self.strips, self.nverts);
+        let sink = &mut *self.sink;
+        let poly = &mut self.poly;
+        poly.clear();
+        // Strip state: the previous two indices and the position in the strip.
+        let mut k = 0usize;
+        let mut prev = [0u32; 2];
+        body.list(n, item, scratch, |v| {
+            let idx = to_index(v);
+            if strips && idx == Some(-1) {
+                k = 0;
+                return Ok(());
+            }
+            let idx = match idx {
+                Some(x) if x >= 0 && (x as u64) < nverts => x as u32,
+                _ => {
+                    return Err(Fail::Bad(format!(
+                        "vertex index {v} is out of range (the file has {nverts} vertices)"
+                    )));
+                }
+            };
+            if strips {
+                if k >= 2 {
+                    let t = if k.is_multiple_of(2) {
+                        [prev[0], prev[1], idx]
+                    } else {
+                        [prev[1], prev[0], idx]
+                    };
+                    if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                        sink.triangle(t);
+                    }
+                }
+                prev = [prev[1], idx];
+                k += 1;
+            } else {
+                poly.push(idx);
+            }
+            Ok(())
+        })?;
+        if !strips && poly.len() >= 3 {
+            for j in 1..poly.len() - 1 {
+                sink.triangle([poly[0], poly[j], poly[j + 1]]);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Skips an element this pass does not read: fixed-size binary records a buffer at a time,
+/// anything else value by value.
+fn skip_element<R: BufRead>(
+    body: &mut Body<R>,
+    el: &Element,
+    scratch: &mut Vec<u8>,
+    path: &Path,
+    fail: &FailFn<'_, R>,
+) -> Result<()> {
+    if let (true, Some(size)) = (body.binary, el.fixed_size()) {
+        let done = body
+            .skip(el.count * size as u64)
+            .map_err(|e| Error::io(path, e))?;
+        if done < el.count * size as u64 {
+            let i = done / size as u64;
+            return Err(fail(body, Fail::Eof, &el.name, i));
+        }
+        return Ok(());
+    }
+    for i in 0..el.count {
+        for p in &el.props {
+            match p.kind {
+                Kind::Scalar(s) => {
+                    body.scalar(s, scratch)
+                        .map_err(|f| fail(body, f, &el.name, i))?;
+                }
+                Kind::List { count, item } => {
+                    let n = body
+                        .scalar(count, scratch)
+                        .map_err(|f| fail(body, f, &el.name, i))?;
+                    let n = to_index(n).filter(|&n| n >= 0).ok_or_else(|| {
+                        Error::parse(
+                            path,
+                            body.location(),
+                            format!("{} {i}: bad list length {n}", el.name),
+                        )
+                    })?;
+                    body.list(n as usize, item, scratch, |_| Ok(()))
+                        .map_err(|f| fail(body, f, &el.name, i))?;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Reads the vertex element into `sink`: positions (which must be finite), and normals, colours
+/// and texture coordinates when the element has them.
 #[allow(clippy::too_many_arguments)]
 fn read_vertices<R: BufRead>(
     body: &mut Body<R>,
