@@ -103,6 +103,32 @@ fn errors_and_spheres_grow_up_the_dag() {
     assert!(d.groups.iter().any(|g| g.error > 0.0));
 }
 
+/// A cluster's error is what a cut trusts to keep it under a pixel: no vertex of a coarser
+/// cluster lies farther from the input than twice its error (measured on the horse: at most
+/// 1.8x; the error is the grouped rounds' quadric distance, not a bound, hence the slack).
+#[test]
+fn no_vertex_lies_far_beyond_its_clusters_error() {
+    for (name, m) in closed_meshes() {
+        let (d, _) = built(&m, &DagOptions::default());
+        let bvh = meshslim::metrics::TriangleBvh::new(&m);
+        let mut coarse = 0;
+        for c in d.clusters.iter().filter(|c| c.depth > 0) {
+            coarse += 1;
+            for &v in d.triangles(c).as_flattened() {
+                let p = d.mesh.positions[v as usize].map(|x| x as f64);
+                let far = bvh.closest(p, None).unwrap().dist2.sqrt();
+                assert!(
+                    far <= 2.0 * c.error as f64 + 1e-6,
+                    "{name}: a depth-{} cluster's vertex {far:.3e} from the input, its error {:.3e}",
+                    c.depth,
+                    c.error
+                );
+            }
+        }
+        assert!(coarse > 10, "{name}: {coarse} coarse clusters");
+    }
+}
+
 #[test]
 fn cuts_at_any_error_are_closed_and_coarsen_as_the_error_grows() {
     for (name, m) in closed_meshes() {

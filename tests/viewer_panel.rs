@@ -234,6 +234,45 @@ fn a_mesh_becomes_a_dag_from_the_panel_and_saves() {
     assert_eq!(read.mesh.triangles.len(), built.mesh.triangles.len());
 }
 
+/// A mesh of the window's auto-DAG size or more gets its DAG built as a job when it opens
+/// (the command line's default builder), drawn whole until then and as its cut after; a
+/// smaller one, or with the threshold 0, does not.
+#[test]
+fn a_large_mesh_is_drawn_as_its_dag_once_built() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let m = meshslim::mesh::noisy_sphere(4, 0.01, 3);
+    let faces = m.triangles.len();
+    for (threshold, built) in [(faces, true), (faces + 1, false), (0, false)] {
+        let mut h = harness(Model::from_mesh("sphere".into(), m.clone()).unwrap());
+        h.state_mut().set_auto_dag(threshold);
+        h.step();
+        assert_eq!(h.state().jobs.busy(), built, "{}", h.state().status);
+        if built {
+            assert!(
+                h.state().status.contains("moves like a small mesh"),
+                "{}",
+                h.state().status
+            );
+            finish_job(&mut h);
+            h.step();
+        }
+        let s = h.state();
+        assert_eq!(
+            s.scene.dag.is_some(),
+            built,
+            "threshold {threshold}: {}",
+            s.status
+        );
+        if built {
+            let dag = s.scene.dag_built.clone().unwrap();
+            let cli = meshslim::dag::build(&m, &meshslim::dag::DagOptions::default()).unwrap();
+            assert_eq!(*dag, cli.0, "the command line's DAG");
+        }
+    }
+}
+
 /// On a software adapter (lavapipe here) the window starts on cpu-parallel, as the library's
 /// `auto` would, and its panel says why; gpu stays one click away.
 #[test]
@@ -327,4 +366,39 @@ fn an_idle_window_says_it_draws_on_input() {
     h.step();
     assert!(h.query_by_label("frames: drawn on input (idle)").is_some());
     assert!(h.query_by_label_contains("FPS").is_none());
+}
+
+/// While a drag orbits the camera, the panel shows the time between the pictures drawn (a drag
+/// draws one per move), not "drawn on input"; once it ends, the line goes back to idle.
+#[test]
+fn a_drag_shows_the_time_between_the_frames_it_draws() {
+    if gpu_context().is_none() {
+        return;
+    }
+    let mut h = harness(
+        Model::from_mesh("torus".into(), meshslim::mesh::torus(1.0, 0.35, 48, 24)).unwrap(),
+    );
+    h.step();
+    h.step();
+    let camera = h.state().eye.camera;
+    // The middle of the 3D view, right of the side panel.
+    let at = egui::pos2(650.0, 300.0);
+    h.hover_at(at);
+    h.drag_at(at);
+    h.step();
+    for k in 1..=6 {
+        h.hover_at(at + egui::vec2(12.0 * k as f32, 0.0));
+        h.step();
+    }
+    assert_ne!(h.state().eye.camera, camera, "the drag orbits");
+    assert!(h.state().eye.moving);
+    assert!(
+        h.query_by_label_contains("frames shown").is_some(),
+        "the panel times the drag's frames"
+    );
+    h.drop_at(at + egui::vec2(72.0, 0.0));
+    h.step();
+    h.step();
+    assert!(!h.state().eye.moving);
+    assert!(h.query_by_label("frames: drawn on input (idle)").is_some());
 }

@@ -33,7 +33,9 @@ A cluster DAG (X.mslod, from 'meshslim dag build') is drawn as a renderer draws 
 the device picks each cluster's coarsest version whose error projects under --pixels (default 1;
 in the window, a slider) and that is in view, and draws from those draws with no read-back.
 --frames N draws and times N more frames from the same camera, and --json prints the median
-frame time and the triangles a frame drew, for a DAG and a plain mesh alike.
+frame time and the triangles a frame drew, for a DAG and a plain mesh alike. In the window, a
+mesh of a million faces or more (--auto-dag) is drawn as its DAG once built, as a job, and whole
+until then; O shows it whole.
 
 Examples:
   meshslim view ../shared/models/horse.ply
@@ -114,6 +116,11 @@ pub struct ViewArgs {
     /// side the mesh rests on (horse.ply stands on +Z), else the file's convention (+Y, STL +Z)
     #[arg(long, value_enum, value_name = "AXIS", allow_hyphen_values = true)]
     pub up: Option<crate::viewer::camera::Up>,
+
+    /// In the window: a mesh of at least this many faces is drawn as its cluster DAG, built as
+    /// a job when it opens (Esc cancels it), so that it orbits like a small mesh; 0: never
+    #[arg(long, value_name = "FACES", default_value_t = crate::viewer::AUTO_DAG_FACES)]
+    pub auto_dag: usize,
 }
 
 /// A threshold in pixels: finite and above zero.
@@ -139,146 +146,22 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
         wireframe: args.wireframe,
         error_scale: 0.0,
     };
-    let model = |input: &Input| -> Result<crate::viewer::Model> {
-        match input {
-            Input::File(path) => progress
-                .spinner(format!("reading {}", path.display()), || {
-                    crate::viewer::Model::open(path, args.texture.as_deref())
-                })
-                .map(|mut m| {
-                    m.up_axis = args.up.unwrap_or(m.up_axis);
-                    m
-                })
-                .map_err(lib)
-                .context("cannot read the input"),
-            Input::Builtin { .. } => {
-                let mesh = load(input, &progress)?;
-                let mut m = crate::viewer::Model::from_mesh(input.display(), mesh).map_err(lib)?;
-                m.up_axis = args.up.unwrap_or(m.up_axis);
-                if let Some(t) = &args.texture {
-                    m.texture = Some(crate::viewer::scene::read_texture(t).map_err(lib)?);
-                }
-                Ok(m)
-            }
-        }
-    };
-    let dag_only = |what: &str| -> Result<()> {
-        match &args.input {
-            Some(i) if is_dag(i) => Ok(()),
-            _ => Err(UsageError(format!("{what} is for the screenshot of a DAG (X.mslod)")).into()),
-        }
-    };
-    if args.pixels.is_some() {
-        dag_only("--pixels")?;
-    }
-    if args.screenshot.is_none() && (args.frames > 0 || args.json || args.pixels.is_some()) {
-        return Err(UsageError(
-            "--frames, --json and --pixels go with --screenshot (the window has a slider for \
-             the pixels)"
-                .into(),
-        )
-        .into());
-    }
-    if args.frames > 0 && args.side_by_side {
-        return Err(UsageError("--frames times one view: not with --side-by-side".into()).into());
-    }
+    check_flags(&args)?;
     let Some(png) = args.screenshot.clone() else {
-        // A file that cannot be opened fails here, not in a window that opens to say so.
-        if let Some(Input::File(p)) = &args.input {
-            std::fs::File::open(p)
-                .map_err(|e| {
-                    lib(crate::Error::Io {
-                        path: p.clone(),
-                        source: e,
-                    })
-                })
-                .context("cannot read the input")?;
-        }
-        let start = match &args.input {
-            Some(Input::File(p)) if ManifestKind::of(p).is_some() => {
-                // A manifest made from a generated mesh: made again here, where the builtins
-                // are; a file is read by the window.
-                let input = manifest::input_of(p)
-                    .map_err(lib)
-                    .context("cannot read the manifest")?;
-                if input.starts_with(BUILTIN_PREFIX) {
-                    let made = parse_input_arg(&input).map_err(|e| {
-                        UsageError(format!("{}: its input {input}: {e}", p.display()))
-                    })?;
-                    crate::viewer::Start::Manifest(p.clone(), model(&made)?)
-                } else {
-                    crate::viewer::Start::Open(p.clone())
-                }
-            }
-            Some(Input::File(p)) if args.texture.is_none() => crate::viewer::Start::Open(p.clone()),
-            Some(input) => crate::viewer::Start::Model(model(input)?),
-            None => crate::viewer::Start::Nothing,
-        };
-        let size = args.size.unwrap_or((1280, 800));
-        crate::viewer::run_window(
-            start,
-            args.ratio.unwrap_or(0.1),
-            args.method.method(),
-            (style, args.mode),
-            size,
-            args.up,
-        )
-        .map_err(lib)?;
-        return Ok(ExitCode::SUCCESS);
+        return open_window(&args, style, &progress);
     };
     let Some(input) = &args.input else {
         return Err(UsageError("--screenshot needs a MESH to draw".into()).into());
     };
-    if let Input::File(p) = input
-        && ManifestKind::of(p).is_some()
-    {
-        return Err(UsageError(format!(
-            "{}: a manifest opens in the window (without --screenshot); a screenshot draws one \
-             mesh: give one of its files",
-            p.display()
-        ))
-        .into());
-    }
-    if !png
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
-    {
-        return Err(UsageError(format!(
-            "{}: the screenshot is a PNG; name it FILE.png",
-            png.display()
-        ))
-        .into());
-    }
-    // Before any reading or rendering: a screenshot with nowhere to go fails at once.
-    check_directory(&png, "the screenshot's directory")?;
-    let dag = if is_dag(input) {
-        let Input::File(path) = input else {
-            unreachable!("is_dag holds for files")
-        };
-        if args.ratio.is_some() || args.side_by_side {
-            return Err(UsageError(
-                "a DAG is drawn as its cut: --ratio and --side-by-side are for meshes".into(),
-            )
-            .into());
-        }
-        Some(
-            progress
-                .spinner(format!("reading {}", path.display()), || {
-                    crate::dag::file::read(path)
-                })
-                .map_err(lib)
-                .context("cannot read the DAG")?,
-        )
-    } else {
-        None
-    };
+    check_screenshot(input, &png)?;
+    let dag = read_dag(&args, input, &progress)?;
     let model = match &dag {
         Some(d) => {
             let mut m = crate::viewer::Model::leaves_of(d, input.display()).map_err(lib)?;
             m.up_axis = args.up.unwrap_or(m.up_axis);
             m
         }
-        None => model(input)?,
+        None => read_model(&args, &progress, input)?,
     };
     let style = crate::viewer::Style {
         // As the window opens it: a textured mesh in texture mode, a painted one in colour.
@@ -311,6 +194,175 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
     crate::io::write_atomic(&png, |w| w.write_all(&frame.png))
         .map_err(lib)
         .context("cannot write the screenshot")?;
+    report(&args, &png, &frame, size, style, dag.is_some())
+}
+
+/// The mesh of `input` for the window or a screenshot, its up axis and texture as given.
+fn read_model(args: &ViewArgs, progress: &Progress, input: &Input) -> Result<crate::viewer::Model> {
+    match input {
+        Input::File(path) => progress
+            .spinner(format!("reading {}", path.display()), || {
+                crate::viewer::Model::open(path, args.texture.as_deref())
+            })
+            .map(|mut m| {
+                m.up_axis = args.up.unwrap_or(m.up_axis);
+                m
+            })
+            .map_err(lib)
+            .context("cannot read the input"),
+        Input::Builtin { .. } => {
+            let mesh = load(input, progress)?;
+            let mut m = crate::viewer::Model::from_mesh(input.display(), mesh).map_err(lib)?;
+            m.up_axis = args.up.unwrap_or(m.up_axis);
+            if let Some(t) = &args.texture {
+                m.texture = Some(crate::viewer::scene::read_texture(t).map_err(lib)?);
+            }
+            Ok(m)
+        }
+    }
+}
+
+/// The flags that go together: --pixels with a DAG, --frames, --json and --pixels with
+/// --screenshot, --frames not with --side-by-side.
+fn check_flags(args: &ViewArgs) -> Result<()> {
+    let dag_only = |what: &str| -> Result<()> {
+        match &args.input {
+            Some(i) if is_dag(i) => Ok(()),
+            _ => Err(UsageError(format!("{what} is for the screenshot of a DAG (X.mslod)")).into()),
+        }
+    };
+    if args.pixels.is_some() {
+        dag_only("--pixels")?;
+    }
+    if args.screenshot.is_none() && (args.frames > 0 || args.json || args.pixels.is_some()) {
+        return Err(UsageError(
+            "--frames, --json and --pixels go with --screenshot (the window has a slider for \
+             the pixels)"
+                .into(),
+        )
+        .into());
+    }
+    if args.frames > 0 && args.side_by_side {
+        return Err(UsageError("--frames times one view: not with --side-by-side".into()).into());
+    }
+    Ok(())
+}
+
+/// The window on `args.input` (blocks until it is closed).
+fn open_window(
+    args: &ViewArgs,
+    style: crate::viewer::Style,
+    progress: &Progress,
+) -> Result<ExitCode> {
+    // A file that cannot be opened fails here, not in a window that opens to say so.
+    if let Some(Input::File(p)) = &args.input {
+        std::fs::File::open(p)
+            .map_err(|e| {
+                lib(crate::Error::Io {
+                    path: p.clone(),
+                    source: e,
+                })
+            })
+            .context("cannot read the input")?;
+    }
+    let start = match &args.input {
+        Some(Input::File(p)) if ManifestKind::of(p).is_some() => {
+            // A manifest made from a generated mesh: made again here, where the builtins
+            // are; a file is read by the window.
+            let input = manifest::input_of(p)
+                .map_err(lib)
+                .context("cannot read the manifest")?;
+            if input.starts_with(BUILTIN_PREFIX) {
+                let made = parse_input_arg(&input)
+                    .map_err(|e| UsageError(format!("{}: its input {input}: {e}", p.display())))?;
+                crate::viewer::Start::Manifest(p.clone(), read_model(args, progress, &made)?)
+            } else {
+                crate::viewer::Start::Open(p.clone())
+            }
+        }
+        Some(Input::File(p)) if args.texture.is_none() => crate::viewer::Start::Open(p.clone()),
+        Some(input) => crate::viewer::Start::Model(read_model(args, progress, input)?),
+        None => crate::viewer::Start::Nothing,
+    };
+    let size = args.size.unwrap_or((1280, 800));
+    crate::viewer::run_window(
+        start,
+        args.ratio.unwrap_or(0.1),
+        args.method.method(),
+        (style, args.mode),
+        size,
+        args.up,
+        args.auto_dag,
+    )
+    .map_err(lib)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// A screenshot draws one mesh into a PNG whose folder exists: checked before anything is read.
+fn check_screenshot(input: &Input, png: &std::path::Path) -> Result<()> {
+    if let Input::File(p) = input
+        && ManifestKind::of(p).is_some()
+    {
+        return Err(UsageError(format!(
+            "{}: a manifest opens in the window (without --screenshot); a screenshot draws one \
+             mesh: give one of its files",
+            p.display()
+        ))
+        .into());
+    }
+    if !png
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+    {
+        return Err(UsageError(format!(
+            "{}: the screenshot is a PNG; name it FILE.png",
+            png.display()
+        ))
+        .into());
+    }
+    // Before any reading or rendering: a screenshot with nowhere to go fails at once.
+    check_directory(png, "the screenshot's directory")?;
+    Ok(())
+}
+
+/// The DAG of `input` when it is a .mslod (which --ratio and --side-by-side do not go with).
+fn read_dag(
+    args: &ViewArgs,
+    input: &Input,
+    progress: &Progress,
+) -> Result<Option<crate::dag::Dag>> {
+    Ok(if is_dag(input) {
+        let Input::File(path) = input else {
+            unreachable!("is_dag holds for files")
+        };
+        if args.ratio.is_some() || args.side_by_side {
+            return Err(UsageError(
+                "a DAG is drawn as its cut: --ratio and --side-by-side are for meshes".into(),
+            )
+            .into());
+        }
+        Some(
+            progress
+                .spinner(format!("reading {}", path.display()), || {
+                    crate::dag::file::read(path)
+                })
+                .map_err(lib)
+                .context("cannot read the DAG")?,
+        )
+    } else {
+        None
+    })
+}
+
+/// What the screenshot drew: JSON with --json, else a line.
+fn report(
+    args: &ViewArgs,
+    png: &std::path::Path,
+    frame: &crate::viewer::Frame,
+    size: (u32, u32),
+    style: crate::viewer::Style,
+    is_dag: bool,
+) -> Result<ExitCode> {
     if args.json {
         let mut times = frame.frame_seconds.clone();
         times.sort_by(f64::total_cmp);
@@ -323,7 +375,7 @@ pub(super) fn run_view(args: ViewArgs) -> Result<ExitCode> {
             "triangles_drawn": frame.triangles_drawn,
             "clusters_drawn": frame.clusters_drawn.map(|c| c.0),
             "clusters_in_cut": frame.clusters_drawn.map(|c| c.1),
-            "pixels": dag.as_ref().map(|_| args.pixels.unwrap_or(1.0)),
+            "pixels": is_dag.then(|| args.pixels.unwrap_or(1.0)),
             "frames": frame.frame_seconds.len(),
             "frame_seconds": median,
             "frame_seconds_each": frame.frame_seconds,

@@ -119,6 +119,13 @@ impl ViewerApp {
         }
     }
 
+    /// The faces from which a mesh opened is drawn as its cluster DAG (0: never); the model
+    /// shown is checked again against it.
+    pub fn set_auto_dag(&mut self, faces: usize) {
+        self.panel.auto_dag_faces = faces;
+        self.scene.dag_unchecked = self.scene.model.is_some();
+    }
+
     /// The target in faces, as the face-count field holds it.
     pub fn set_target_faces(&mut self, faces: usize) {
         self.panel.faces_text = faces.to_string();
@@ -167,6 +174,7 @@ impl eframe::App for ViewerApp {
         let ctx = ui.ctx().clone();
         self.view.tick(&self.scene);
         self.poll_job();
+        self.auto_dag();
         let mut actions: Vec<Action> = panels::dropped_file(&ctx).into_iter().collect();
         let seen = Seen {
             scene: &self.scene,

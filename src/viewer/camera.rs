@@ -317,6 +317,9 @@ pub struct Eye {
     /// An axis chosen before any model was shown (the command line's `--up` for a file read
     /// once the window is up): the first model takes it, later ones their own.
     pub(super) up_for_next: Option<Up>,
+    /// Whether the last frame's input dragged, zoomed or flew the camera: the panel then shows
+    /// the time between the pictures the user sees, not "drawn on input".
+    pub moving: bool,
 }
 
 impl Default for Eye {
@@ -327,6 +330,7 @@ impl Default for Eye {
             fly_speed: 0.5,
             up: None,
             up_for_next: None,
+            moving: false,
         }
     }
 }
@@ -373,6 +377,12 @@ impl Eye {
     /// Drags, wheel and pinch on the 3D view (`r`), and the fly keys when no text field has
     /// the keyboard.
     pub fn input(&mut self, ui: &egui::Ui, r: &egui::Response) {
+        let before = self.camera;
+        self.input_camera(ui, r);
+        self.moving = self.camera != before || r.dragged();
+    }
+
+    fn input_camera(&mut self, ui: &egui::Ui, r: &egui::Response) {
         let size = r.rect.size().max(egui::vec2(1.0, 1.0));
         let d = r.drag_delta();
         // Radians per point: a drag across the view turns about half a turn.

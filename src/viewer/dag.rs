@@ -28,7 +28,17 @@ pub struct DagScene {
     cluster_error: Vec<f32>,
     center: [f64; 3],
     scale: f64,
+    /// The last host cut and the parameters it was taken with: the panel's counts and the
+    /// heatmap's top ask for the same cut in a frame, and the camera is mostly still.
+    last_cut: std::cell::RefCell<Option<HostCut>>,
 }
+
+/// A cut taken on the host: its parameters, each cluster's draw and the counts.
+type HostCut = (
+    crate::compute::types::CutParams,
+    Vec<crate::compute::types::CornerDraw>,
+    [u32; 4],
+);
 
 impl DagScene {
     /// `dag` uploaded on the device of `pipelines`, in the normalized frame (`center`,
@@ -94,6 +104,7 @@ impl DagScene {
             cluster_error,
             center,
             scale,
+            last_cut: std::cell::RefCell::new(None),
         })
     }
 
@@ -101,7 +112,7 @@ impl DagScene {
     /// (the panel's counts; the device's own are never read back while drawing): clusters in
     /// the cut, clusters drawn, triangles drawn.
     pub fn counts(&self, cam: &Camera, size: (u32, u32), pixels: f64) -> [u32; 4] {
-        self.host_cut(cam, size, pixels).1
+        self.with_host_cut(cam, size, pixels, |_, counts| *counts)
     }
 
     /// The top of the heatmap for the cut of `cam`: the largest distance of a drawn cluster's
@@ -110,24 +121,32 @@ impl DagScene {
         if self.cluster_error.is_empty() {
             return 0.0;
         }
-        let (draws, _) = self.host_cut(cam, size, pixels);
-        (draws.iter().zip(&self.cluster_error))
-            .filter(|(d, _)| d.instance_count > 0)
-            .fold(0f32, |m, (_, &e)| m.max(e))
+        self.with_host_cut(cam, size, pixels, |draws, _| {
+            (draws.iter().zip(&self.cluster_error))
+                .filter(|(d, _)| d.instance_count > 0)
+                .fold(0f32, |m, (_, &e)| m.max(e))
+        })
     }
 
-    /// The cut of `cam` by the stage's twin on the host: each cluster's draw, and the counts.
-    fn host_cut(
+    /// `f` of the cut of `cam` by the stage's twin on the host (each cluster's draw, and the
+    /// counts), taken again only when its parameters changed.
+    fn with_host_cut<T>(
         &self,
         cam: &Camera,
         size: (u32, u32),
         pixels: f64,
-    ) -> (Vec<crate::compute::types::CornerDraw>, [u32; 4]) {
+        f: impl FnOnce(&[crate::compute::types::CornerDraw], &[u32; 4]) -> T,
+    ) -> T {
         let p = self.cut_params(cam, size, pixels);
-        let mut draws = vec![crate::compute::types::CornerDraw::default(); self.clusters.len()];
-        let mut counts = [0; 4];
-        crate::dag::cut::dag_cut(&p, &self.clusters, &mut draws, &mut counts);
-        (draws, counts)
+        let mut last = self.last_cut.borrow_mut();
+        if last.as_ref().is_none_or(|(q, _, _)| *q != p) {
+            let mut draws = vec![crate::compute::types::CornerDraw::default(); self.clusters.len()];
+            let mut counts = [0; 4];
+            crate::dag::cut::dag_cut(&p, &self.clusters, &mut draws, &mut counts);
+            *last = Some((p, draws, counts));
+        }
+        let (_, draws, counts) = last.as_ref().expect("taken just above");
+        f(draws, counts)
     }
 
     /// The cut of `cam` at `pixels` on a `size` view, as `dag cut --camera` takes it: the eye
@@ -160,25 +179,33 @@ impl DagScene {
     }
 }
 
-/// Draws `frames` frames of `items` from `cam` into `target`, each submitted and waited for
-/// (`before` records what a frame needs first: a DAG's cut); the seconds of each.
-#[allow(clippy::too_many_arguments)]
+/// Draws `frames` frames of `scene` into `target` as `view` = (camera, style) sees it, each
+/// submitted and waited for (`before` records what a frame needs first: a DAG's cut); the
+/// seconds of each.
 pub fn time_frames(
     ctx: &crate::compute::context::GpuContext,
     renderer: &mut Renderer,
     target: &Target,
-    cam: &Camera,
-    style: &Style,
-    items: &[(&SceneMesh, Mat4)],
+    (cam, style): (&Camera, &Style),
+    scene: &SceneMesh,
     frames: usize,
     before: &mut dyn FnMut(&mut wgpu::CommandEncoder),
 ) -> Result<Vec<f64>> {
+    let items = [(scene, cam.model)];
     let mut seconds = Vec::with_capacity(frames);
     for _ in 0..frames {
         let t = Instant::now();
         let mut enc = ctx.device.create_command_encoder(&Default::default());
         before(&mut enc);
-        renderer.draw(&ctx.device, &ctx.queue, &mut enc, target, cam, style, items);
+        renderer.draw(
+            &ctx.device,
+            &ctx.queue,
+            &mut enc,
+            target,
+            cam,
+            style,
+            &items,
+        );
         ctx.queue.submit([enc.finish()]);
         ctx.device
             .poll(wgpu::PollType::wait_indefinitely())

@@ -22,6 +22,7 @@ pub mod views;
 use crate::error::{Error, Result};
 use crate::options::{Backend, SimplifyOptions};
 pub use app::{Start, ViewerApp};
+pub use panels::AUTO_DAG_FACES;
 pub use render::{Mode, Renderer, Style, encode_png};
 pub use scene::{Image, Model};
 
@@ -101,7 +102,97 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
         frames,
         dag,
     } = shot;
-    // Checked before the GPU work: a texture or colour mode with nothing to show fails at once.
+    check_mode(model, &style)?;
+    let (ctx, sim) = crate::rounds::gpu::shared()?;
+    // Every piece of device work below (uploads, the simplification, the texture, the draw) is
+    // caught here and becomes an error, not a panic in wgpu's default handler.
+    let scope = crate::compute::gpu::ErrorScope::push(&ctx.device);
+    let simplified = match ratio < 1.0 {
+        true => Some(simplify_for_shot(ctx, sim, model, ratio, method)?),
+        false => None,
+    };
+    let original = match (&simplified, side_by_side) {
+        (Some(_), false) => None,
+        _ => Some(model.original(&ctx.device)?),
+    };
+    let (scene, faces) = match &simplified {
+        Some((s, faces)) => (s, *faces),
+        None => (original.as_ref().expect("made above"), model.faces()),
+    };
+    style.error_scale = scene.max_error;
+    let mut renderer = shot_renderer(ctx, model, &style)?;
+    // The window's first view of the model, for each pane's shape.
+    let pane = if side_by_side {
+        ((size.0 / 2).max(1), size.1)
+    } else {
+        size
+    };
+    let cam = model.home_camera(pane);
+    let frame = match dag {
+        Some((dag, pixels)) => {
+            let view = (&cam, size, pixels, frames);
+            shoot_dag(ctx, &mut renderer, model, dag, view, &mut style)?
+        }
+        None => {
+            let mut draw = |mesh: &render::SceneMesh, size| {
+                let items = [(mesh, cam.model)];
+                render::render_rgba(
+                    &ctx.device,
+                    &ctx.queue,
+                    &mut renderer,
+                    &items,
+                    &cam,
+                    &style,
+                    size,
+                )
+            };
+            let (rgba, size) = if side_by_side {
+                let left = draw(original.as_ref().expect("made above"), pane)?;
+                // The right pane's width takes the odd pixel.
+                let right_pane = (size.0 - pane.0, size.1);
+                let right = draw(scene, right_pane)?;
+                views::side_by_side(
+                    vec![(left, pane), (right, right_pane)],
+                    &views::pane_labels(simplified.is_some()),
+                )?
+            } else {
+                (draw(scene, size)?, size)
+            };
+            // The frames timed after the picture, as a DAG's are (side by side draws two
+            // panes: not one frame of the window's).
+            let frame_seconds = match frames > 0 && !side_by_side {
+                true => {
+                    let target = render::Target::new(&ctx.device, size)?;
+                    let view = (&cam, &style);
+                    dag::time_frames(
+                        ctx,
+                        &mut renderer,
+                        &target,
+                        view,
+                        scene,
+                        frames,
+                        &mut |_| {},
+                    )?
+                }
+                false => Vec::new(),
+            };
+            Frame {
+                adapter: ctx.adapter_name.clone(),
+                faces,
+                max_error: scene.max_error as f64,
+                png: encode_png(&rgba, size)?,
+                frame_seconds,
+                triangles_drawn: faces,
+                clusters_drawn: None,
+            }
+        }
+    };
+    scope.check("rendering the frame")?;
+    Ok(frame)
+}
+
+/// A colour or texture mode the mesh cannot show, refused before any GPU work.
+fn check_mode(model: &Model, style: &Style) -> Result<()> {
     if style.mode == Mode::Color && model.mesh.colors.is_none() {
         return Err(Error::InvalidOption(
             "--mode color: the mesh has no vertex colours".into(),
@@ -115,41 +206,44 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
             })
         )));
     }
-    let (ctx, sim) = crate::rounds::gpu::shared()?;
-    // Every piece of device work below (uploads, the simplification, the texture, the draw) is
-    // caught here and becomes an error, not a panic in wgpu's default handler.
-    let scope = crate::compute::gpu::ErrorScope::push(&ctx.device);
-    let simplified = if ratio < 1.0 {
-        let mut opts = SimplifyOptions::with_ratio(model.up.face_count(), ratio)?;
-        opts.method = method;
-        // The GPU runs the rounds and the clustering; hybrid runs on the CPU as `simplify
-        // --method hybrid` does by default (its clustering, then the greedy queue or the
-        // rounds), decimate on one core.
-        opts.backend = match method {
-            crate::Method::Hybrid => Backend::Cpu,
-            crate::Method::Decimate => Backend::Cpu,
-            _ => Backend::Gpu,
-        };
-        let on = crate::simplify::OnDevice {
-            rounds: Some(sim),
-            cluster: Some(crate::cluster::gpu::shared()?),
-            upload: None,
-            share_queue: false,
-        };
-        let s = scene::simplify(&ctx.device, on, model, &opts, &mut |_| {}, &|_| {})?;
-        Some((s.scene, s.report.output_faces))
-    } else {
-        None
+    Ok(())
+}
+
+/// `model` simplified to `ratio` by `method` for the screenshot, and its faces.
+fn simplify_for_shot(
+    ctx: &crate::compute::context::GpuContext,
+    sim: &crate::rounds::gpu::GpuSimplifier,
+    model: &Model,
+    ratio: f64,
+    method: crate::Method,
+) -> Result<(render::SceneMesh, usize)> {
+    let mut opts = SimplifyOptions::with_ratio(model.up.face_count(), ratio)?;
+    opts.method = method;
+    // The GPU runs the rounds and the clustering; hybrid runs on the CPU as `simplify
+    // --method hybrid` does by default (its clustering, then the greedy queue or the
+    // rounds), decimate on one core.
+    opts.backend = match method {
+        crate::Method::Hybrid => Backend::Cpu,
+        crate::Method::Decimate => Backend::Cpu,
+        _ => Backend::Gpu,
     };
-    let original = match (&simplified, side_by_side) {
-        (Some(_), false) => None,
-        _ => Some(model.original(&ctx.device)?),
+    let on = crate::simplify::OnDevice {
+        rounds: Some(sim),
+        cluster: Some(crate::cluster::gpu::shared()?),
+        upload: None,
+        share_queue: false,
     };
-    let (scene, faces) = match &simplified {
-        Some((s, faces)) => (s, *faces),
-        None => (original.as_ref().expect("made above"), model.faces()),
-    };
-    style.error_scale = scene.max_error;
+    let s = scene::simplify(&ctx.device, on, model, &opts, &mut |_| {}, &|_| {})?;
+    Ok((s.scene, s.report.output_faces))
+}
+
+/// The screenshot's renderer, with the model's texture when the texture mode draws it (one
+/// larger than the device takes is an error).
+fn shot_renderer(
+    ctx: &crate::compute::context::GpuContext,
+    model: &Model,
+    style: &Style,
+) -> Result<Renderer> {
     let mut renderer = Renderer::new(&ctx.device, &ctx.queue);
     let max = ctx.device.limits().max_texture_dimension_2d;
     if let Some(t) = model
@@ -165,122 +259,66 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
         }
         renderer.set_texture(&ctx.device, &ctx.queue, Some((&t.rgba, t.size)));
     }
-    // The window's first view of the model, for each pane's shape.
-    let pane = if side_by_side {
-        ((size.0 / 2).max(1), size.1)
-    } else {
-        size
+    Ok(renderer)
+}
+
+/// The screenshot of a DAG: its cut from `view` = (camera, size, pixels, frames timed after
+/// the picture), each frame cut and drawn on the device, and the cut's counts read back.
+fn shoot_dag(
+    ctx: &crate::compute::context::GpuContext,
+    renderer: &mut Renderer,
+    model: &Model,
+    dag: &crate::dag::Dag,
+    (cam, size, pixels, frames): (&camera::Camera, (u32, u32), f64, usize),
+    style: &mut Style,
+) -> Result<Frame> {
+    let frame = (model.up.center, model.up.scale);
+    // The heatmap's distances cost a query a vertex: made only for it.
+    let error = match style.mode {
+        Mode::Heatmap => model.dag_errors(dag),
+        _ => Vec::new(),
     };
-    let mut eye = camera::Eye::default();
-    eye.home(
-        model.up_axis,
-        model.stood,
-        model.extent(),
-        pane.0 as f32 / pane.1 as f32,
-    );
-    let cam = eye.camera;
-    if let Some((dag, pixels)) = dag {
-        let frame = (model.up.center, model.up.scale);
-        // The heatmap's distances cost a query a vertex: made only for it.
-        let error = match style.mode {
-            Mode::Heatmap => model.dag_errors(dag),
-            _ => Vec::new(),
-        };
-        let mut d = dag::DagScene::new(&ctx.pipelines, &ctx.queue, dag, frame, error)?;
-        style.error_scale = d.heat_top(&cam, size, pixels);
-        let p = d.cut_params(&cam, size, pixels);
-        let target = render::Target::new(&ctx.device, size)?;
-        let items = [(&d.scene, cam.model)];
-        let cut = &mut d.cut;
-        // Each frame cuts and draws; the first, which also makes what a first use makes, is
-        // the picture and is not timed.
-        let mut seconds = dag::time_frames(
-            ctx,
-            &mut renderer,
-            &target,
-            &cam,
-            &style,
-            &items,
-            frames + 1,
-            &mut |enc| cut.record(enc, &p),
-        )?;
-        seconds.remove(0);
-        let rgba = target.read_rgba(&ctx.device, &ctx.queue)?;
-        let counts = crate::compute::context::read_back(
-            &ctx.device,
-            &ctx.queue,
-            &d.cut.counts,
-            16,
-            "reading the cut's counts",
-        )?;
-        let counts: [u32; 4] = bytemuck::pod_read_unaligned(&counts);
-        scope.check("rendering the frame")?;
-        return Ok(Frame {
-            adapter: ctx.adapter_name.clone(),
-            faces: dag.mesh.triangles.len(),
-            max_error: style.error_scale as f64,
-            png: encode_png(&rgba, size)?,
-            frame_seconds: seconds,
-            triangles_drawn: counts[2] as usize,
-            clusters_drawn: Some((counts[1] as usize, counts[0] as usize)),
-        });
-    }
-    let mut draw = |mesh: &render::SceneMesh, size| {
-        let items = [(mesh, cam.model)];
-        render::render_rgba(
-            &ctx.device,
-            &ctx.queue,
-            &mut renderer,
-            &items,
-            &cam,
-            &style,
-            size,
-        )
-    };
-    let (rgba, size) = if side_by_side {
-        let left = draw(original.as_ref().expect("made above"), pane)?;
-        // The right pane's width takes the odd pixel.
-        let right_pane = (size.0 - pane.0, size.1);
-        let right = draw(scene, right_pane)?;
-        views::side_by_side(
-            vec![(left, pane), (right, right_pane)],
-            &views::pane_labels(simplified.is_some()),
-        )?
-    } else {
-        (draw(scene, size)?, size)
-    };
-    // The frames timed after the picture, as a DAG's are (side by side draws two panes: not
-    // one frame of the window's).
-    let frame_seconds = if frames > 0 && !side_by_side {
-        let target = render::Target::new(&ctx.device, size)?;
-        let items = [(scene, cam.model)];
-        dag::time_frames(
-            ctx,
-            &mut renderer,
-            &target,
-            &cam,
-            &style,
-            &items,
-            frames,
-            &mut |_| {},
-        )?
-    } else {
-        Vec::new()
-    };
-    scope.check("rendering the frame")?;
+    let mut d = dag::DagScene::new(&ctx.pipelines, &ctx.queue, dag, frame, error)?;
+    style.error_scale = d.heat_top(cam, size, pixels);
+    let p = d.cut_params(cam, size, pixels);
+    let target = render::Target::new(&ctx.device, size)?;
+    let (scene, cut) = (&d.scene, &mut d.cut);
+    // Each frame cuts and draws; the first, which also makes what a first use makes, is
+    // the picture and is not timed.
+    let record = &mut |enc: &mut wgpu::CommandEncoder| cut.record(enc, &p);
+    let mut seconds = dag::time_frames(
+        ctx,
+        renderer,
+        &target,
+        (cam, style),
+        scene,
+        frames + 1,
+        record,
+    )?;
+    seconds.remove(0);
+    let rgba = target.read_rgba(&ctx.device, &ctx.queue)?;
+    let counts = crate::compute::context::read_back(
+        &ctx.device,
+        &ctx.queue,
+        &d.cut.counts,
+        16,
+        "reading the cut's counts",
+    )?;
+    let counts: [u32; 4] = bytemuck::pod_read_unaligned(&counts);
     Ok(Frame {
         adapter: ctx.adapter_name.clone(),
-        faces,
-        max_error: scene.max_error as f64,
+        faces: dag.mesh.triangles.len(),
+        max_error: style.error_scale as f64,
         png: encode_png(&rgba, size)?,
-        frame_seconds,
-        triangles_drawn: faces,
-        clusters_drawn: None,
+        frame_seconds: seconds,
+        triangles_drawn: counts[2] as usize,
+        clusters_drawn: Some((counts[1] as usize, counts[0] as usize)),
     })
 }
 
 /// Opens the interactive window with `ratio` as the starting target, drawn in `style` (in
-/// `mode` when given, else as the mesh picks), of `size` points (blocks until it is closed).
+/// `mode` when given, else as the mesh picks), of `size` points, a mesh of `auto_dag` faces or
+/// more drawn as its cluster DAG (blocks until it is closed).
 pub fn run_window(
     start: Start,
     ratio: f64,
@@ -288,6 +326,7 @@ pub fn run_window(
     (style, mode): (Style, Option<Mode>),
     size: (u32, u32),
     up: Option<camera::Up>,
+    auto_dag: usize,
 ) -> Result<()> {
     let options = eframe::NativeOptions {
         viewport: eframe::egui::ViewportBuilder::default()
@@ -315,6 +354,7 @@ pub fn run_window(
             app.set_method(method);
             app.set_style(style, mode);
             app.set_up(up);
+            app.set_auto_dag(auto_dag);
             Ok(Box::new(app))
         }),
     )

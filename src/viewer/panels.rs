@@ -70,7 +70,14 @@ pub struct Panel {
     pub shot_path: String,
     pub show_help: bool,
     pub(super) browser: Option<Browser>,
+    /// A mesh of at least this many faces is drawn as its cluster DAG, built as a job when it
+    /// opens (0: never): drawn whole, a 4M-face scan takes a second a frame on a software
+    /// rasterizer, as its cut at 1 px a fiftieth of that (docs/PERFORMANCE.md, the DAG's cut).
+    pub auto_dag_faces: usize,
 }
+
+/// The window's default [`Panel::auto_dag_faces`].
+pub const AUTO_DAG_FACES: usize = 1_000_000;
 
 impl Panel {
     pub(super) fn new(backend: Backend, backend_why: String) -> Panel {
@@ -86,6 +93,7 @@ impl Panel {
             shot_path: "meshslim-view.png".into(),
             show_help: false,
             browser: None,
+            auto_dag_faces: AUTO_DAG_FACES,
         }
     }
 
@@ -302,7 +310,7 @@ impl Panel {
         ui.separator();
         self.front_ui(ui, seen, &mut act);
         ui.separator();
-        let animating = seen.jobs.busy() || view.lod_shown(scene) || eye.fly;
+        let animating = seen.jobs.busy() || view.lod_shown(scene) || eye.fly || eye.moving;
         stats_ui(ui, view, seen, animating);
         ui.separator();
         ui.horizontal(|ui| {
@@ -615,9 +623,10 @@ fn dag_ui(ui: &mut egui::Ui, view: &mut View3d, eye: &Eye, seen: &Seen, act: &mu
 fn stats_ui(ui: &mut egui::Ui, view: &View3d, seen: &Seen, animating: bool) {
     ui.label(format!("device: {}", seen.gpu.adapter));
     // The time between the pictures the user sees, while the window draws on its own (a few
-    // times a second during a job, continuously in the LOD scene and fly mode) or a picture has
-    // been drawing for long (a drag on a large mesh). Otherwise it draws on input alone, and the
-    // gap between frames is the user's, not the renderer's.
+    // times a second during a job, continuously in the LOD scene and fly mode), while the camera
+    // moves (a drag draws a frame per move) or a picture has been drawing for long (a drag on a
+    // large mesh). Otherwise it draws on input alone, and the gap between frames is the user's,
+    // not the renderer's.
     // A poll that does not wait runs the callbacks of the renders the device has finished.
     let _ = seen.gpu.device.poll(wgpu::PollType::Poll);
     let now = std::time::Instant::now();

@@ -83,6 +83,8 @@ pub struct Scene {
     pub dag: Option<std::sync::Mutex<super::dag::DagScene>>,
     /// The DAG as built in the window, until saved.
     pub dag_built: Option<Arc<crate::dag::Dag>>,
+    /// A model came and has not yet been checked for a DAG of its own (a large mesh gets one).
+    pub(super) dag_unchecked: bool,
 }
 
 impl Scene {
@@ -97,6 +99,7 @@ impl Scene {
         self.front = None;
         self.dag = None;
         self.dag_built = None;
+        self.dag_unchecked = true;
     }
 
     pub(super) fn set_simplified(&mut self, s: Simplified) {

@@ -90,15 +90,26 @@ impl FrameClock {
 
     /// A render of the 3D view was submitted: its end is timed when the device has done it.
     fn submitted(&mut self, queue: &wgpu::Queue) {
-        if !self.pending() {
-            self.waiting_since = Some(Instant::now());
-        }
-        self.submitted += 1;
+        self.submitted_at(Instant::now());
         let shown = self.shown.clone();
         queue.on_submitted_work_done(move || {
             let mut s = shown.lock().unwrap_or_else(|p| p.into_inner());
             s.finished(Instant::now());
         });
+    }
+
+    /// The bookkeeping of a render submitted at `now`. One submitted well after the last
+    /// picture with none on the device follows idle time (nothing asked for a frame): the gap
+    /// it ends is timed from its submission, so that the user's pause is not a slow frame.
+    fn submitted_at(&mut self, now: Instant) {
+        if !self.pending() {
+            self.waiting_since = Some(now);
+            let mut s = self.shown.lock().unwrap_or_else(|p| p.into_inner());
+            if s.last.is_some_and(|l| (now - l).as_secs_f64() > STALLED) {
+                s.last = Some(now);
+            }
+        }
+        self.submitted += 1;
     }
 
     /// Whether a render is still on the device: the screen shows an older picture.
@@ -674,6 +685,28 @@ mod tests {
         assert!(clock.stalled(at(1.9)));
         let gap = clock.shown_gap(at(1.9)).unwrap();
         assert!((gap - 1.8).abs() < 1e-9, "{gap}");
+    }
+
+    #[test]
+    fn a_pause_between_inputs_is_not_a_slow_frame() {
+        let mut clock = FrameClock::default();
+        let t0 = Instant::now();
+        let at = |s: f64| t0 + std::time::Duration::from_secs_f64(s);
+        for (k, t) in [0.0, 0.02, 0.04].into_iter().enumerate() {
+            clock.submitted_at(at(t));
+            clock.shown.lock().unwrap().finished(at(t + 0.02));
+            assert_eq!(clock.shown.lock().unwrap().done, k as u64 + 1);
+        }
+        // Five idle seconds, then a drag's frame drawn in 20 ms: the gap is that frame's.
+        clock.submitted_at(at(5.06));
+        clock.shown.lock().unwrap().finished(at(5.08));
+        let gap = clock.shown_gap(at(5.08)).unwrap();
+        assert!((gap - 0.02).abs() < 1e-9, "{gap}");
+        // Frames submitted back to back are timed from the picture before, however slow.
+        clock.submitted_at(at(5.09));
+        clock.shown.lock().unwrap().finished(at(6.08));
+        let gap = clock.shown_gap(at(6.08)).unwrap();
+        assert!((gap - (0.9 * 0.02 + 0.1 * 1.0)).abs() < 1e-9, "{gap}");
     }
 
     #[test]
