@@ -25,9 +25,9 @@ fn a_mesh_against_itself_is_zero() {
     let d = &c.distance;
     // Zero up to the rounding of a sample projected back onto its own face (~1e-16).
     for s in [&d.a_to_b, &d.b_to_a] {
-        assert!(s.max_rel < 1e-12, "{s:?}");
-        assert!(s.mean_rel < 1e-12, "{s:?}");
-        assert!(s.rms_rel < 1e-12, "{s:?}");
+        assert!(s.distances.max_rel < 1e-12, "{s:?}");
+        assert!(s.distances.mean_rel < 1e-12, "{s:?}");
+        assert!(s.distances.rms_rel < 1e-12, "{s:?}");
         assert_eq!(
             s.face_samples,
             (10 * m.face_count()).max(meshslim::metrics::MIN_FACE_SAMPLES)
@@ -54,10 +54,10 @@ fn a_flat_grid_lifted_along_its_normal_is_exactly_that_far() {
     let c = compare(&a, &b, &CompareOptions::default()).unwrap();
     let diag = a.bounds().unwrap().diagonal();
     for s in [&c.distance.a_to_b, &c.distance.b_to_a] {
-        assert!(close(s.max, d as f64, 1e-12), "{s:?}");
-        assert!(close(s.mean, d as f64, 1e-12), "{s:?}");
-        assert!(close(s.rms, d as f64, 1e-12), "{s:?}");
-        assert!(close(s.max_rel, d as f64 / diag, 1e-12), "{s:?}");
+        assert!(close(s.distances.max, d as f64, 1e-12), "{s:?}");
+        assert!(close(s.distances.mean, d as f64, 1e-12), "{s:?}");
+        assert!(close(s.distances.rms, d as f64, 1e-12), "{s:?}");
+        assert!(close(s.distances.max_rel, d as f64 / diag, 1e-12), "{s:?}");
     }
     assert!(close(c.distance.two_sided.mean, d as f64, 1e-12));
     assert!(close(c.area.relative.unwrap(), 0.0, 1e-12));
@@ -82,13 +82,13 @@ fn sphere_against_inscribed_icosphere_has_the_known_gap() {
     let gap = 1.0 - r_min;
     let c = compare(&fine, &coarse, &CompareOptions::default()).unwrap();
     let ab = &c.distance.a_to_b;
-    assert!(ab.max <= gap + 1e-6, "{} > {gap}", ab.max);
+    assert!(ab.distances.max <= gap + 1e-6, "{} > {gap}", ab.distances.max);
     // The fine sphere has a vertex within ~0.02 rad of each coarse face centre's direction:
     // its distance falls short of the gap by ~θ²/2 ≈ 2e-4, 0.1% of the gap.
-    assert!(ab.max >= 0.99 * gap, "{} vs {gap}", ab.max);
-    assert!(ab.mean > 0.2 * gap && ab.mean < gap, "{} vs {gap}", ab.mean);
+    assert!(ab.distances.max >= 0.99 * gap, "{} vs {gap}", ab.distances.max);
+    assert!(ab.distances.mean > 0.2 * gap && ab.distances.mean < gap, "{} vs {gap}", ab.distances.mean);
     // Every point of B is inside the unit sphere and outside the fine sphere's inscribed ball.
-    assert!(c.distance.b_to_a.max <= gap + 1e-6);
+    assert!(c.distance.b_to_a.distances.max <= gap + 1e-6);
     assert!(c.volume.relative.unwrap() < 0.0, "B is inside A");
 }
 
@@ -104,11 +104,23 @@ fn a_small_patch_is_close_to_a_big_grid_but_not_the_other_way() {
     }
     let c = compare(&a, &b, &CompareOptions::default()).unwrap();
     let far = (2.0f64 * 0.75 * 0.75).sqrt();
-    assert!(close(c.distance.a_to_b.max, far, 1e-6), "{c:?}");
-    assert!(c.distance.a_to_b.mean > 0.3, "{:?}", c.distance.a_to_b);
-    assert!(c.distance.b_to_a.max < 1e-12, "{:?}", c.distance.b_to_a);
-    assert!(c.distance.b_to_a.mean < 1e-12, "{:?}", c.distance.b_to_a);
-    assert_eq!(c.distance.two_sided.max, c.distance.a_to_b.max);
+    assert!(close(c.distance.a_to_b.distances.max, far, 1e-6), "{c:?}");
+    assert!(
+        c.distance.a_to_b.distances.mean > 0.3,
+        "{:?}",
+        c.distance.a_to_b
+    );
+    assert!(
+        c.distance.b_to_a.distances.max < 1e-12,
+        "{:?}",
+        c.distance.b_to_a
+    );
+    assert!(
+        c.distance.b_to_a.distances.mean < 1e-12,
+        "{:?}",
+        c.distance.b_to_a
+    );
+    assert_eq!(c.distance.two_sided.max, c.distance.a_to_b.distances.max);
     assert!(close(c.area.relative.unwrap(), 0.0625 - 1.0, 1e-9));
 }
 
@@ -152,11 +164,11 @@ fn a_maximum_inside_an_edge_is_found() {
         };
         let c = compare(&a, &b, &opts).unwrap();
         let ba = &c.distance.b_to_a;
-        assert!(ba.max <= want + 1e-6, "above the true maximum: {ba:?}");
+        assert!(ba.distances.max <= want + 1e-6, "above the true maximum: {ba:?}");
         assert!(
-            ba.max >= want * (1.0 - 2e-3),
+            ba.distances.max >= want * (1.0 - 2e-3),
             "{} vs {want}: {ba:?}",
-            ba.max
+            ba.distances.max
         );
         // Without the edges the maximum is missed by far.
         let faces_only = CompareOptions {
@@ -164,7 +176,11 @@ fn a_maximum_inside_an_edge_is_found() {
             ..opts
         };
         let f = compare(&a, &b, &faces_only).unwrap();
-        assert!(f.distance.b_to_a.max < 0.71, "{:?}", f.distance.b_to_a);
+        assert!(
+            f.distance.b_to_a.distances.max < 0.71,
+            "{:?}",
+            f.distance.b_to_a
+        );
     }
 }
 
@@ -188,9 +204,15 @@ fn the_same_seed_gives_the_same_figures_and_another_seed_other_samples() {
     assert_eq!(c1, c2);
     assert_eq!(c1.distance.a_to_b.face_samples, 20_000);
     let c3 = compare(&a, &b, &CompareOptions { seed: 10, ..opts }).unwrap();
-    assert_ne!(c1.distance.a_to_b.mean, c3.distance.a_to_b.mean);
+    assert_ne!(
+        c1.distance.a_to_b.distances.mean,
+        c3.distance.a_to_b.distances.mean
+    );
     // ... but estimates of the same mean.
-    let (m1, m3) = (c1.distance.a_to_b.mean, c3.distance.a_to_b.mean);
+    let (m1, m3) = (
+        c1.distance.a_to_b.distances.mean,
+        c3.distance.a_to_b.distances.mean,
+    );
     assert!((m1 - m3).abs() < 0.02 * m1, "{m1} vs {m3}");
 }
 
@@ -213,8 +235,8 @@ fn the_figures_do_not_depend_on_the_thread_count() {
     let four = run(4);
     assert_eq!(one, four);
     assert_eq!(
-        one.distance.a_to_b.mean.to_bits(),
-        four.distance.a_to_b.mean.to_bits()
+        one.distance.a_to_b.distances.mean.to_bits(),
+        four.distance.a_to_b.distances.mean.to_bits()
     );
 }
 

@@ -315,9 +315,9 @@ pub(super) fn write_comparison(
             out,
             "  {:<10} {:>22} {:>22} {:>22}  {} + {} + {}",
             name,
-            cell(s.max, s.max_rel),
-            cell(s.mean, s.mean_rel),
-            cell(s.rms, s.rms_rel),
+            cell(s.distances.max, s.distances.max_rel),
+            cell(s.distances.mean, s.distances.mean_rel),
+            cell(s.distances.rms, s.distances.rms_rel),
             s.face_samples,
             s.vertex_samples,
             s.edge_samples

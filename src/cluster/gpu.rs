@@ -372,51 +372,16 @@ impl<'a> GpuClusterMesh<'a> {
 
     /// `(buffer, byte offset, bytes)` ranges read back through one staging buffer, one wait.
     pub(super) fn read_many(&self, ranges: &[(ClusterBuf, u64, u64)]) -> Result<Vec<Vec<u8>>> {
-        let dev = &self.sim.device;
-        let scope = ErrorScope::push(dev);
-        let out = self.read_ranges(ranges);
-        scope.check_with("reading back the clustering", out)
-    }
-
-    fn read_ranges(&self, ranges: &[(ClusterBuf, u64, u64)]) -> Result<Vec<Vec<u8>>> {
-        let dev = &self.sim.device;
-        let total: u64 = ranges.iter().map(|r| r.2.next_multiple_of(4)).sum();
-        let staging = dev.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("meshslim.cluster_download"),
-            size: total.max(4),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = dev.create_command_encoder(&Default::default());
-        let mut at = 0;
-        for &(buf, offset, bytes) in ranges {
-            let size = bytes.next_multiple_of(4);
-            if size > 0 {
-                enc.copy_buffer_to_buffer(self.buffer(buf, None), offset, &staging, at, size);
-            }
-            at += size;
-        }
-        self.sim.queue.submit([enc.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        staging.map_async(wgpu::MapMode::Read, .., move |r| {
-            let _ = tx.send(r);
-        });
-        self.wait()?;
-        rx.recv()
-            .map_err(|_| Error::Gpu("the device dropped a read-back".into()))?
-            .map_err(|e| Error::Gpu(format!("mapping a read-back buffer: {e}")))?;
-        let view = staging
-            .get_mapped_range(..)
-            .map_err(|e| Error::Gpu(format!("reading back: {e}")))?;
-        let mut out = Vec::with_capacity(ranges.len());
-        let mut at = 0usize;
-        for &(_, _, bytes) in ranges {
-            out.push(view[at..at + bytes as usize].to_vec());
-            at += bytes.next_multiple_of(4) as usize;
-        }
-        drop(view);
-        staging.unmap();
-        Ok(out)
+        let ranges: Vec<(&wgpu::Buffer, u64, u64)> = ranges
+            .iter()
+            .map(|&(buf, offset, bytes)| (self.buffer(buf, None), offset, bytes))
+            .collect();
+        crate::compute::context::read_ranges(
+            &self.sim.device,
+            &self.sim.queue,
+            &ranges,
+            "reading back the clustering",
+        )
     }
 }
 

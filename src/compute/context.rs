@@ -243,8 +243,8 @@ pub fn map_and_wait(
     (outcome, waited)
 }
 
-/// The first `bytes` of `buf` (a multiple of 4, `COPY_SRC`), copied to a staging buffer after
-/// the work already submitted and read with one wait; `doing` says what for in an error.
+/// The first `bytes` of `buf` (`COPY_SRC`), copied to a staging buffer after the work already
+/// submitted and read with one wait; `doing` says what for in an error.
 pub fn read_back(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -252,16 +252,34 @@ pub fn read_back(
     bytes: u64,
     doing: &str,
 ) -> Result<Vec<u8>> {
+    Ok(read_ranges(device, queue, &[(buf, 0, bytes)], doing)?.remove(0))
+}
+
+/// `(buffer, byte offset, bytes)` ranges (`COPY_SRC`), copied side by side into one staging
+/// buffer after the work already submitted and read with one wait: each range's bytes, in order.
+/// Each copy is rounded up to 4 bytes, as copies must be; `doing` says what for in an error.
+pub fn read_ranges(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    ranges: &[(&wgpu::Buffer, u64, u64)],
+    doing: &str,
+) -> Result<Vec<Vec<u8>>> {
     let scope = crate::compute::gpu::ErrorScope::push(device);
+    let total: u64 = ranges.iter().map(|r| r.2.next_multiple_of(4)).sum();
     let staging = checked_buffer(
         device,
         "meshslim.read_back",
-        bytes,
+        total.max(4),
         wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
     )?;
     let mut enc = device.create_command_encoder(&Default::default());
-    if bytes > 0 {
-        enc.copy_buffer_to_buffer(buf, 0, &staging, 0, bytes);
+    let mut at = 0;
+    for &(buf, offset, bytes) in ranges {
+        let size = bytes.next_multiple_of(4);
+        if size > 0 {
+            enc.copy_buffer_to_buffer(buf, offset, &staging, at, size);
+        }
+        at += size;
     }
     queue.submit([enc.finish()]);
     let read = map_and_wait(device, &staging)
@@ -271,7 +289,15 @@ pub fn read_back(
             let view = staging
                 .get_mapped_range(..)
                 .map_err(|e| Error::Gpu(format!("{doing}: {e}")))?;
-            Ok(view[..bytes as usize].to_vec())
+            let mut at = 0usize;
+            Ok(ranges
+                .iter()
+                .map(|&(_, _, bytes)| {
+                    let part = view[at..at + bytes as usize].to_vec();
+                    at += bytes.next_multiple_of(4) as usize;
+                    part
+                })
+                .collect())
         });
     scope.check_with(doing, read)
 }

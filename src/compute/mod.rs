@@ -38,23 +38,23 @@ mod tests {
     /// is the same stage of the same shader (the shared ones).
     #[test]
     fn an_entry_point_names_one_stage_across_families() {
-        let rounds = crate::rounds::schedule::STAGES
-            .iter()
-            .flat_map(|l| l.iter())
-            .map(|s| (s.entry, s.shader));
-        let cluster = crate::cluster::gpu_schedule::STAGES
-            .iter()
-            .flat_map(|l| l.iter())
-            .map(|s| (s.entry, s.shader));
-        let prepare = crate::rounds::prepare::STAGES
-            .iter()
-            .flat_map(|l| l.iter())
-            .map(|s| (s.entry, s.shader));
-        let dag = crate::dag::schedule::STAGES
-            .iter()
-            .flat_map(|l| l.iter())
-            .map(|s| (s.entry, s.shader));
-        let all: Vec<(&str, &str)> = rounds.chain(cluster).chain(prepare).chain(dag).collect();
+        // Each family's stages are of its own buffer type, so a macro rather than a function.
+        macro_rules! entries {
+            ($($stages:path),*) => {
+                [$($stages
+                    .iter()
+                    .flat_map(|l| l.iter())
+                    .map(|s| (s.entry, s.shader))
+                    .collect::<Vec<(&str, &str)>>()),*]
+                .concat()
+            };
+        }
+        let all = entries!(
+            crate::rounds::schedule::STAGES,
+            crate::cluster::gpu_schedule::STAGES,
+            crate::rounds::prepare::STAGES,
+            crate::dag::schedule::STAGES
+        );
         for (i, (entry, shader)) in all.iter().enumerate() {
             for (e2, s2) in &all[..i] {
                 assert!(

@@ -7,7 +7,7 @@ use super::meshlets::{Limits, split};
 use super::{Cluster, Dag, Group, NONE, round_up, sphere_around, sphere_of_points};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::mesh::weld::bits;
+use crate::mesh::weld::{bits, vertex_bits};
 use crate::options::{AttributeWeights, Backend, Cancel, SimplifyOptions};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
@@ -396,12 +396,19 @@ impl Builder {
         mesh.triangles
             .retain(|t| c(t[0]) != c(t[1]) && c(t[1]) != c(t[2]) && c(t[0]) != c(t[2]));
         let parts = split(&mesh.triangles, &mesh.positions, &class, self.limits);
-        let mut by_bits: FxHashMap<[u32; 9], u32> = FxHashMap::default();
+        // Not the normal: a pinned vertex keeps its place and appearance but gets a normal made
+        // again.
+        let mut by_bits: FxHashMap<[u32; 12], u32> = FxHashMap::default();
         for &g in ids {
-            by_bits.insert(vertex_bits(&self.store.mesh, g as usize), g);
+            by_bits.insert(vertex_bits(&self.store.mesh, g as usize, false), g);
         }
         let known = (0..mesh.positions.len())
-            .map(|v| by_bits.get(&vertex_bits(&mesh, v)).copied().unwrap_or(NONE))
+            .map(|v| {
+                by_bits
+                    .get(&vertex_bits(&mesh, v, false))
+                    .copied()
+                    .unwrap_or(NONE)
+            })
             .collect();
         Simplified {
             mesh,
@@ -631,25 +638,6 @@ fn submesh(m: &Mesh, ids: &[u32], tris: Vec<[u32; 3]>) -> Mesh {
         groups: Vec::new(),
         ..m.clone_without_geometry()
     }
-}
-
-/// Vertex `v` of `m` as bits: position, UV, colour (zero where absent). Not the normal: a
-/// pinned vertex keeps its place and appearance but gets a normal made again.
-fn vertex_bits(m: &Mesh, v: usize) -> [u32; 9] {
-    let mut key = [0u32; 9];
-    let mut put = |at: usize, xs: &[f32]| {
-        for (i, &x) in xs.iter().enumerate() {
-            key[at + i] = bits(x);
-        }
-    };
-    put(0, &m.positions[v]);
-    if let Some(t) = &m.uvs {
-        put(3, &t[v]);
-    }
-    if let Some(c) = &m.colors {
-        put(5, &c[v]);
-    }
-    key
 }
 
 /// Per vertex: a class id shared by the vertices at its position.

@@ -3,7 +3,7 @@
 //! anything back.
 
 use super::schedule::{self as sched, DagBuf, DagGrid};
-use crate::compute::context::{checked_buffer, checked_buffer_write, read_back};
+use crate::compute::context::{checked_buffer, checked_buffer_write, read_ranges};
 use crate::compute::gpu::{ErrorScope, Groups, Kernels, Pipelines, Runner, record};
 use crate::compute::types::{CornerDraw, CutCluster, CutParams, WG};
 use crate::error::{Error, Result};
@@ -106,20 +106,13 @@ impl GpuCut {
         self.queue.submit([enc.finish()]);
         scope.check("cutting the DAG")?;
         let bytes = self.clusters as u64 * std::mem::size_of::<CornerDraw>() as u64;
-        let draws = read_back(
+        let read = read_ranges(
             &self.device,
             &self.queue,
-            &self.draws,
-            bytes,
+            &[(&self.draws, 0, bytes), (&self.counts, 0, 16)],
             "reading the cut",
         )?;
-        let counts = read_back(
-            &self.device,
-            &self.queue,
-            &self.counts,
-            16,
-            "reading the cut",
-        )?;
+        let [draws, counts]: [Vec<u8>; 2] = read.try_into().expect("one part per range");
         Ok((
             bytemuck::pod_collect_to_vec(&draws),
             bytemuck::pod_read_unaligned(&counts),

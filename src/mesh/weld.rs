@@ -152,29 +152,32 @@ fn apply(mesh: &Mesh, remap: Vec<u32>, firsts: &[u32]) -> WeldResult {
     WeldResult { mesh: out, remap }
 }
 
+/// Vertex `v`'s channels as bits: position, normal (with `with_normal`), UV and colour; an absent
+/// channel (or the normal left out) is zero on every vertex, so equal keys mean the same vertex.
+pub(crate) fn vertex_bits(mesh: &Mesh, v: usize, with_normal: bool) -> [u32; 12] {
+    let mut k = [0u32; 12];
+    let mut put = |at: usize, xs: &[f32]| {
+        for (i, &x) in xs.iter().enumerate() {
+            k[at + i] = bits(x);
+        }
+    };
+    put(0, &mesh.positions[v]);
+    if let Some(n) = mesh.normals.as_ref().filter(|_| with_normal) {
+        put(3, &n[v]);
+    }
+    if let Some(t) = &mesh.uvs {
+        put(6, &t[v]);
+    }
+    if let Some(c) = &mesh.colors {
+        put(8, &c[v]);
+    }
+    k
+}
+
 /// Merges vertices with identical position and attributes; faces are kept (even ones that become
 /// degenerate, which the topology report then counts).
 pub fn weld(mesh: &Mesh) -> WeldResult {
-    // Position, normal, UV and colour bits; an absent channel is zero on every vertex.
-    let key = |v: usize| {
-        let mut k = [0u32; 12];
-        let mut put = |at: usize, xs: &[f32]| {
-            for (i, &x) in xs.iter().enumerate() {
-                k[at + i] = bits(x);
-            }
-        };
-        put(0, &mesh.positions[v]);
-        if let Some(n) = &mesh.normals {
-            put(3, &n[v]);
-        }
-        if let Some(t) = &mesh.uvs {
-            put(6, &t[v]);
-        }
-        if let Some(c) = &mesh.colors {
-            put(8, &c[v]);
-        }
-        k
-    };
+    let key = |v: usize| vertex_bits(mesh, v, true);
     if mesh.normals.is_none() && mesh.uvs.is_none() && mesh.colors.is_none() {
         return weld_positions(mesh);
     }

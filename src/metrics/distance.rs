@@ -11,11 +11,12 @@ use glam::DVec3;
 /// the number of threads, and the partial sums are added in task order.
 const CHUNK: usize = 8192;
 
-/// Distances from the samples of one mesh to the other mesh's surface.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct DirectionStats {
+/// Largest, mean and root-mean-square distance, and the three relative to A's diagonal: of one
+/// direction ([`DirectionStats`]) or of both combined (`Distance::two_sided`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Distances {
     /// Largest distance over every sample (faces, vertices, edges): the one-sided Hausdorff
-    /// distance.
+    /// distance (both directions: the Hausdorff distance).
     pub max: f64,
     /// Mean over the area-uniform face samples: an estimate of the mean distance over the surface.
     pub mean: f64,
@@ -25,6 +26,29 @@ pub struct DirectionStats {
     pub max_rel: f64,
     pub mean_rel: f64,
     pub rms_rel: f64,
+}
+
+impl Distances {
+    /// The three figures, and each relative to `diagonal` (0 for a diagonal of 0).
+    pub fn new(max: f64, mean: f64, rms: f64, diagonal: f64) -> Distances {
+        let rel = |v: f64| if diagonal > 0.0 { v / diagonal } else { 0.0 };
+        Distances {
+            max,
+            mean,
+            rms,
+            max_rel: rel(max),
+            mean_rel: rel(mean),
+            rms_rel: rel(rms),
+        }
+    }
+}
+
+/// Distances from the samples of one mesh to the other mesh's surface.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DirectionStats {
+    /// The distances; flattened, so that the JSON keys stand beside the sample counts.
+    #[serde(flatten)]
+    pub distances: Distances,
     /// Points sampled uniformly by area on the faces.
     pub face_samples: usize,
     /// Vertices used by a face, each measured once.
@@ -370,12 +394,7 @@ pub(crate) fn one_direction(
     };
     let rel = |v: f64| if diagonal > 0.0 { v / diagonal } else { 0.0 };
     DirectionStats {
-        max,
-        mean,
-        rms,
-        max_rel: rel(max),
-        mean_rel: rel(mean),
-        rms_rel: rel(rms),
+        distances: Distances::new(max, mean, rms, diagonal),
         face_samples: faces.n,
         vertex_samples: verts.n,
         edge_samples: edges.n,

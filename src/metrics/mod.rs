@@ -27,7 +27,7 @@ mod distance;
 pub use appearance::{Appearance, AttributeStats, Texture};
 pub(crate) use appearance::{mix, weights_at};
 pub use bvh::{Hit, TriangleBvh, point_triangle_dist2};
-pub use distance::DirectionStats;
+pub use distance::{DirectionStats, Distances};
 
 use serde::Serialize;
 
@@ -98,18 +98,7 @@ pub struct Distance {
     /// plain average of the two directions' means, (mean(A→B) + mean(B→A)) / 2, not weighted by
     /// sample counts; `rms` is sqrt((rms(A→B)² + rms(B→A)²) / 2). MeshLab's filter reports each
     /// direction separately; this is how `benches/meshlab_compare.py` combines them.
-    pub two_sided: TwoSided,
-}
-
-/// The two directions combined (see [`Distance::two_sided`]).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct TwoSided {
-    pub max: f64,
-    pub mean: f64,
-    pub rms: f64,
-    pub max_rel: f64,
-    pub mean_rel: f64,
-    pub rms_rel: f64,
+    pub two_sided: Distances,
 }
 
 /// A measure of A and of B, and B's change relative to A.
@@ -359,18 +348,13 @@ pub fn compare(a: &Mesh, b: &Mesh, opts: &CompareOptions) -> Result<Comparison> 
             (distance, look)
         },
     );
-    let rel = |v: f64| if diagonal > 0.0 { v / diagonal } else { 0.0 };
-    let max = a_to_b.max.max(b_to_a.max);
-    let mean = 0.5 * (a_to_b.mean + b_to_a.mean);
-    let rms = (0.5 * (a_to_b.rms * a_to_b.rms + b_to_a.rms * b_to_a.rms)).sqrt();
-    let two_sided = TwoSided {
-        max,
-        mean,
-        rms,
-        max_rel: rel(max),
-        mean_rel: rel(mean),
-        rms_rel: rel(rms),
-    };
+    let (ab, ba) = (&a_to_b.distances, &b_to_a.distances);
+    let two_sided = Distances::new(
+        ab.max.max(ba.max),
+        0.5 * (ab.mean + ba.mean),
+        (0.5 * (ab.rms * ab.rms + ba.rms * ba.rms)).sqrt(),
+        diagonal,
+    );
     let (ca, cb) = (TopologyCounts::of(&ta), TopologyCounts::of(&tb));
     Ok(Comparison {
         faces_a: a.face_count(),
@@ -450,7 +434,7 @@ impl<'a> MeanDistance<'a> {
             // A surface of no area: its mean comes from vertex and edge samples.
             return Ok(compare(self.a, b, &self.opts)?.distance.two_sided.mean_rel);
         }
-        let mean = 0.5 * (ab.mean + ba.mean);
+        let mean = 0.5 * (ab.distances.mean + ba.distances.mean);
         Ok(if self.diagonal > 0.0 {
             mean / self.diagonal
         } else {

@@ -327,15 +327,8 @@ impl Target {
             },
         );
         queue.submit([enc.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        readback.map_async(wgpu::MapMode::Read, .., move |r| {
-            let _ = tx.send(r);
-        });
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| Error::Gpu(format!("waiting for the frame: {e}")))?;
-        rx.recv()
-            .map_err(|_| Error::Gpu("the device dropped the frame".into()))?
+        crate::compute::context::map_and_wait(device, &readback)
+            .0
             .map_err(|e| Error::Gpu(format!("reading the frame: {e}")))?;
         let view = readback
             .get_mapped_range(..)
