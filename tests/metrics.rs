@@ -82,11 +82,23 @@ fn sphere_against_inscribed_icosphere_has_the_known_gap() {
     let gap = 1.0 - r_min;
     let c = compare(&fine, &coarse, &CompareOptions::default()).unwrap();
     let ab = &c.distance.a_to_b;
-    assert!(ab.distances.max <= gap + 1e-6, "{} > {gap}", ab.distances.max);
+    assert!(
+        ab.distances.max <= gap + 1e-6,
+        "{} > {gap}",
+        ab.distances.max
+    );
     // The fine sphere has a vertex within ~0.02 rad of each coarse face centre's direction:
     // its distance falls short of the gap by ~θ²/2 ≈ 2e-4, 0.1% of the gap.
-    assert!(ab.distances.max >= 0.99 * gap, "{} vs {gap}", ab.distances.max);
-    assert!(ab.distances.mean > 0.2 * gap && ab.distances.mean < gap, "{} vs {gap}", ab.distances.mean);
+    assert!(
+        ab.distances.max >= 0.99 * gap,
+        "{} vs {gap}",
+        ab.distances.max
+    );
+    assert!(
+        ab.distances.mean > 0.2 * gap && ab.distances.mean < gap,
+        "{} vs {gap}",
+        ab.distances.mean
+    );
     // Every point of B is inside the unit sphere and outside the fine sphere's inscribed ball.
     assert!(c.distance.b_to_a.distances.max <= gap + 1e-6);
     assert!(c.volume.relative.unwrap() < 0.0, "B is inside A");
@@ -164,7 +176,10 @@ fn a_maximum_inside_an_edge_is_found() {
         };
         let c = compare(&a, &b, &opts).unwrap();
         let ba = &c.distance.b_to_a;
-        assert!(ba.distances.max <= want + 1e-6, "above the true maximum: {ba:?}");
+        assert!(
+            ba.distances.max <= want + 1e-6,
+            "above the true maximum: {ba:?}"
+        );
         assert!(
             ba.distances.max >= want * (1.0 - 2e-3),
             "{} vs {want}: {ba:?}",

@@ -213,16 +213,31 @@ impl Kernels {
         self.max_workgroups
     }
 
-    /// The bind group of `stage` on the buffers `bind` gives, to record passes with
-    /// ([`Kernels::pass_bound`]) as long as those buffers live: a family that keeps its
-    /// buffers makes each once, not once a pass.
+    /// The bind group of `stage` on the buffers `bind` gives (each binding's buffer, in binding
+    /// order, on the layout of its pipeline), to record passes with ([`Kernels::pass_bound`]) as
+    /// long as those buffers live: a family that keeps its buffers makes each once, not once a
+    /// pass.
     pub fn bind_group<'b, B: Copy, G>(
         &self,
         device: &wgpu::Device,
         stage: &Stage<B, G>,
         bind: impl Fn(B) -> &'b wgpu::Buffer,
     ) -> wgpu::BindGroup {
-        bind_group(device, &self.pipelines, stage, bind)
+        let layout = self.pipelines[stage.entry].get_bind_group_layout(0);
+        let entries: Vec<wgpu::BindGroupEntry> = stage
+            .bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: bind(b.buf).as_entire_binding(),
+            })
+            .collect();
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(stage.entry),
+            layout: &layout,
+            entries: &entries,
+        })
     }
 
     /// One compute pass of `stage` with a bind group made by [`Kernels::bind_group`].
@@ -235,21 +250,19 @@ impl Kernels {
         indirect: Option<&wgpu::Buffer>,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
-        dispatch(
-            enc,
-            &self.pipelines,
-            stage,
-            bg,
-            groups,
-            self.max_workgroups,
-            indirect,
-            timestamps,
-        )
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(stage.entry),
+            timestamp_writes: timestamps,
+        });
+        self.dispatch_in(&mut pass, stage, bg, groups, indirect)
     }
 
     /// One dispatch of `stage` into an open compute pass, with a bind group made by
-    /// [`Kernels::bind_group`]: a family that records many dispatches back to back puts them
-    /// in one pass, since wgpu encodes each pass into command buffers of its own.
+    /// [`Kernels::bind_group`], over `groups` (a direct count beyond the device's
+    /// `max_compute_workgroups_per_dimension` is split over y; the shader folds y back into
+    /// its index); `indirect` holds the arguments of an indirect grid. A family that records
+    /// many dispatches back to back puts them in one pass, since wgpu encodes each pass into
+    /// command buffers of its own.
     pub fn dispatch_in<B, G>(
         &self,
         pass: &mut wgpu::ComputePass,
@@ -258,18 +271,30 @@ impl Kernels {
         groups: Groups,
         indirect: Option<&wgpu::Buffer>,
     ) {
-        dispatch_in(
-            pass,
-            &self.pipelines,
-            stage,
-            bg,
-            groups,
-            self.max_workgroups,
-            indirect,
-        )
+        let (label, pipeline) = (stage.entry, &self.pipelines[stage.entry]);
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bg, &[]);
+        match (groups, indirect) {
+            (Groups::Indirect(offset), Some(args)) => {
+                pass.dispatch_workgroups_indirect(args, offset)
+            }
+            (Groups::Indirect(_), None) => {
+                unreachable!("{label}: an indirect grid without its arguments buffer")
+            }
+            (Groups::Direct(groups), _) => {
+                let (groups, max_x) = (groups.max(1), self.max_workgroups);
+                let (x, y) = if groups <= max_x {
+                    (groups, 1)
+                } else {
+                    (max_x, groups.div_ceil(max_x))
+                };
+                pass.dispatch_workgroups(x, y, 1);
+            }
+        }
     }
 
-    /// One compute pass of `stage` into `enc`: see [`pass`].
+    /// One compute pass of `stage` into `enc` on a bind group made for it from `bind` (see
+    /// [`Kernels::bind_group`] and [`Kernels::dispatch_in`]), with `timestamps` when given.
     #[allow(clippy::too_many_arguments)]
     pub fn pass<'b, B: Copy, G>(
         &self,
@@ -281,17 +306,8 @@ impl Kernels {
         indirect: Option<&wgpu::Buffer>,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
-        pass(
-            device,
-            enc,
-            &self.pipelines,
-            stage,
-            bind,
-            groups,
-            self.max_workgroups,
-            indirect,
-            timestamps,
-        )
+        let bg = self.bind_group(device, stage, bind);
+        self.pass_bound(enc, stage, &bg, groups, indirect, timestamps)
     }
 }
 
@@ -394,102 +410,6 @@ pub fn record<B: Copy + 'static, G: 'static, C: Copy, X: Copy>(
                 }
             }
             Step::Own(x) => runner.own(enc, x),
-        }
-    }
-}
-
-/// The bind group of `stage`: each binding's buffer from `bind`, in binding order, on the layout
-/// of its pipeline in `pipelines`.
-fn bind_group<'b, B: Copy, G>(
-    device: &wgpu::Device,
-    pipelines: &HashMap<&'static str, wgpu::ComputePipeline>,
-    stage: &Stage<B, G>,
-    bind: impl Fn(B) -> &'b wgpu::Buffer,
-) -> wgpu::BindGroup {
-    let layout = pipelines[stage.entry].get_bind_group_layout(0);
-    let entries: Vec<wgpu::BindGroupEntry> = stage
-        .bindings
-        .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry {
-            binding: i as u32,
-            resource: bind(b.buf).as_entire_binding(),
-        })
-        .collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some(stage.entry),
-        layout: &layout,
-        entries: &entries,
-    })
-}
-
-/// One compute pass of `stage`: its pipeline from `pipelines`, each binding's buffer from
-/// `bind` in binding order, over `groups` (a direct count beyond `max_x` is split over y; the
-/// shader folds y back into its index), with `timestamps` when given; `indirect` holds the
-/// arguments of an indirect grid.
-#[allow(clippy::too_many_arguments)]
-fn pass<'b, B: Copy, G>(
-    device: &wgpu::Device,
-    enc: &mut wgpu::CommandEncoder,
-    pipelines: &HashMap<&'static str, wgpu::ComputePipeline>,
-    stage: &Stage<B, G>,
-    bind: impl Fn(B) -> &'b wgpu::Buffer,
-    groups: Groups,
-    max_x: u32,
-    indirect: Option<&wgpu::Buffer>,
-    timestamps: Option<wgpu::ComputePassTimestampWrites>,
-) {
-    let bg = bind_group(device, pipelines, stage, bind);
-    dispatch(
-        enc, pipelines, stage, &bg, groups, max_x, indirect, timestamps,
-    )
-}
-
-/// One compute pass of `stage` with its bind group `bg` (see [`pass`]).
-#[allow(clippy::too_many_arguments)]
-fn dispatch<B, G>(
-    enc: &mut wgpu::CommandEncoder,
-    pipelines: &HashMap<&'static str, wgpu::ComputePipeline>,
-    stage: &Stage<B, G>,
-    bg: &wgpu::BindGroup,
-    groups: Groups,
-    max_x: u32,
-    indirect: Option<&wgpu::Buffer>,
-    timestamps: Option<wgpu::ComputePassTimestampWrites>,
-) {
-    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-        label: Some(stage.entry),
-        timestamp_writes: timestamps,
-    });
-    dispatch_in(&mut pass, pipelines, stage, bg, groups, max_x, indirect)
-}
-
-/// One dispatch of `stage` into an open compute pass (see [`pass`]).
-fn dispatch_in<B, G>(
-    pass: &mut wgpu::ComputePass,
-    pipelines: &HashMap<&'static str, wgpu::ComputePipeline>,
-    stage: &Stage<B, G>,
-    bg: &wgpu::BindGroup,
-    groups: Groups,
-    max_x: u32,
-    indirect: Option<&wgpu::Buffer>,
-) {
-    let (label, pipeline) = (stage.entry, &pipelines[stage.entry]);
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, bg, &[]);
-    match (groups, indirect) {
-        (Groups::Indirect(offset), Some(args)) => pass.dispatch_workgroups_indirect(args, offset),
-        (Groups::Indirect(_), None) => {
-            unreachable!("{label}: an indirect grid without its arguments buffer")
-        }
-        (Groups::Direct(groups), _) => {
-            let groups = groups.max(1);
-            let (x, y) = if groups <= max_x {
-                (groups, 1)
-            } else {
-                (max_x, groups.div_ceil(max_x))
-            };
-            pass.dispatch_workgroups(x, y, 1);
         }
     }
 }

@@ -6,6 +6,7 @@ use super::triangulate::{fan_from, split_loop};
 use crate::greedy::prepare::Prepared;
 use crate::greedy::state::VertFaces;
 use crate::greedy::triangle_quality;
+use crate::metrics::closest_on_triangle;
 use crate::options::Removal;
 use crate::quadric::Quadric;
 use crate::quadric::attributes::{MAX_CHANNELS, hold};
@@ -406,7 +407,8 @@ impl Engine {
         let mut best = (f64::INFINITY, p, [(u32::MAX, 0.0); 3]);
         for &(t, ..) in &self.new_faces {
             let [a, b, c] = t.map(|x| self.at(x));
-            let (q, w) = closest_on_triangle(p, a, b, c);
+            // A degenerate triangle the region tests let through counts as its first corner.
+            let (q, w) = closest_on_triangle(p, a, b, c).unwrap_or((a, [1.0, 0.0, 0.0]));
             let d = (q - p).length_squared();
             if d < best.0 {
                 best = (d, q, [(t[0], w[0]), (t[1], w[1]), (t[2], w[2])]);
@@ -695,47 +697,6 @@ impl Engine {
     pub fn loop_vertices(&self) -> &[u32] {
         &self.fan.x
     }
-}
-
-/// The point of triangle `abc` nearest `p` and its barycentric coordinates (Ericson,
-/// "Real-Time Collision Detection", 5.1.5).
-fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVec3, [f64; 3]) {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return (a, [1.0, 0.0, 0.0]);
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return (b, [0.0, 1.0, 0.0]);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let t = d1 / (d1 - d3);
-        return (a + ab * t, [1.0 - t, t, 0.0]);
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return (c, [0.0, 0.0, 1.0]);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let t = d2 / (d2 - d6);
-        return (a + ac * t, [1.0 - t, 0.0, t]);
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (b + (c - b) * t, [0.0, 1.0 - t, t]);
-    }
-    let denom = va + vb + vc;
-    if denom == 0.0 {
-        return (a, [1.0, 0.0, 0.0]);
-    }
-    let (v, w) = (vb / denom, vc / denom);
-    (a + ab * v + ac * w, [1.0 - v - w, v, w])
 }
 
 /// A quadric's error as an RMS distance.

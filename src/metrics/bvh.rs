@@ -102,7 +102,7 @@ impl TriangleBvh {
         let hit = self.closest(p.to_array(), hint)?;
         let t = self.tris[self.slot_of_face[hit.face as usize] as usize]
             .map(|v| Vec3::from_array(v).as_dvec3());
-        Some((closest_on_triangle(p, t[0], t[1], t[2]), hit))
+        Some((nearest_on_triangle(p, t[0], t[1], t[2]), hit))
     }
 
     /// The face closest to `p` and its squared distance; `None` for an index without faces.
@@ -298,58 +298,71 @@ const BOX_SLACK: f32 = 1.0 - 1e-5;
 pub fn point_triangle_dist2(p: [f64; 3], t: &[[f32; 3]; 3]) -> f64 {
     let [a, b, c] = t.map(|v| Vec3::from_array(v).as_dvec3());
     let p = DVec3::from_array(p);
-    p.distance_squared(closest_on_triangle(p, a, b, c))
+    p.distance_squared(nearest_on_triangle(p, a, b, c))
 }
 
-fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
-    let ab = b - a;
-    let ac = c - a;
-    let ap = p - a;
-    let d1 = ab.dot(ap);
-    let d2 = ac.dot(ap);
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = p - b;
-    let d3 = ab.dot(bp);
-    let d4 = ac.dot(bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + (b - a) * (d1 / (d1 - d3));
-    }
-    let cp = p - c;
-    let d5 = ab.dot(cp);
-    let d6 = ac.dot(cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + (c - a) * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = va + vb + vc;
-    if denom.abs() < f64::MIN_POSITIVE || !denom.is_finite() {
-        // A degenerate triangle that slipped through the region tests (collinear corners with
-        // p off the line): the nearest of its three edges.
-        return [
+/// The point of triangle `abc` nearest `p`; a degenerate triangle's is the nearest point of its
+/// three edges.
+fn nearest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    match closest_on_triangle(p, a, b, c) {
+        Some((q, _)) => q,
+        None => [
             seg_closest(p, a, b),
             seg_closest(p, b, c),
             seg_closest(p, a, c),
         ]
         .into_iter()
         .min_by(|x, y| p.distance_squared(*x).total_cmp(&p.distance_squared(*y)))
-        .unwrap_or(a);
+        .unwrap_or(a),
     }
-    let v = vb / denom;
-    let w = vc / denom;
-    a + ab * v + ac * w
+}
+
+/// The point of triangle `abc` nearest `p` and its barycentric coordinates, by the Voronoi
+/// regions of its vertices, edges and face (Ericson, "Real-Time Collision Detection", 5.1.5);
+/// `None` for a degenerate triangle the region tests let through (collinear corners with `p`
+/// off their line), which each caller settles in its own way.
+pub(crate) fn closest_on_triangle(
+    p: DVec3,
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+) -> Option<(DVec3, [f64; 3])> {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return Some((a, [1.0, 0.0, 0.0]));
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return Some((b, [0.0, 1.0, 0.0]));
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let t = d1 / (d1 - d3);
+        return Some((a + ab * t, [1.0 - t, t, 0.0]));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return Some((c, [0.0, 0.0, 1.0]));
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let t = d2 / (d2 - d6);
+        return Some((a + ac * t, [1.0 - t, 0.0, t]));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return Some((b + (c - b) * t, [0.0, 1.0 - t, t]));
+    }
+    let denom = va + vb + vc;
+    if denom.abs() < f64::MIN_POSITIVE || !denom.is_finite() {
+        return None;
+    }
+    let (v, w) = (vb / denom, vc / denom);
+    Some((a + ab * v + ac * w, [1.0 - v - w, v, w]))
 }
 
 fn seg_closest(p: DVec3, a: DVec3, b: DVec3) -> DVec3 {

@@ -26,6 +26,7 @@ mod distance;
 
 pub use appearance::{Appearance, AttributeStats, Texture};
 pub(crate) use appearance::{mix, weights_at};
+pub(crate) use bvh::closest_on_triangle;
 pub use bvh::{Hit, TriangleBvh, point_triangle_dist2};
 pub use distance::{DirectionStats, Distances};
 
