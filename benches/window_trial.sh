@@ -36,7 +36,12 @@ echo "orbit: $(echo "$(date +%s.%N) - $start" | bc) s, distinct pictures in 8 sc
 sleep 1
 shot 3-after-orbit
 # The pixel threshold: the panel's "error (pixels)" slider dragged from 1 px to its end, 16 px.
-xdotool mousemove 72 483 mousedown 1 mousemove 130 483 mousemove 200 483 mouseup 1
+# The window draws on input only, so the drag is spread over several frames (one burst of
+# events is one frame, in which egui sees the press and the release but no drag).
+xdotool mousemove 72 485 mousedown 1
+for x in 90 110 130 150 170 190 200; do sleep 0.1; xdotool mousemove "$x" 485; done
+sleep 0.1
+xdotool mouseup 1
 sleep 1
 shot 4-sixteen-pixels
 # Key 7 colours the cut by cluster (the window takes the keyboard first: Xvfb has no window

@@ -368,7 +368,7 @@ impl ViewerApp {
             Done::Dag(Ok(built)) => {
                 let (d, dag) = *built;
                 self.status = format!(
-                    "{label}: {} clusters, {} levels in {secs:.1} s",
+                    "{label}: done, {} clusters, {} levels in {secs:.1} s",
                     dag.clusters.len(),
                     dag.levels()
                 );
