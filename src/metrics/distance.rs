@@ -41,6 +41,17 @@ impl Distances {
             rms_rel: rel(rms),
         }
     }
+
+    /// Both directions combined: the larger maximum (the Hausdorff distance), the plain
+    /// average of the two means, and sqrt((rms(A→B)² + rms(B→A)²) / 2).
+    pub fn two_sided(ab: &Distances, ba: &Distances, diagonal: f64) -> Distances {
+        Distances::new(
+            ab.max.max(ba.max),
+            0.5 * (ab.mean + ba.mean),
+            (0.5 * (ab.rms * ab.rms + ba.rms * ba.rms)).sqrt(),
+            diagonal,
+        )
+    }
 }
 
 /// Distances from the samples of one mesh to the other mesh's surface.

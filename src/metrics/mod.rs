@@ -349,13 +349,7 @@ pub fn compare(a: &Mesh, b: &Mesh, opts: &CompareOptions) -> Result<Comparison> 
             (distance, look)
         },
     );
-    let (ab, ba) = (&a_to_b.distances, &b_to_a.distances);
-    let two_sided = Distances::new(
-        ab.max.max(ba.max),
-        0.5 * (ab.mean + ba.mean),
-        (0.5 * (ab.rms * ab.rms + ba.rms * ba.rms)).sqrt(),
-        diagonal,
-    );
+    let two_sided = Distances::two_sided(&a_to_b.distances, &b_to_a.distances, diagonal);
     let (ca, cb) = (TopologyCounts::of(&ta), TopologyCounts::of(&tb));
     Ok(Comparison {
         faces_a: a.face_count(),
@@ -435,12 +429,7 @@ impl<'a> MeanDistance<'a> {
             // A surface of no area: its mean comes from vertex and edge samples.
             return Ok(compare(self.a, b, &self.opts)?.distance.two_sided.mean_rel);
         }
-        let mean = 0.5 * (ab.distances.mean + ba.distances.mean);
-        Ok(if self.diagonal > 0.0 {
-            mean / self.diagonal
-        } else {
-            0.0
-        })
+        Ok(Distances::two_sided(&ab.distances, &ba.distances, self.diagonal).mean_rel)
     }
 }
 

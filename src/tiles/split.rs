@@ -368,8 +368,8 @@ struct Parts<'d> {
 impl Drop for Parts<'_> {
     fn drop(&mut self) {
         for i in 0..self.tiles {
-            for ext in ["faces.part", "ids.part"] {
-                let _ = std::fs::remove_file(self.dir.join(format!("tile-{i:04}.{ext}")));
+            for ext in [".faces.part", ".ids.part"] {
+                let _ = std::fs::remove_file(self.dir.join(part_name(i, ext)));
             }
         }
     }

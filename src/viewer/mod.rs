@@ -107,6 +107,22 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
     // Every piece of device work below (uploads, the simplification, the texture, the draw) is
     // caught here and becomes an error, not a panic in wgpu's default handler.
     let scope = crate::compute::gpu::ErrorScope::push(&ctx.device);
+    // The window's first view of the model, for each pane's shape.
+    let pane = if side_by_side {
+        ((size.0 / 2).max(1), size.1)
+    } else {
+        size
+    };
+    let cam = model.home_camera(pane);
+    if let Some((dag, pixels)) = dag {
+        // A DAG draws its own cut: the input mesh is not uploaded (the command line takes
+        // neither --ratio nor --side-by-side with one).
+        let mut renderer = shot_renderer(ctx, model, &style)?;
+        let view = (&cam, size, pixels, frames);
+        let frame = shoot_dag(ctx, &mut renderer, model, dag, view, &mut style)?;
+        scope.check("rendering the frame")?;
+        return Ok(frame);
+    }
     let simplified = match ratio < 1.0 {
         true => Some(simplify_for_shot(ctx, sim, model, ratio, method)?),
         false => None,
@@ -121,71 +137,56 @@ pub fn shoot(model: &Model, shot: Shot) -> Result<Frame> {
     };
     style.error_scale = scene.max_error;
     let mut renderer = shot_renderer(ctx, model, &style)?;
-    // The window's first view of the model, for each pane's shape.
-    let pane = if side_by_side {
-        ((size.0 / 2).max(1), size.1)
-    } else {
-        size
+    let mut draw = |mesh: &render::SceneMesh, size| {
+        let items = [(mesh, cam.model)];
+        render::render_rgba(
+            &ctx.device,
+            &ctx.queue,
+            &mut renderer,
+            &items,
+            &cam,
+            &style,
+            size,
+        )
     };
-    let cam = model.home_camera(pane);
-    let frame = match dag {
-        Some((dag, pixels)) => {
-            let view = (&cam, size, pixels, frames);
-            shoot_dag(ctx, &mut renderer, model, dag, view, &mut style)?
+    let (rgba, size) = if side_by_side {
+        let left = draw(original.as_ref().expect("made above"), pane)?;
+        // The right pane's width takes the odd pixel.
+        let right_pane = (size.0 - pane.0, size.1);
+        let right = draw(scene, right_pane)?;
+        views::side_by_side(
+            vec![(left, pane), (right, right_pane)],
+            &views::pane_labels(simplified.is_some()),
+        )?
+    } else {
+        (draw(scene, size)?, size)
+    };
+    // The frames timed after the picture, as a DAG's are (side by side draws two
+    // panes: not one frame of the window's).
+    let frame_seconds = match frames > 0 && !side_by_side {
+        true => {
+            let target = render::Target::new(&ctx.device, size)?;
+            let view = (&cam, &style);
+            dag::time_frames(
+                ctx,
+                &mut renderer,
+                &target,
+                view,
+                scene,
+                frames,
+                &mut |_| {},
+            )?
         }
-        None => {
-            let mut draw = |mesh: &render::SceneMesh, size| {
-                let items = [(mesh, cam.model)];
-                render::render_rgba(
-                    &ctx.device,
-                    &ctx.queue,
-                    &mut renderer,
-                    &items,
-                    &cam,
-                    &style,
-                    size,
-                )
-            };
-            let (rgba, size) = if side_by_side {
-                let left = draw(original.as_ref().expect("made above"), pane)?;
-                // The right pane's width takes the odd pixel.
-                let right_pane = (size.0 - pane.0, size.1);
-                let right = draw(scene, right_pane)?;
-                views::side_by_side(
-                    vec![(left, pane), (right, right_pane)],
-                    &views::pane_labels(simplified.is_some()),
-                )?
-            } else {
-                (draw(scene, size)?, size)
-            };
-            // The frames timed after the picture, as a DAG's are (side by side draws two
-            // panes: not one frame of the window's).
-            let frame_seconds = match frames > 0 && !side_by_side {
-                true => {
-                    let target = render::Target::new(&ctx.device, size)?;
-                    let view = (&cam, &style);
-                    dag::time_frames(
-                        ctx,
-                        &mut renderer,
-                        &target,
-                        view,
-                        scene,
-                        frames,
-                        &mut |_| {},
-                    )?
-                }
-                false => Vec::new(),
-            };
-            Frame {
-                adapter: ctx.adapter_name.clone(),
-                faces,
-                max_error: scene.max_error as f64,
-                png: encode_png(&rgba, size)?,
-                frame_seconds,
-                triangles_drawn: faces,
-                clusters_drawn: None,
-            }
-        }
+        false => Vec::new(),
+    };
+    let frame = Frame {
+        adapter: ctx.adapter_name.clone(),
+        faces,
+        max_error: scene.max_error as f64,
+        png: encode_png(&rgba, size)?,
+        frame_seconds,
+        triangles_drawn: faces,
+        clusters_drawn: None,
     };
     scope.check("rendering the frame")?;
     Ok(frame)
